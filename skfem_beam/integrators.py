@@ -34,6 +34,7 @@ from .problem import check_beta, check_positive
 from .semidiscrete import SemiDiscrete
 
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(4)
+FAILED, UNSTABLE = 1, 2
 
 
 @dataclass
@@ -173,10 +174,13 @@ def _run(n0, n1, mode, kappa, save_every, frame_every, dt, beta,
          M2, Am, Achol, Mb, Kb, loads, G,
          Cp, Ci, Cx, lo, hi, W, D, Ddiag, state, active_prev,
          Ep, Ei, Ex, slo, shi, Op, Oi, Ox,
-         u_prev, u_cur, obs, obsv, energy, lam, frames, stats, counters):
-    """Steps n = n0..n1−1 (computing u^{n+1}); counters: [impacts, contact steps, qp its].
+         u_prev, u_cur, obs, obsv, energy, lam, frames, stats, counters, Ebound):
+    """Steps n = n0..n1−1 (computing u^{n+1}).
 
     mode: 0 no constraint, 1 projection, 2 active set, 3 penalty (stiffness kappa).
+    counters: [impacts, steps in contact, QP iterations, step where it stopped].
+    Returns 0, FAILED (a contact solve failed at counters[3]) or UNSTABLE (the energy
+    saved at state counters[3] is non-finite or above Ebound).
     """
     n = u_cur.size
     m = lo.size
@@ -200,14 +204,16 @@ def _run(n0, n1, mode, kappa, save_every, frame_every, dt, beta,
         if mode == 3:
             its = compliance_solve(D, yf, lo, hi, dt2 * beta * kappa, state, mu)
             if its < 0:
-                return step
+                counters[3] = step + 1
+                return FAILED
             counters[2] += its
         elif mode == 1:
             project(Ddiag, yf, lo, hi, mu)
         elif mode == 2:
             its = box_qp(D, yf, lo, hi, state, mu)
             if its < 0:
-                return step
+                counters[3] = step + 1
+                return FAILED
             counters[2] += its
         finish_step(x, W, mu, u_prev, u_cur)
         _values(Cp, Ci, Cx, u_cur, cy)
@@ -226,7 +232,10 @@ def _run(n0, n1, mode, kappa, save_every, frame_every, dt, beta,
         record(step + 1, save_every, frame_every, u_prev, u_cur, mu, dt, beta, Mb, Kb, dt2,
                Op, Oi, Ox, Ep, Ei, Ex, slo, shi, cy, lo, hi,
                obs, obsv, energy, lam, frames, stats, d)
-    return -1
+        if (step + 1) % save_every == 0 and not abs(energy[(step + 1) // save_every]) <= Ebound:
+            counters[3] = step + 1
+            return UNSTABLE
+    return 0
 
 
 @njit(cache=True)
@@ -263,13 +272,16 @@ def _csr(a):
 
 def solve(system: SemiDiscrete, dt: float, T: float, beta: float = 0.5, solver: str = "auto",
           stiffness: float | None = None, save_every: int = 1, frames: int = 200,
-          progress: bool | None = None, chunk: int = 20000,
-          growth_limit: float = 1e3) -> Result:
+          progress: bool | None = None, chunk: int = 20000, load_window: str = "forward",
+          growth_limit: float = 10.0) -> Result:
     """Integrate ``system`` over [0, T] with step ``dt``: the one entry point.
 
     ``solver`` names the contact solver (see :mod:`skfem_beam.contact`); with
     ``stiffness`` = κ the obstacles are instead one-sided springs (normal compliance,
     κ in the units of the semi-discrete equation, i.e. per unit mass for the beam).
+    ``load_window``: fⁿ averages f over [tₙ, tₙ+Δt] ("forward", the papers' choice) or
+    over [tₙ−Δt/2, tₙ+Δt/2] ("centered").  The forward window lags the load by Δt/2,
+    which makes a forced run first order in Δt; the centred one keeps it second order.
 
     The run stops with status "unstable" when the discrete energy exceeds
     ``growth_limit`` × the a-priori bound (√E¹ + Σ‖Gⁿ‖_{M⁻¹}Δt)² or a value turns
@@ -312,7 +324,9 @@ def solve(system: SemiDiscrete, dt: float, T: float, beta: float = 0.5, solver: 
 
     # load: time averages fⁿ for n = 0..N, then Gⁿ = βf^{n+1} + (1−2β)fⁿ + βf^{n−1}
     nK = system.loads.shape[1]
-    tgrid = np.arange(N + 1) * dt
+    if load_window not in ("forward", "centered"):
+        raise InputError(f"load_window={load_window!r} is not one of: forward, centered")
+    tgrid = np.arange(N + 1) * dt - (0.5 * dt if load_window == "centered" else 0.0)
     fbar = np.column_stack([time_averages(a, tgrid, dt) for a in system.load_time]) \
         if nK else np.zeros((N + 1, 0))
 
@@ -344,7 +358,7 @@ def solve(system: SemiDiscrete, dt: float, T: float, beta: float = 0.5, solver: 
     lam = np.zeros((nsave, m))
     fr = np.full((N // frame_every + 1, system.n), np.nan)
     stats = np.zeros(4)
-    counters = np.zeros(3, dtype=np.int64)
+    counters = np.zeros(4, dtype=np.int64)
     state = np.zeros(m, dtype=np.int8)
     active_prev = np.zeros(m, dtype=np.bool_)
 
@@ -388,37 +402,44 @@ def solve(system: SemiDiscrete, dt: float, T: float, beta: float = 0.5, solver: 
         from tqdm import tqdm
         bar = tqdm(total=N, unit="step", unit_scale=True, leave=False)
     wall = 0.0
-    last_good = 1
+    last_good = N
+    if pysolver is None:   # load the compiled kernel outside the timed loop (zero steps)
+        _run(1, 1, mode, kappa, save_every, frame_every, dt, beta, M2b.band, Amb.band, Ab.chol,
+             Mb.band, Kb.band, loads, G_all[:0], Cp, Ci, Cx, lo, hi, W, D, Ddiag, state,
+             active_prev, Ep, Ei, Ex, slo, shi, Op, Oi, Ox, u_prev, u_cur, obs, obsv, energy,
+             lam, fr, stats, counters, 0.0)
     for n0 in range(1, N, chunk):
         n1 = min(N, n0 + chunk)
         G = np.ascontiguousarray(G_all[n0 - 1:n1 - 1]) if nK else np.zeros((n1 - n0, 0))
+        Ebound = bound(n1)   # the bound grows with n: its chunk-end value is the loosest
         t0 = time.perf_counter()
         if pysolver is None:
-            failed = _run(n0, n1, mode, kappa, save_every, frame_every, dt, beta,
-                          M2b.band, Amb.band, Ab.chol, Mb.band, Kb.band, loads, G,
-                          Cp, Ci, Cx, lo, hi, W, D, Ddiag, state, active_prev,
-                          Ep, Ei, Ex, slo, shi, Op, Oi, Ox,
-                          u_prev, u_cur, obs, obsv, energy, lam, fr, stats, counters)
+            code = _run(n0, n1, mode, kappa, save_every, frame_every, dt, beta,
+                        M2b.band, Amb.band, Ab.chol, Mb.band, Kb.band, loads, G,
+                        Cp, Ci, Cx, lo, hi, W, D, Ddiag, state, active_prev,
+                        Ep, Ei, Ex, slo, shi, Op, Oi, Ox,
+                        u_prev, u_cur, obs, obsv, energy, lam, fr, stats, counters, Ebound)
         else:
-            failed = _python_chunk(pysolver, n0, n1, save_every, frame_every, dt, beta,
-                                   M2b, Amb, Ab, Mb, Kb, loads, G, Cp, Ci, Cx, lo, hi, W,
-                                   active_prev, Ep, Ei, Ex, slo, shi, Op, Oi, Ox,
-                                   u_prev, u_cur, obs, obsv, energy, lam, fr, stats, counters)
+            code = _python_chunk(pysolver, n0, n1, save_every, frame_every, dt, beta,
+                                 M2b, Amb, Ab, Mb, Kb, loads, G, Cp, Ci, Cx, lo, hi, W,
+                                 active_prev, Ep, Ei, Ex, slo, shi, Op, Oi, Ox,
+                                 u_prev, u_cur, obs, obsv, energy, lam, fr, stats, counters,
+                                 Ebound)
         wall += time.perf_counter() - t0
-        if failed >= 0:
-            raise SolverError(f"the {name} contact solver failed at step {failed + 1} "
-                              f"(t={(failed + 1) * dt:.6g} s)")
         if bar is not None:
             bar.update(n1 - n0)
-        k1 = n1 // save_every
-        E = energy[(n0 // save_every):k1 + 1]
-        Emax = np.nanmax(np.abs(E)) if np.isfinite(E).any() else np.inf
-        if not np.isfinite(u_cur).all() or not np.isfinite(E).all() or Emax > bound(n1):
+        if code == FAILED:
+            k = int(counters[3])
+            raise SolverError(f"the {name} contact solver failed at step {k} (t={k * dt:.6g} s)")
+        if code == UNSTABLE:
+            k = int(counters[3])
+            limit = linear_stability_limit(kappa_h(system), beta)
             status = "unstable"
-            message = (f"unstable between step {n0} (t={n0 * dt:.6g} s) and step {n1} "
-                       f"(t={n1 * dt:.6g} s): energy {Emax:.3g} exceeds {bound(n1):.3g}")
+            message = (f"unstable at step {k} (t={k * dt:.6g} s): energy "
+                       f"{energy[k // save_every]:.3g} exceeds {Ebound:.3g}; dt={dt:g} s, "
+                       f"beta={beta:g}, linear stability limit 2/√(κ_h(1−4β)) = {limit:.4g} s")
+            last_good = (k // save_every - 1) * save_every
             break
-        last_good = n1
     if bar is not None:
         bar.close()
 
@@ -443,7 +464,8 @@ def solve(system: SemiDiscrete, dt: float, T: float, beta: float = 0.5, solver: 
 
 def _python_chunk(pysolver, n0, n1, save_every, frame_every, dt, beta, M2b, Amb, Ab, Mb, Kb,
                   loads, G, Cp, Ci, Cx, lo, hi, W, active_prev, Ep, Ei, Ex, slo, shi,
-                  Op, Oi, Ox, u_prev, u_cur, obs, obsv, energy, lam, fr, stats, counters):
+                  Op, Oi, Ox, u_prev, u_cur, obs, obsv, energy, lam, fr, stats, counters,
+                  Ebound):
     """The same step as `_run`, with the contact solve done by a Python-level engine."""
     n, m = u_cur.size, lo.size
     x, yf, d = np.empty(n), np.empty(m), np.empty(n)
@@ -465,4 +487,7 @@ def _python_chunk(pysolver, n0, n1, save_every, frame_every, dt, beta, M2b, Amb,
         record(step + 1, save_every, frame_every, u_prev, u_cur, mu, dt, beta, Mb.band,
                Kb.band, dt2, Op, Oi, Ox, Ep, Ei, Ex, slo, shi, cy, lo, hi,
                obs, obsv, energy, lam, fr, stats, d)
-    return -1
+        if (step + 1) % save_every == 0 and not abs(energy[(step + 1) // save_every]) <= Ebound:
+            counters[3] = step + 1
+            return UNSTABLE
+    return 0

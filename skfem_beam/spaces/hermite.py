@@ -79,7 +79,7 @@ class HermiteSpace:
             phi = b.basis[i][0]
             r.append(rows)
             c.append(np.broadcast_to(b.element_dofs[i][:, None], (ne, nq)))
-            v0.append(phi.value)
+            v0.append(np.asarray(phi))
             v2.append(phi.hess[0, 0])
         r, c = np.concatenate(r).ravel(), np.concatenate(c).ravel()
         shape = (ne * nq, b.N)

@@ -1,0 +1,1 @@
+"""One module per scene; each is a thin command line over the Python API."""

@@ -1,0 +1,95 @@
+"""What every case's command line shares: flags, one-line errors, exit codes.
+
+Exit codes: 0 success, 2 bad input, 3 a solver failed, 4 the run went unstable
+(its files up to the last good step are written, with status "unstable").
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+
+from . import __version__
+from .contact import SOLVERS
+from .errors import InputError, SolverError
+
+EXIT_INPUT, EXIT_SOLVER, EXIT_UNSTABLE = 2, 3, 4
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse, but a bad flag gives one line on stderr, not a usage block."""
+
+    def error(self, message):
+        self.exit(EXIT_INPUT, f"{self.prog}: error: {message}\n")
+
+
+def parser(prog: str, description: str, *, J=None, dt=None, T=None, beta=0.5,
+           element=True, solver=True) -> Parser:
+    """The flags every scene takes; a scene adds its own."""
+    p = Parser(prog=prog, description=description,
+               formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    if J is not None:
+        p.add_argument("--J", type=int, default=J, help="number of elements")
+    p.add_argument("--dt", type=float, default=dt, help="time step (s)")
+    p.add_argument("--T", type=float, default=T, help="final time (s)")
+    p.add_argument("--beta", type=float, default=beta, help="Newmark β in [0, 1/2]")
+    if element:
+        p.add_argument("--element", default="hermite", help="hermite | bspline")
+    if solver:
+        p.add_argument("--solver", default="auto", help=" | ".join(SOLVERS))
+    p.add_argument("--method", default="contact",
+                   help="contact (contact-implicit scheme) | penalty (normal compliance)")
+    p.add_argument("--stiffness", type=float, default=1e8,
+                   help="penalty stiffness 1/ε (N/m) for --method penalty")
+    p.add_argument("--save-every", type=int, default=1,
+                   help="keep every n-th step in timeseries.csv")
+    p.add_argument("--frames", type=int, default=200, help="field snapshots kept")
+    p.add_argument("--out", default=f"out/{prog.rsplit('.', 1)[-1]}", help="output folder")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing --out folder")
+    p.add_argument("--version", action="version", version=f"skfem_beam {__version__}")
+    return p
+
+
+def check_method(args) -> None:
+    if args.method not in ("contact", "penalty"):
+        raise InputError(f"--method {args.method!r} is not one of: contact, penalty")
+
+
+def main_guard(main) -> None:
+    """Run ``main()``; turn the project's errors into one stderr line and an exit code."""
+    try:
+        code = main()
+    except InputError as e:
+        print(f"error: {e}", file=sys.stderr)
+        sys.exit(EXIT_INPUT)
+    except SolverError as e:
+        print(f"error: {e}", file=sys.stderr)
+        sys.exit(EXIT_SOLVER)
+    except OSError as e:   # disk full, folder removed under us, ...
+        print(f"error: could not write the results: {e}", file=sys.stderr)
+        sys.exit(EXIT_SOLVER)
+    except KeyboardInterrupt:
+        print("interrupted: no output written", file=sys.stderr)
+        sys.exit(130)
+    sys.exit(code or 0)
+
+
+def warn(message: str) -> None:
+    print(f"warning: {message}", file=sys.stderr)
+
+
+def report(result, out) -> int:
+    """One line on stdout for a finished run; the exit code."""
+    if result.status != "success":
+        print(f"error: {result.message}; results up to t={result.t[-1]:.6g} s written to {out}",
+              file=sys.stderr)
+        return EXIT_UNSTABLE
+    print(f"{result.steps} steps in {result.wall_time_s:.3g} s "
+          f"({1e6 * result.wall_time_s / max(1, result.steps):.3g} µs/step), "
+          f"{result.impacts} impacts, max nodal violation {result.max_nodal_violation:.2e} m"
+          f" -> {out}")
+    return 0
+
+
+def stamp() -> dict:
+    return {"package_version": __version__, "written": time.strftime("%Y-%m-%dT%H:%M:%S%z")}

@@ -1,0 +1,81 @@
+"""Output folders that are never half written, and the files of the output contract.
+
+A run writes into a hidden sibling folder and renames it into place at the end, so a
+failed or interrupted run leaves no partial ``--out`` folder behind.
+"""
+from __future__ import annotations
+
+import csv
+import json
+import os
+import shutil
+import tempfile
+from contextlib import contextmanager
+from pathlib import Path
+
+import numpy as np
+
+from .errors import InputError
+
+
+def check_output_dir(out: str | os.PathLike, overwrite: bool = False) -> Path:
+    """Refuse an ``--out`` that cannot be written, or holds another run (unless overwrite)."""
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise InputError(f"--out {out} exists and is not a folder")
+    if out.is_dir() and any(out.iterdir()) and not overwrite:
+        raise InputError(f"--out {out} already holds files; pass --overwrite to replace them")
+    parent = out.resolve().parent
+    if not parent.is_dir():
+        raise InputError(f"--out {out}: parent folder {parent} does not exist")
+    try:   # a real probe: permission bits say little (root, read-only mounts, /proc)
+        os.rmdir(tempfile.mkdtemp(prefix=f".{out.name}.", dir=parent))
+    except OSError as e:
+        raise InputError(f"--out {out}: folder {parent} is not writable ({e.strerror})") from None
+    return out
+
+
+@contextmanager
+def output_dir(out: str | os.PathLike, overwrite: bool = False):
+    """Yield a temporary folder; on success it replaces ``out`` in one rename."""
+    out = check_output_dir(out, overwrite)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.resolve().parent))
+    try:
+        yield tmp
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    if out.exists():
+        shutil.rmtree(out)
+    os.replace(tmp, out)
+
+
+def _plain(value):
+    """JSON-friendly: numpy scalars to Python, non-finite floats to strings."""
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not np.isfinite(value):
+        return str(value)
+    return value
+
+
+def write_summary(folder: Path, summary: dict) -> None:
+    with open(folder / "summary.json", "w") as fh:
+        json.dump(_plain(summary), fh, indent=2, ensure_ascii=False)
+        fh.write("\n")
+
+
+def write_timeseries(folder: Path, columns: dict[str, np.ndarray],
+                     name: str = "timeseries.csv") -> None:
+    """One CSV with a header row; columns of equal length."""
+    keys = list(columns)
+    data = np.column_stack([np.asarray(columns[k], dtype=float) for k in keys])
+    with open(folder / name, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(keys)
+        for row in data:
+            w.writerow([f"{v:.12g}" for v in row])

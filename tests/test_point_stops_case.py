@@ -1,0 +1,105 @@
+"""The point-stops case end to end, and its refusals of bad input."""
+import csv
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from skfem_beam.cases import point_stops
+from skfem_beam.cli import main_guard
+from skfem_beam import Beam, BeamProblem, InitialState, InputError, Obstacles, beam_system, solve
+
+CASE = [sys.executable, "-m", "skfem_beam.cases.point_stops"]
+
+
+def run(args, **kw):
+    return subprocess.run(CASE + args, capture_output=True, text=True, timeout=300, **kw)
+
+
+def test_case_runs_end_to_end(tmp_path):
+    out = tmp_path / "run"
+    p = run(["--T", "0.3", "--out", str(out)])
+    assert p.returncode == 0, p.stderr
+    files = {f.name for f in out.iterdir()}
+    assert {"summary.json", "timeseries.csv", "tip_displacement.png"} <= files
+    s = json.loads((out / "summary.json").read_text())
+    for key in ("case", "J", "dt", "T", "beta", "element", "solver", "steps", "wall_time_s",
+                "max_penetration", "max_nodal_violation", "energy_final", "impacts"):
+        assert key in s
+    assert s["steps"] == 6000 and s["solver"] == "projection" and s["status"] == "success"
+    assert s["max_nodal_violation"] == 0.0 and s["impacts"] >= 1
+    rows = list(csv.DictReader(open(out / "timeseries.csv")))
+    assert len(rows) == 6001
+    tip = np.array([float(r["tip_displacement"]) for r in rows])
+    assert np.abs(tip).max() <= 0.1 * (1 + 1e-15) and tip.max() == pytest.approx(0.1, abs=1e-15)
+    assert {"t", "tip_velocity", "energy", "contact_force", "contact_force_N"} <= set(rows[0])
+
+
+def test_case_matches_the_api(tmp_path, pipe):
+    """The command line is a thin shell: same numbers as the API."""
+    out = tmp_path / "run"
+    assert run(["--T", "0.2", "--out", str(out)]).returncode == 0
+    rows = list(csv.DictReader(open(out / "timeseries.csv")))
+    r = solve(beam_system(pipe), 5e-5, 0.2, 0.5)
+    tip = np.array([float(x["tip_displacement"]) for x in rows])
+    assert np.abs(tip - r.observed["tip_displacement"]).max() < 1e-12
+
+
+@pytest.mark.parametrize("args, word", [
+    (["--J", "0"], "J=0"), (["--J", "-3"], "J=-3"), (["--J", "x"], "--J"),
+    (["--dt", "0"], "dt=0"), (["--dt=-1e-5"], "dt=-1e-05"), (["--dt", "-1e-5"], "--dt"),
+    (["--L", "0"], "L=0"), (["--k2", "-1"], "k2=-1"), (["--beta", "0.6"], "beta=0.6"),
+    (["--beta", "-0.1"], "beta=-0.1"), (["--gap", "0"], "gap=0"), (["--dt", "nan"], "dt=nan"),
+    (["--k2", "inf"], "k2=inf"), (["--T", "0"], "T=0"), (["--element", "p2"], "element='p2'"),
+    (["--solver", "magic"], "solver='magic'"), (["--method", "springs"], "--method"),
+])
+def test_bad_input_one_line_no_output(tmp_path, capsys, args, word):
+    """In-process through the same guard as ``python -m`` (a subprocess each is slow)."""
+    out = tmp_path / "run"
+    with pytest.raises(SystemExit) as exit_:
+        main_guard(lambda: point_stops.main(["--T", "0.01", "--out", str(out)] + args))
+    assert exit_.value.code == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and word in lines[0], lines
+    assert not out.exists()
+    assert not list(tmp_path.iterdir())   # no hidden partial folder either
+
+
+def test_bad_input_through_python_m(tmp_path):
+    p = run(["--J", "0", "--out", str(tmp_path / "run")])
+    assert p.returncode == 2 and p.stderr.strip() == "error: J=0 must be a whole number ≥ 1"
+    assert not list(tmp_path.iterdir())
+
+
+def test_unwritable_out_and_existing_results(tmp_path):
+    p = run(["--T", "0.01", "--out", "/proc/forbidden/run"])
+    assert p.returncode == 2 and len(p.stderr.strip().splitlines()) == 1
+    out = tmp_path / "run"
+    assert run(["--T", "0.01", "--out", str(out)]).returncode == 0
+    p = run(["--T", "0.01", "--out", str(out)])
+    assert p.returncode == 2 and "--overwrite" in p.stderr
+    assert run(["--T", "0.02", "--out", str(out), "--overwrite"]).returncode == 0
+    assert json.loads((out / "summary.json").read_text())["steps"] == 400
+
+
+def test_unstable_run_exit_code_and_valid_files(tmp_path):
+    out = tmp_path / "run"
+    p = run(["--beta", "0.1", "--dt", "1.92e-5", "--T", "0.1", "--out", str(out)])
+    assert p.returncode == 4
+    assert "warning" in p.stderr and "unstable at step" in p.stderr
+    s = json.loads((out / "summary.json").read_text())
+    assert s["status"] == "unstable"
+    data = np.genfromtxt(out / "timeseries.csv", delimiter=",", names=True)
+    assert np.isfinite(data.view((float, len(data.dtype)))).all()
+
+
+def test_api_refuses_bad_obstacles_and_initial_state():
+    with pytest.raises(InputError, match="g1 ≥ g2"):
+        BeamProblem(Beam(1.0, 1.0), Obstacles.point_stops(1.0, 0.1, -0.1), J=4)
+    with pytest.raises(InputError, match="u0 violates"):
+        beam_system(BeamProblem(Beam(1.0, 1.0), Obstacles.point_stops(1.0, -0.01, 0.01),
+                                initial=InitialState(u0=lambda x: 0.1 * x**2), J=4))
+    with pytest.raises(InputError, match="break point"):
+        BeamProblem(Beam(1.0, 1.0), Obstacles.point_stops(0.55, -0.01, 0.01), J=4)

@@ -29,7 +29,7 @@ from .contact.active_set import box_qp
 from .contact.penalty import compliance_solve, spring_force
 from .contact.projection import project
 from .errors import InputError, SolverError
-from .linalg import Banded, band_dot, band_matvec, band_solve
+from .linalg import Banded, band_solve, rows_dot, rows_matvec2
 from .problem import check_beta, check_positive
 from .semidiscrete import SemiDiscrete
 
@@ -84,9 +84,7 @@ def free_step(M2, Am, Achol, loads, g, u_prev, u_cur, dt2, Cp, Ci, Cx, x, yf, r_
     ``r_expl``: explicit part of a penalty force on the constrained values (zero for
     Signorini), added to the load as Δt² Cᵀ r_expl.
     """
-    x[:] = 0.0
-    band_matvec(M2, u_cur, x, 1.0)
-    band_matvec(Am, u_prev, x, -1.0)
+    rows_matvec2(M2, u_cur, Am, u_prev, x)
     for k in range(g.size):
         c = dt2 * g[k]
         for i in range(x.size):
@@ -115,16 +113,18 @@ def finish_step(x, W, mu, u_prev, u_cur):
 
 
 @njit(cache=True)
-def energy_beta(Mb, Kb, u_prev, u_cur, dt, beta, d):
-    """E_β = δᵀ(M/Δt² + βK)δ + uⁿᵀ K uⁿ⁻¹,  δ = uⁿ − uⁿ⁻¹ (exactly conserved without contact)."""
+def energy_beta(Eb, Kb, u_prev, u_cur, d):
+    """E_β = δᵀ(M/Δt² + βK)δ + uⁿᵀ K uⁿ⁻¹,  δ = uⁿ − uⁿ⁻¹ (exactly conserved without contact).
+
+    ``Eb`` is M/Δt² + βK and ``Kb`` is K, both in row layout.
+    """
     for i in range(d.size):
         d[i] = u_cur[i] - u_prev[i]
-    return (band_dot(Mb, d, d) / dt**2 + beta * band_dot(Kb, d, d)
-            + band_dot(Kb, u_cur, u_prev))
+    return rows_dot(Eb, d, d) + rows_dot(Kb, u_cur, u_prev)
 
 
 @njit(cache=True)
-def record(n, save_every, frame_every, u_prev, u_cur, mu, dt, beta, Mb, Kb, dt2,
+def record(n, save_every, frame_every, u_prev, u_cur, mu, dt, Eb, Kb, dt2,
            Op, Oi, Ox, Ep, Ei, Ex, slo, shi, C_y, lo, hi,
            obs, obsv, energy, lam, frames, stats, d):
     """Diagnostics after state n: penetration (every step), saved series, frames.
@@ -153,7 +153,7 @@ def record(n, save_every, frame_every, u_prev, u_cur, mu, dt, beta, Mb, Kb, dt2,
                 sv += Ox[p] * (u_cur[Oi[p]] - u_prev[Oi[p]])
             obs[k, r] = s
             obsv[k, r] = sv / dt
-        energy[k] = 0.5 * energy_beta(Mb, Kb, u_prev, u_cur, dt, beta, d)
+        energy[k] = 0.5 * energy_beta(Eb, Kb, u_prev, u_cur, d)
         for j in range(mu.size):
             lam[k, j] = mu[j] / dt2
     if n % frame_every == 0:
@@ -171,7 +171,7 @@ def _penalty_explicit(beta, kappa, y_cur, y_prev, lo, hi, r_cur, r_prev, r_expl)
 
 @njit(cache=True)
 def _run(n0, n1, mode, kappa, save_every, frame_every, dt, beta,
-         M2, Am, Achol, Mb, Kb, loads, G,
+         M2, Am, Achol, Eb, Kb, loads, G,
          Cp, Ci, Cx, lo, hi, W, D, Ddiag, state, active_prev,
          Ep, Ei, Ex, slo, shi, Op, Oi, Ox,
          u_prev, u_cur, obs, obsv, energy, lam, frames, stats, counters, Ebound):
@@ -229,7 +229,7 @@ def _run(n0, n1, mode, kappa, save_every, frame_every, dt, beta,
                 mu[j] += dt2 * r_expl[j]
         if any_active:
             counters[1] += 1
-        record(step + 1, save_every, frame_every, u_prev, u_cur, mu, dt, beta, Mb, Kb, dt2,
+        record(step + 1, save_every, frame_every, u_prev, u_cur, mu, dt, Eb, Kb, dt2,
                Op, Oi, Ox, Ep, Ei, Ex, slo, shi, cy, lo, hi,
                obs, obsv, energy, lam, frames, stats, d)
         if (step + 1) % save_every == 0 and not abs(energy[(step + 1) // save_every]) <= Ebound:
@@ -303,7 +303,7 @@ def solve(system: SemiDiscrete, dt: float, T: float, beta: float = 0.5, solver: 
     Am = M + dt**2 * beta * K - (0.5 * dt * B if B is not None else 0)
     M2 = 2 * M - dt**2 * (1 - 2 * beta) * K
     Ab = Banded(A, factor=True)
-    M2b, Amb, Mb, Kb = Banded(M2), Banded(Am), Banded(M), Banded(K)
+    M2b, Amb, Eb, Kb = Banded(M2), Banded(Am), Banded(M / dt**2 + beta * K), Banded(K)
 
     C = system.C.tocsr()
     m = C.shape[0]
@@ -380,12 +380,12 @@ def solve(system: SemiDiscrete, dt: float, T: float, beta: float = 0.5, solver: 
     # states 0 and 1 (E_β needs two states: the energy saved at t = 0 is E_β¹)
     obs[0] = Orows @ u_prev
     obsv[0] = Orows @ system.v0
-    record(1, save_every, frame_every, u_prev, u_cur, np.zeros(m), dt, beta, Mb.band, Kb.band,
+    record(1, save_every, frame_every, u_prev, u_cur, np.zeros(m), dt, Eb.rows, Kb.rows,
            dt**2, Op, Oi, Ox, Ep, Ei, Ex, slo, shi, C @ u_cur, lo, hi,
            obs, obsv, energy, lam, fr, stats, d)
     fr[0] = u_prev
 
-    E1 = 0.5 * energy_beta(Mb.band, Kb.band, u_prev, u_cur, dt, beta, d)
+    E1 = 0.5 * energy_beta(Eb.rows, Kb.rows, u_prev, u_cur, d)
     energy[0] = E1
     Minv_norm = np.sqrt(np.array([lv @ scipy.sparse.linalg.spsolve(M.tocsc(), lv)
                                   for lv in loads.T])) if nK else np.zeros(0)
@@ -404,8 +404,8 @@ def solve(system: SemiDiscrete, dt: float, T: float, beta: float = 0.5, solver: 
     wall = 0.0
     last_good = N
     if pysolver is None:   # load the compiled kernel outside the timed loop (zero steps)
-        _run(1, 1, mode, kappa, save_every, frame_every, dt, beta, M2b.band, Amb.band, Ab.chol,
-             Mb.band, Kb.band, loads, G_all[:0], Cp, Ci, Cx, lo, hi, W, D, Ddiag, state,
+        _run(1, 1, mode, kappa, save_every, frame_every, dt, beta, M2b.rows, Amb.rows, Ab.chol,
+             Eb.rows, Kb.rows, loads, G_all[:0], Cp, Ci, Cx, lo, hi, W, D, Ddiag, state,
              active_prev, Ep, Ei, Ex, slo, shi, Op, Oi, Ox, u_prev, u_cur, obs, obsv, energy,
              lam, fr, stats, counters, 0.0)
     for n0 in range(1, N, chunk):
@@ -415,13 +415,13 @@ def solve(system: SemiDiscrete, dt: float, T: float, beta: float = 0.5, solver: 
         t0 = time.perf_counter()
         if pysolver is None:
             code = _run(n0, n1, mode, kappa, save_every, frame_every, dt, beta,
-                        M2b.band, Amb.band, Ab.chol, Mb.band, Kb.band, loads, G,
+                        M2b.rows, Amb.rows, Ab.chol, Eb.rows, Kb.rows, loads, G,
                         Cp, Ci, Cx, lo, hi, W, D, Ddiag, state, active_prev,
                         Ep, Ei, Ex, slo, shi, Op, Oi, Ox,
                         u_prev, u_cur, obs, obsv, energy, lam, fr, stats, counters, Ebound)
         else:
             code = _python_chunk(pysolver, n0, n1, save_every, frame_every, dt, beta,
-                                 M2b, Amb, Ab, Mb, Kb, loads, G, Cp, Ci, Cx, lo, hi, W,
+                                 M2b, Amb, Ab, Eb, Kb, loads, G, Cp, Ci, Cx, lo, hi, W,
                                  active_prev, Ep, Ei, Ex, slo, shi, Op, Oi, Ox,
                                  u_prev, u_cur, obs, obsv, energy, lam, fr, stats, counters,
                                  Ebound)
@@ -462,7 +462,7 @@ def solve(system: SemiDiscrete, dt: float, T: float, beta: float = 0.5, solver: 
         qp_iterations=int(counters[2]), system=system)
 
 
-def _python_chunk(pysolver, n0, n1, save_every, frame_every, dt, beta, M2b, Amb, Ab, Mb, Kb,
+def _python_chunk(pysolver, n0, n1, save_every, frame_every, dt, beta, M2b, Amb, Ab, Eb, Kb,
                   loads, G, Cp, Ci, Cx, lo, hi, W, active_prev, Ep, Ei, Ex, slo, shi,
                   Op, Oi, Ox, u_prev, u_cur, obs, obsv, energy, lam, fr, stats, counters,
                   Ebound):
@@ -471,7 +471,7 @@ def _python_chunk(pysolver, n0, n1, save_every, frame_every, dt, beta, M2b, Amb,
     x, yf, d = np.empty(n), np.empty(m), np.empty(n)
     dt2 = dt * dt
     for step in range(n0, n1):
-        free_step(M2b.band, Amb.band, Ab.chol, loads, G[step - n0], u_prev, u_cur, dt2,
+        free_step(M2b.rows, Amb.rows, Ab.chol, loads, G[step - n0], u_prev, u_cur, dt2,
                   Cp, Ci, Cx, x, yf)
         try:
             mu, its = pysolver.solve(x, yf)
@@ -484,8 +484,8 @@ def _python_chunk(pysolver, n0, n1, save_every, frame_every, dt, beta, M2b, Amb,
         active_prev[:] = active
         counters[1] += int(active.any())
         cy = np.array([Cx[Cp[j]:Cp[j + 1]] @ u_cur[Ci[Cp[j]:Cp[j + 1]]] for j in range(m)])
-        record(step + 1, save_every, frame_every, u_prev, u_cur, mu, dt, beta, Mb.band,
-               Kb.band, dt2, Op, Oi, Ox, Ep, Ei, Ex, slo, shi, cy, lo, hi,
+        record(step + 1, save_every, frame_every, u_prev, u_cur, mu, dt, Eb.rows,
+               Kb.rows, dt2, Op, Oi, Ox, Ep, Ei, Ex, slo, shi, cy, lo, hi,
                obs, obsv, energy, lam, fr, stats, d)
         if (step + 1) % save_every == 0 and not abs(energy[(step + 1) // save_every]) <= Ebound:
             counters[3] = step + 1

@@ -29,3 +29,27 @@ def trajectory_chart(path, t, series: dict, stops=(), title="", ylabel="displace
 
 def energy_chart(path, t, energy, title="discrete energy ½E_β"):
     trajectory_chart(path, t, {"energy": energy}, title=title, ylabel="energy (m³/s²)")
+
+
+def shape_chart(path, result, count=14, title=""):
+    """The beam u(x, t_k) at ``count`` saved frames with the obstacles (papers' Figs 1–3)."""
+    system = result.system
+    sampler = system.space.sampler(np.linspace(0.0, 1.0, 9))
+    fig, ax = plt.subplots(figsize=(9, 4), dpi=110)
+    idx = np.unique(np.linspace(0, len(result.frames_t) - 1, count).astype(int))
+    cmap = plt.get_cmap("viridis")
+    for i, k in enumerate(idx):
+        ax.plot(sampler.x, sampler.E0 @ result.frames_u[k], lw=0.9, color=cmap(i / max(1, len(idx) - 1)),
+                label=f"t={result.frames_t[k]:.3g} s" if i in (0, len(idx) - 1) else None)
+    if system.sample_x is not None and system.sample_x.size:
+        for g in (system.sample_lo, system.sample_hi):
+            gx = np.where(np.isfinite(g), g, np.nan)
+            ax.plot(system.sample_x, gx, "k", lw=1.5)
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("u (m)")
+    ax.set_title(title)
+    ax.legend(loc="best", fontsize=8)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)

@@ -6,13 +6,16 @@ import numpy as np
 from .. import cli
 from ..integrators import kappa_h, linear_stability_limit, solve
 from ..io import check_output_dir, output_dir, write_summary, write_timeseries
-from ..plotting import energy_chart, trajectory_chart
+from ..plotting import energy_chart, shape_chart, trajectory_chart
 from ..problem import check_beta, check_positive
 from ..semidiscrete import beam_system
 
 
-def run_beam_case(case: str, problem, args, config: dict, stops=()) -> int:
-    """Discretise ``problem``, run it with the flags in ``args``, write DIR, return exit code."""
+def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) -> int:
+    """Discretise ``problem``, run it with the flags in ``args``, write DIR, return exit code.
+
+    ``extra(folder, result)`` may write more files into the output folder.
+    """
     cli.check_method(args)
     check_beta(args.beta)
     check_positive("dt", args.dt)
@@ -72,4 +75,7 @@ def run_beam_case(case: str, problem, args, config: dict, stops=()) -> int:
         if np.any(force):
             trajectory_chart(tmp / "contact_force.png", result.t, {"contact force": force},
                              title=f"{case}: net contact force", ylabel="force (m²/s²)")
+        shape_chart(tmp / "beam_shapes.png", result, title=f"{case}: u(x, t) at saved times")
+        if extra is not None:
+            extra(tmp, result)
     return cli.report(result, out)

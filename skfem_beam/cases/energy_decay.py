@@ -1,0 +1,53 @@
+"""Energy of the discrete scheme with f = 0: constant between impacts, dropping at impacts.
+
+    python -m skfem_beam.cases.energy_decay [--beta 0.5] [--compare-beta 0.25] ...
+
+The second paper's Figs 4–7: u0 = 0.005 x², v0 = −x, g = ±(0.2 + 0.3 (x − L/2)²).
+Writes the usual folder for --beta, plus energy.csv / energy_decay.png with the
+energy history ½E_β^n of --beta and of --compare-beta side by side.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .. import cli
+from ..integrators import solve
+from ..io import write_timeseries
+from ..plotting import trajectory_chart
+from ..problem import InitialState, Load, check_beta, check_positive
+from ..semidiscrete import beam_system
+from . import _longitudinal
+from ._beam import run_beam_case
+from .convex_obstacles import obstacles as convex
+
+
+def main(argv=None) -> int:
+    p = _longitudinal.parser("skfem_beam.cases.energy_decay", __doc__, T=1.0)
+    p.add_argument("--compare-beta", type=float, default=0.25,
+                   help="a second β whose energy is charted beside --beta (negative: none)")
+    args = p.parse_args(argv)
+    check_positive("L", args.L)
+    other = None if args.compare_beta < 0 else check_beta(args.compare_beta)
+    pb = _longitudinal.problem(args, convex(args.L, 0.2, 0.3), load=Load(),
+                               initial=InitialState(u0=lambda x: 0.005 * x**2,
+                                                    du0=lambda x: 0.01 * x,
+                                                    v0=lambda x: -x))
+
+    def energy_files(folder, result):
+        columns = {"t": result.t, f"energy_beta_{result.beta:g}": result.energy}
+        if other is not None:
+            r2 = solve(beam_system(pb), args.dt, args.T, other, solver=args.solver,
+                       save_every=args.save_every, frames=2)
+            columns[f"energy_beta_{other:g}"] = r2.energy[:result.t.size]
+        write_timeseries(folder, columns, "energy.csv")
+        trajectory_chart(folder / "energy_decay.png", result.t,
+                         {k: v for k, v in columns.items() if k != "t"},
+                         title=f"discrete energy ½E_β, f = 0 (J={pb.J}, {pb.element}, Δt={args.dt:g} s)",
+                         ylabel="energy (m³/s²)")
+
+    config = {"f": "0", "u0": "0.005 x²", "v0": "-x", "g": "±(0.2 + 0.3 (x − L/2)²)"}
+    return run_beam_case("energy_decay", pb, args, config, extra=energy_files)
+
+
+if __name__ == "__main__":
+    cli.main_guard(main)

@@ -149,8 +149,8 @@ class Load:
 class InitialState:
     """u(x,0) = u0(x), u_t(x,0) = v0(x) (functions of x; None means zero).
 
-    ``du0`` (the slope of u0) is used by the Hermite interpolant; when omitted it is
-    computed by a centred difference.
+    ``du0`` (the slope of u0) is used by the interpolants (Hermite: slopes at the nodes;
+    B-spline: the tip slope); when omitted it is computed by a five-point difference.
     """
     u0: Profile | None = None
     v0: Profile | None = None

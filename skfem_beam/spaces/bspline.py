@@ -24,7 +24,7 @@ from skfem.quadrature import get_quadrature
 from skfem.refdom import RefLine
 
 from ..errors import InputError
-from .hermite import Sampler
+from .hermite import Sampler, five_point_slope
 
 _t = Polynomial([0.0, 1.0])
 # the paper's shape functions on one element, in ξ: B_{e-1}, B_e, B_{e+1}, B_{e+2}
@@ -137,9 +137,7 @@ class BSplineSpace:
         """
         J, h, L = self.J, self._hu, self.nodes[-1]
         if du is None:
-            e = 1e-3 * (L - self.nodes[0])
-            du = lambda z: (u(z - 2 * e) - 8 * u(z - e)                # noqa: E731
-                            + 8 * u(z + e) - u(z + 2 * e)) / (12 * e)
+            du = five_point_slope(u, 1e-3 * (L - self.nodes[0]))
         # u'(x_J) = (c_{J+1} − c_{J−1}) / 2h in B-spline coefficients (full indices J, J+2)
         slope = sp.csr_matrix(([-0.5 / h, 0.5 / h], ([0, 0], [J, J + 2])), shape=(1, J + 3))
         A = sp.vstack([self.C, self._reduce_cols(slope)]).tocsc()

@@ -69,15 +69,6 @@ class LagrangeSpace:
         self.S = stiffness.assemble(self._basis).tocsr()
         self.C = sp.identity(self.n, format="csr")
 
-    def value_row(self, x0: float) -> np.ndarray:
-        """The row vector r with u(x0) = r · coefficients (hat functions at x0)."""
-        x = self.nodes
-        j = int(np.clip(np.searchsorted(x, x0) - 1, 0, self.J - 1))
-        s = (x0 - x[j]) / self.h[j]
-        r = np.zeros(self.n)
-        r[j], r[j + 1] = 1.0 - s, s
-        return r
-
     def sampler(self, xi) -> Sampler:
         """Values at local abscissae ξ of every element; P1 has no second derivative
         inside an element, so ``E2`` is zero."""

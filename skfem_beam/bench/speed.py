@@ -1,0 +1,107 @@
+"""Per-step cost and whole-run wall time of every scene and solver, beside the floor.
+
+    python -m skfem_beam.bench.speed [--quick] [--out docs/speed.json]
+
+The floor is one pre-factored banded Cholesky solve (LAPACK dpbtrs) per step of the
+same matrix A, timed in the same run.  Each configuration runs in a fresh child process
+so that its peak resident memory (ru_maxrss) is its own; times are the best of
+``--repeat`` runs of the time loop alone (the result's wall_time_s).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import resource
+import subprocess
+import sys
+
+# (label, scene, parameters, target seconds for the time loop or None)
+CONFIGS = [
+    ("point stops J=19 dt=5e-5 T=2", "point_stops", dict(dt=5e-5, T=2.0), 0.1),
+    ("point stops J=19 dt=1e-6 T=2 (save every 50)", "point_stops",
+     dict(dt=1e-6, T=2.0, save_every=50), 5.0),
+    ("convex J=40 hermite dt=1e-3 T=1", "convex", dict(J=40, dt=1e-3, T=1.0), 0.05),
+    ("convex J=40 bspline dt=1e-3 T=1", "convex", dict(J=40, dt=1e-3, T=1.0, element="bspline"), 0.05),
+    ("convex J=160 hermite dt=1e-3 T=1", "convex", dict(J=160, dt=1e-3, T=1.0), 0.5),
+    ("convex J=160 bspline dt=1e-3 T=1", "convex", dict(J=160, dt=1e-3, T=1.0, element="bspline"), 0.5),
+    ("convex J=40 hermite dt=1e-4 T=1", "convex", dict(J=40, dt=1e-4, T=1.0), 0.5),
+    ("flat J=40 hermite dt=1e-3 T=1", "flat", dict(J=40, dt=1e-3, T=1.0), None),
+]
+SOLVERS = {"point_stops": ["projection", "active-set", "daqp", "osqp"],
+           "convex": ["active-set", "daqp", "osqp"], "flat": ["active-set", "daqp", "osqp"]}
+SLOW = {"osqp", "daqp"}   # Python-level engines: only on the short configurations
+
+
+def build(scene: str, p: dict):
+    from ..cases import convex_obstacles, flat_obstacles, point_stops
+    from ..problem import Beam, BeamProblem, Load
+    import numpy as np
+    if scene == "point_stops":
+        return point_stops.problem(J=p.get("J", 19), element=p.get("element", "hermite"))
+    L = 10.0
+    obst = convex_obstacles.obstacles(L) if scene == "convex" else flat_obstacles.obstacles(L)
+    return BeamProblem(Beam(L, 282.84), obst, load=Load.uniform(lambda t: np.sin(10 * t)),
+                       J=p.get("J", 40), element=p.get("element", "hermite"))
+
+
+def child(scene: str, p: dict, solver: str, repeat: int) -> dict:
+    """Runs in the child process: the timings of one configuration."""
+    from ..integrators import solve
+    from ..semidiscrete import beam_system
+    from ._floor import banded_solve_floor
+    system = beam_system(build(scene, p))
+    kw = dict(dt=p["dt"], T=p["T"], beta=0.5, solver=solver,
+              save_every=p.get("save_every", 1), frames=50, progress=False)
+    best = None
+    for _ in range(repeat):
+        r = solve(system, **kw)
+        best = r if best is None or r.wall_time_s < best.wall_time_s else best
+    A = system.M + p["dt"] ** 2 * 0.5 * system.K
+    floor = banded_solve_floor(A, best.steps)
+    return {"solver": best.solver, "steps": best.steps, "wall_time_s": best.wall_time_s,
+            "us_per_step": 1e6 * best.wall_time_s / best.steps,
+            "floor_s": floor, "floor_us_per_step": 1e6 * floor / best.steps,
+            "impacts": best.impacts, "max_nodal_violation": best.max_nodal_violation,
+            "peak_rss_MB": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="skfem_beam.bench.speed", description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="one repeat, fast solvers only")
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--out", default="speed.json")
+    ap.add_argument("--child", help=argparse.SUPPRESS)
+    args = ap.parse_args(argv)
+    if args.child:
+        scene, p, solver, repeat = json.loads(args.child)
+        print(json.dumps(child(scene, p, solver, repeat)))
+        return 0
+    repeat = 1 if args.quick else args.repeat
+    rows = []
+    print(f"{'configuration':48s} {'solver':11s} {'steps':>8s} {'loop s':>8s} {'µs/step':>8s} "
+          f"{'floor µs':>8s} {'target s':>8s} {'MB':>6s}")
+    for label, scene, p, target in CONFIGS:
+        for solver in SOLVERS[scene]:
+            long = p["dt"] < 1e-3 and scene != "point_stops" or p["dt"] < 5e-5
+            if solver in SLOW and (args.quick or long):
+                continue
+            if scene == "point_stops" and solver == "active-set" and args.quick:
+                continue
+            cmd = [sys.executable, "-m", "skfem_beam.bench.speed", "--child",
+                   json.dumps([scene, p, solver, repeat])]
+            res = json.loads(subprocess.run(cmd, check=True, capture_output=True,
+                                            text=True).stdout.strip().splitlines()[-1])
+            res.update(configuration=label, target_s=target)
+            rows.append(res)
+            t = f"{target:g}" if target else "-"
+            print(f"{label:48s} {res['solver']:11s} {res['steps']:8d} {res['wall_time_s']:8.4f} "
+                  f"{res['us_per_step']:8.2f} {res['floor_us_per_step']:8.2f} {t:>8s} "
+                  f"{res['peak_rss_MB']:6.0f}", flush=True)
+    with open(args.out, "w") as fh:
+        json.dump({"machine": "see README (2-core CI machine)", "rows": rows}, fh, indent=2)
+    print(f"written {args.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -45,8 +45,8 @@ class Result:
     their backward-difference velocities (uⁿ − uⁿ⁻¹)/Δt; ``energy``: ½E_β^n (the
     discrete energy of DESIGN.md, halved so that it tends to ½|u̇|² + ½a(u,u));
     ``contact_force``: nodal contact forces λ (saved × m, force per unit mass per
-    length, m²/s² for the beam); ``frames_t``/``frames_u``: decimated coefficient
-    vectors; ``status``: "success" or "unstable"; ``message`` says why.
+    length, m²/s² for the beam); ``frames_t``, ``frames_u``, ``frames_v`` (backward
+    difference velocity), ``frames_force`` (λ): decimated coefficient vectors; ``status``: "success" or "unstable"; ``message`` says why.
     """
     t: np.ndarray
     observed: dict
@@ -55,6 +55,8 @@ class Result:
     contact_force: np.ndarray
     frames_t: np.ndarray
     frames_u: np.ndarray
+    frames_v: np.ndarray
+    frames_force: np.ndarray
     status: str
     message: str
     steps: int
@@ -126,7 +128,7 @@ def energy_beta(Eb, Kb, u_prev, u_cur, d):
 @njit(cache=True)
 def record(n, save_every, frame_every, u_prev, u_cur, mu, dt, Eb, Kb, dt2,
            Op, Oi, Ox, Ep, Ei, Ex, slo, shi, C_y, lo, hi,
-           obs, obsv, energy, lam, frames, stats, d):
+           obs, obsv, energy, lam, frames, frames_v, frames_f, stats, d):
     """Diagnostics after state n: penetration (every step), saved series, frames.
 
     stats: [max nodal violation, max (g1−u)⁺ sampled, max (u−g2)⁺ sampled, steps in contact]
@@ -157,7 +159,12 @@ def record(n, save_every, frame_every, u_prev, u_cur, mu, dt, Eb, Kb, dt2,
         for j in range(mu.size):
             lam[k, j] = mu[j] / dt2
     if n % frame_every == 0:
-        frames[n // frame_every, :] = u_cur
+        k = n // frame_every
+        for i in range(u_cur.size):
+            frames[k, i] = u_cur[i]
+            frames_v[k, i] = (u_cur[i] - u_prev[i]) / dt
+        for j in range(mu.size):
+            frames_f[k, j] = mu[j] / dt2
 
 
 @njit(cache=True)
@@ -174,7 +181,8 @@ def _run(n0, n1, mode, kappa, save_every, frame_every, dt, beta,
          M2, Am, Achol, Eb, Kb, loads, G,
          Cp, Ci, Cx, lo, hi, W, D, Ddiag, state, active_prev,
          Ep, Ei, Ex, slo, shi, Op, Oi, Ox,
-         u_prev, u_cur, obs, obsv, energy, lam, frames, stats, counters, Ebound):
+         u_prev, u_cur, obs, obsv, energy, lam, frames, frames_v, frames_f, stats, counters,
+         Ebound):
     """Steps n = n0..n1−1 (computing u^{n+1}).
 
     mode: 0 no constraint, 1 projection, 2 active set, 3 penalty (stiffness kappa).
@@ -231,7 +239,7 @@ def _run(n0, n1, mode, kappa, save_every, frame_every, dt, beta,
             counters[1] += 1
         record(step + 1, save_every, frame_every, u_prev, u_cur, mu, dt, Eb, Kb, dt2,
                Op, Oi, Ox, Ep, Ei, Ex, slo, shi, cy, lo, hi,
-               obs, obsv, energy, lam, frames, stats, d)
+               obs, obsv, energy, lam, frames, frames_v, frames_f, stats, d)
         if (step + 1) % save_every == 0 and not abs(energy[(step + 1) // save_every]) <= Ebound:
             counters[3] = step + 1
             return UNSTABLE
@@ -361,6 +369,8 @@ def solve(system: SemiDiscrete, dt: float, T: float, beta: float = 0.5, solver: 
     energy = np.full(nsave, np.nan)
     lam = np.zeros((nsave, m))
     fr = np.full((N // frame_every + 1, system.n), np.nan)
+    frv = np.full_like(fr, np.nan)
+    frf = np.zeros((fr.shape[0], m))
     stats = np.zeros(4)
     counters = np.zeros(4, dtype=np.int64)
     state = np.zeros(m, dtype=np.int8)
@@ -386,8 +396,8 @@ def solve(system: SemiDiscrete, dt: float, T: float, beta: float = 0.5, solver: 
     obsv[0] = Orows @ system.v0
     record(1, save_every, frame_every, u_prev, u_cur, np.zeros(m), dt, Eb.rows, Kb.rows,
            dt**2, Op, Oi, Ox, Ep, Ei, Ex, slo, shi, C @ u_cur, lo, hi,
-           obs, obsv, energy, lam, fr, stats, d)
-    fr[0] = u_prev
+           obs, obsv, energy, lam, fr, frv, frf, stats, d)
+    fr[0], frv[0] = u_prev, system.v0
 
     E1 = 0.5 * energy_beta(Eb.rows, Kb.rows, u_prev, u_cur, d)
     energy[0] = E1
@@ -407,7 +417,7 @@ def solve(system: SemiDiscrete, dt: float, T: float, beta: float = 0.5, solver: 
         _run(1, 1, mode, kappa, save_every, frame_every, dt, beta, M2b.rows, Amb.rows, Ab.chol,
              Eb.rows, Kb.rows, loads, np.zeros((0, nK)), Cp, Ci, Cx, lo, hi, W, D, Ddiag, state,
              active_prev, Ep, Ei, Ex, slo, shi, Op, Oi, Ox, u_prev, u_cur, obs, obsv, energy,
-             lam, fr, stats, counters, 0.0)
+             lam, fr, frv, frf, stats, counters, 0.0)
     for n0 in range(1, N, chunk):
         n1 = min(N, n0 + chunk)
         t0 = time.perf_counter()
@@ -420,12 +430,14 @@ def solve(system: SemiDiscrete, dt: float, T: float, beta: float = 0.5, solver: 
                         M2b.rows, Amb.rows, Ab.chol, Eb.rows, Kb.rows, loads, G,
                         Cp, Ci, Cx, lo, hi, W, D, Ddiag, state, active_prev,
                         Ep, Ei, Ex, slo, shi, Op, Oi, Ox,
-                        u_prev, u_cur, obs, obsv, energy, lam, fr, stats, counters, Ebound)
+                        u_prev, u_cur, obs, obsv, energy, lam, fr, frv, frf, stats, counters,
+                        Ebound)
         else:
             code = _python_chunk(pysolver, n0, n1, save_every, frame_every, dt, beta,
                                  M2b, Amb, Ab, Eb, Kb, loads, G, Cp, Ci, Cx, lo, hi, W,
                                  active_prev, Ep, Ei, Ex, slo, shi, Op, Oi, Ox,
-                                 u_prev, u_cur, obs, obsv, energy, lam, fr, stats, counters,
+                                 u_prev, u_cur, obs, obsv, energy, lam, fr, frv, frf, stats,
+                                 counters,
                                  Ebound)
         wall += time.perf_counter() - t0
         if bar is not None:
@@ -448,7 +460,8 @@ def solve(system: SemiDiscrete, dt: float, T: float, beta: float = 0.5, solver: 
     if status != "success":
         keep = last_good // save_every + 1
         obs, obsv, energy, lam = obs[:keep], obsv[:keep], energy[:keep], lam[:keep]
-        fr = fr[:last_good // frame_every + 1]
+        nf = last_good // frame_every + 1
+        fr, frv, frf = fr[:nf], frv[:nf], frf[:nf]
     steps = last_good
     t = np.arange(obs.shape[0]) * save_every * dt
     names = list(system.observe)
@@ -456,6 +469,7 @@ def solve(system: SemiDiscrete, dt: float, T: float, beta: float = 0.5, solver: 
         t=t, observed={k: obs[:, i] for i, k in enumerate(names)},
         velocity={k: obsv[:, i] for i, k in enumerate(names)}, energy=energy,
         contact_force=lam, frames_t=np.arange(fr.shape[0]) * frame_every * dt, frames_u=fr,
+        frames_v=frv, frames_force=frf,
         status=status, message=message, steps=steps, dt=dt, T=N * dt, beta=beta, solver=name,
         wall_time_s=wall, max_nodal_violation=float(max(stats[0], 0.0)),
         max_penetration=float(max(stats[1], stats[2], stats[0], 0.0)),
@@ -466,7 +480,8 @@ def solve(system: SemiDiscrete, dt: float, T: float, beta: float = 0.5, solver: 
 
 def _python_chunk(pysolver, n0, n1, save_every, frame_every, dt, beta, M2b, Amb, Ab, Eb, Kb,
                   loads, G, Cp, Ci, Cx, lo, hi, W, active_prev, Ep, Ei, Ex, slo, shi,
-                  Op, Oi, Ox, u_prev, u_cur, obs, obsv, energy, lam, fr, stats, counters,
+                  Op, Oi, Ox, u_prev, u_cur, obs, obsv, energy, lam, fr, frv, frf, stats,
+                  counters,
                   Ebound):
     """The same step as `_run`, with the contact solve done by a Python-level engine."""
     n, m = u_cur.size, lo.size
@@ -488,7 +503,7 @@ def _python_chunk(pysolver, n0, n1, save_every, frame_every, dt, beta, M2b, Amb,
         cy = np.array([Cx[Cp[j]:Cp[j + 1]] @ u_cur[Ci[Cp[j]:Cp[j + 1]]] for j in range(m)])
         record(step + 1, save_every, frame_every, u_prev, u_cur, mu, dt, Eb.rows,
                Kb.rows, dt2, Op, Oi, Ox, Ep, Ei, Ex, slo, shi, cy, lo, hi,
-               obs, obsv, energy, lam, fr, stats, d)
+               obs, obsv, energy, lam, fr, frv, frf, stats, d)
         if (step + 1) % save_every == 0 and not abs(energy[(step + 1) // save_every]) <= Ebound:
             counters[3] = step + 1
             return UNSTABLE

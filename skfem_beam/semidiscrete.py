@@ -94,4 +94,4 @@ def beam_system(problem: BeamProblem, samples_per_element: int = 20) -> SemiDisc
         sample_x=sampler.x[keep], sample_E=sampler.E0[np.flatnonzero(keep)].tocsr(),
         sample_lo=s_lo[keep], sample_hi=s_hi[keep],
         meta={"kind": "beam", "L": L, "k2": k2, "rho_S": beam.rho_S,
-              "element": problem.element, "J": problem.J})
+              "element": problem.element, "J": problem.J, "problem": problem})

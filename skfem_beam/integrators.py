@@ -19,7 +19,6 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.linalg
 import scipy.sparse
 import scipy.sparse.linalg
 from numba import njit
@@ -32,6 +31,7 @@ from .errors import InputError, SolverError
 from .linalg import Banded, band_solve, rows_dot, rows_matvec2
 from .problem import check_beta, check_positive
 from .semidiscrete import SemiDiscrete
+from .stability import kappa_h, linear_limit
 
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(4)
 FAILED, UNSTABLE = 1, 2
@@ -261,18 +261,6 @@ def time_averages(fun, t0: np.ndarray, dt: float) -> np.ndarray:
     return (np.asarray(fun(s), dtype=float) * _GAUSS_W).sum(axis=1) / 2.0
 
 
-def linear_stability_limit(kappa: float, beta: float) -> float:
-    """Largest stable Δt of linear Newmark (γ = 1/2): 2/√(κ_h(1−4β)); ∞ for β ≥ 1/4."""
-    return math.inf if beta >= 0.25 else 2.0 / math.sqrt(kappa * (1.0 - 4.0 * beta))
-
-
-def kappa_h(system: SemiDiscrete) -> float:
-    """κ_h: the largest generalised eigenvalue of (K, M) (dense; fine for n ≤ a few 1000)."""
-    n = system.n
-    return float(scipy.linalg.eigh(system.K.toarray(), system.M.toarray(), eigvals_only=True,
-                                   subset_by_index=[n - 1, n - 1])[0])
-
-
 def _csr(a):
     a = a.tocsr()
     return (a.indptr.astype(np.int64), a.indices.astype(np.int64), a.data.astype(float))
@@ -447,7 +435,7 @@ def solve(system: SemiDiscrete, dt: float, T: float, beta: float = 0.5, solver: 
             raise SolverError(f"the {name} contact solver failed at step {k} (t={k * dt:.6g} s)")
         if code == UNSTABLE:
             k = int(counters[3])
-            limit = linear_stability_limit(kappa_h(system), beta)
+            limit = linear_limit(kappa_h(system), beta)
             status = "unstable"
             message = (f"unstable at step {k} (t={k * dt:.6g} s): energy "
                        f"{energy[k // save_every]:.3g} exceeds {Ebound:.3g}; dt={dt:g} s, "

@@ -5,7 +5,7 @@ import scipy.linalg
 
 from conftest import rate
 from skfem_beam import (Beam, BeamProblem, InitialState, Load, Obstacles, beam_system, solve)
-from skfem_beam.integrators import kappa_h, linear_stability_limit
+from skfem_beam.stability import kappa_h, linear_limit
 from skfem_beam.reference import cantilever_mode
 
 L, K2 = 1.501, 282.84
@@ -56,7 +56,7 @@ def test_energy_conserved_to_round_off_without_contact(beta):
     # J = 8: evaluating uᵀKu cancels terms of size κ_h|u|² ≫ E, so the round-off of E
     # itself grows like κ_h ~ J⁴ (≈ 5e-9·E at J = 19 near the β = 0.1 limit)
     system = free_system(J=8)
-    dt = 0.5 * linear_stability_limit(kappa_h(system), beta) if beta < 0.25 else 1e-4
+    dt = 0.5 * linear_limit(kappa_h(system), beta) if beta < 0.25 else 1e-4
     r = solve(system, dt, 2000 * dt, beta)
     E = r.energy
     assert np.abs(E - E[0]).max() <= 1e-10 * E[0]   # 2000 steps of round-off
@@ -84,7 +84,7 @@ def test_stops_hold_to_round_off(pipe):
 
 def test_unstable_run_is_detected_and_truncated(pipe):
     system = beam_system(pipe)
-    limit = linear_stability_limit(kappa_h(system), 0.1)
+    limit = linear_limit(kappa_h(system), 0.1)
     r = solve(system, 1.2 * limit, 0.1, 0.1)
     assert r.status == "unstable" and "linear stability limit" in r.message
     assert np.isfinite(r.energy).all() and r.energy.max() < 100 * r.energy[0]

@@ -4,7 +4,8 @@ from __future__ import annotations
 import numpy as np
 
 from .. import cli
-from ..integrators import kappa_h, linear_stability_limit, solve
+from ..integrators import solve
+from ..stability import kappa_h, linear_limit
 from ..io import check_output_dir, output_dir, write_summary, write_timeseries
 from ..plotting import energy_chart, shape_chart, trajectory_chart
 from ..problem import check_beta, check_positive
@@ -24,7 +25,7 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
     check_output_dir(out, args.overwrite)          # fail before the run, not after it
     system = beam_system(problem)
     kappa = kappa_h(system)
-    limit = linear_stability_limit(kappa, args.beta)
+    limit = linear_limit(kappa, args.beta)
     if args.dt > limit:
         cli.warn(f"dt={args.dt:g} s is above the linear stability limit "
                  f"2/√(κ_h(1−4β)) = {limit:.4g} s for beta={args.beta:g} (κ_h={kappa:.4g} s⁻²); "

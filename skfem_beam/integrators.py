@@ -474,10 +474,11 @@ def _python_chunk(pysolver, n0, n1, save_every, frame_every, dt, beta, M2b, Amb,
     """The same step as `_run`, with the contact solve done by a Python-level engine."""
     n, m = u_cur.size, lo.size
     x, yf, d = np.empty(n), np.empty(m), np.empty(n)
+    no_spring = np.zeros(m)
     dt2 = dt * dt
     for step in range(n0, n1):
         free_step(M2b.rows, Amb.rows, Ab.chol, loads, G[step - n0], u_prev, u_cur, dt2,
-                  Cp, Ci, Cx, x, yf)
+                  Cp, Ci, Cx, x, yf, no_spring)
         try:
             mu, its = pysolver.solve(x, yf)
         except SolverError as e:

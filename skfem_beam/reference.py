@@ -27,3 +27,372 @@ def cantilever_mode(x, L: float, n: int) -> np.ndarray:
     sigma = (np.cosh(bl) + np.cos(bl)) / (np.sinh(bl) + np.sin(bl))
     phi = lambda z: np.cosh(z) - np.cos(z) - sigma * (np.sinh(z) - np.sin(z))  # noqa: E731
     return phi(s) / phi(bl)
+
+
+# ---------------------------------------------------------------------------------------
+# The impacting bar (Do, Raupp & Feijoo, Example 1 and its generalisations)
+#
+# Non-dimensional form (ξ = x/L, τ = ct/L, c = √(a/ρ), w = u/L), elastic bar (b = 0),
+# uniform data u0, v0, f:
+#
+#     w_ττ = w_ξξ + f̃,  f̃ = fL/a,   w(ξ,0) = g = u0/L,  w_τ(ξ,0) = v = v0/c,
+#     w_ξ(1,τ) = 0,     at ξ = 0:  elastic  w_ξ = κ min(w, 0), κ = kL/a   (a u_x = k u
+#                                  while in contact, free otherwise);
+#                                  rigid    w ≥ 0, R = −w_ξ ≥ 0, R·w = 0.
+#
+# d'Alembert: w = F(ξ−τ) + G(ξ+τ) + f̃τ²/2.  The data give F, G on [0, 1]; the free end
+# reflects F into G: G(s) = F(2−s) + v for s ≥ 1; the obstacle turns the incoming G into
+# the outgoing p(τ) = F(−τ) through the law at ξ = 0, with U = w(0,τ) = p + G + f̃τ²/2:
+#
+#     free:            p' = G'
+#     elastic contact: p' + κp = G' − κG − κf̃τ²/2      (the Robin condition w_ξ = κw)
+#     rigid contact:   p = −G − f̃τ²/2                  (U = 0), R = −2G' − f̃τ
+#
+# Every piece of p and G is P(s) + e^{−κs}Q(s) (s = τ − τ₀, P, Q polynomials): the
+# data are polynomial, the Robin law adds the exponentials and each round trip (Δτ = 2)
+# raises the degree of Q by one.  Switching times (separation, new contact) are roots
+# of U or R, found by bracketing and Brent's method.  The regions R_I, R_II, R_III of
+# the paper are the first pieces (see bar_elastic_paper).
+# ---------------------------------------------------------------------------------------
+
+from numpy.polynomial import polynomial as _P  # noqa: E402
+
+
+class _ExpPoly:
+    """P(s) + e^{−κs} Q(s) on [t0, t1], s = τ − t0 (ascending coefficient arrays)."""
+
+    __slots__ = ("t0", "t1", "P", "Q", "kappa")
+
+    def __init__(self, t0, t1, P, Q=(0.0,), kappa=0.0):
+        self.t0, self.t1, self.kappa = float(t0), float(t1), float(kappa)
+        self.P = np.atleast_1d(np.asarray(P, dtype=float))
+        self.Q = np.atleast_1d(np.asarray(Q, dtype=float))
+
+    def __call__(self, t):
+        s = np.asarray(t, dtype=float) - self.t0
+        out = _P.polyval(s, self.P)
+        if np.any(self.Q):
+            out = out + np.exp(-self.kappa * s) * _P.polyval(s, self.Q)
+        return out
+
+    def deriv(self) -> "_ExpPoly":
+        return _ExpPoly(self.t0, self.t1, _P.polyder(self.P),
+                        _P.polysub(_P.polyder(self.Q), self.kappa * self.Q), self.kappa)
+
+    def __add__(self, other: "_ExpPoly") -> "_ExpPoly":
+        assert other.t0 == self.t0
+        return _ExpPoly(self.t0, self.t1, _P.polyadd(self.P, other.P),
+                        _P.polyadd(self.Q, other.Q), self.kappa)
+
+    def scale(self, c: float) -> "_ExpPoly":
+        return _ExpPoly(self.t0, self.t1, c * self.P, c * self.Q, self.kappa)
+
+    def rebase(self, t0: float, t1: float | None = None) -> "_ExpPoly":
+        """The same function written in s' = τ − t0 (Taylor coefficients at the new origin)."""
+        d = t0 - self.t0
+        return _ExpPoly(t0, self.t1 if t1 is None else t1, _taylor(self.P, d),
+                        _taylor(self.Q, d) * np.exp(-self.kappa * d), self.kappa)
+
+    def moved(self, shift: float, add: float = 0.0) -> "_ExpPoly":
+        """τ ↦ f(τ − shift) + add, on the interval moved by ``shift``."""
+        P = self.P.copy()
+        P[0] += add
+        return _ExpPoly(self.t0 + shift, self.t1 + shift, P, self.Q, self.kappa)
+
+
+def _taylor(c: np.ndarray, d: float) -> np.ndarray:
+    """Coefficients of c(s + d) in s."""
+    out, fact, cur = np.empty(c.size), 1.0, c
+    for j in range(c.size):
+        out[j] = _P.polyval(d, cur) / fact
+        cur = _P.polyder(cur) if cur.size > 1 else np.zeros(1)
+        fact *= j + 1
+    return out
+
+
+def _robin_solve(q: _ExpPoly, p0: float) -> _ExpPoly:
+    """p' + κp = q, p(t0) = p0, exactly: polynomial part by Σ(−1)ʲq⁽ʲ⁾/κʲ⁺¹, the resonant
+    e^{−κs}Q part by ∫₀ˢQ, the homogeneous part C e^{−κs}."""
+    k = q.kappa
+    Pp, cur, sign = np.zeros(max(q.P.size, 1)), q.P, 1.0
+    for j in range(q.P.size):
+        Pp[:cur.size] += sign * cur / k ** (j + 1)
+        cur = _P.polyder(cur) if cur.size > 1 else np.zeros(1)
+        sign = -sign
+    Qp = _P.polyint(q.Q)          # lower bound 0: Qp(0) = 0
+    Qp[0] += p0 - Pp[0]
+    return _ExpPoly(q.t0, q.t1, Pp, Qp, k)
+
+
+class _Piecewise:
+    """A function of τ made of _ExpPoly pieces that follow each other."""
+
+    def __init__(self):
+        self.pieces: list[_ExpPoly] = []
+
+    def append(self, piece: _ExpPoly):
+        self.pieces.append(piece)
+
+    @property
+    def end(self) -> float:
+        return self.pieces[-1].t1
+
+    def piece_at(self, t: float) -> _ExpPoly:
+        starts = np.array([p.t0 for p in self.pieces])
+        i = int(np.searchsorted(starts, t, side="right")) - 1
+        return self.pieces[max(i, 0)]
+
+    def __call__(self, t, der: int = 0):
+        t = np.asarray(t, dtype=float)
+        starts = np.array([p.t0 for p in self.pieces])
+        idx = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(self.pieces) - 1)
+        out = np.empty(t.shape)
+        for i in np.unique(idx):
+            fn = self.pieces[i]
+            for _ in range(der):
+                fn = fn.deriv()
+            sel = idx == i
+            out[sel] = fn(t[sel])
+        return out
+
+
+def _first_root(fun, a: float, b: float, kappa: float, tol: float, skip: float = 0.0
+                ) -> float | None:
+    """First τ in (a + skip, b] where ``fun`` (≥ 0 just after a) turns negative, or None."""
+    grid = [np.linspace(a, b, 1025), a + (b - a) * np.geomspace(1e-10, 1.0, 80)]
+    if kappa > 0:
+        layer = np.geomspace(1e-4 / kappa, 40.0 / kappa, 200)
+        grid.append(a + layer[layer < b - a])
+    grid = np.unique(np.concatenate(grid))
+    grid = np.concatenate([[a], grid[grid >= a + skip]]) if skip else grid
+    vals = fun(grid)
+    bad = np.flatnonzero(vals[1:] < -tol) + 1
+    if bad.size == 0:
+        return None
+    i = int(bad[0])
+    lo, hi = grid[i - 1], grid[i]
+    if vals[i - 1] <= 0.0:   # bracket degenerate at the start: the switch is immediate
+        return lo
+    return brentq(lambda s: float(fun(np.array([s]))[0]), lo, hi, xtol=1e-15, rtol=1e-15)
+
+
+class BarWaves:
+    """The exact non-dimensional solution w(ξ, τ) of the bar (see the comment above).
+
+    ``kappa``: κ = kL/a of the elastic obstacle, or None for the rigid one.
+    """
+
+    def __init__(self, kappa: float | None, g: float, v: float, f: float, tau_end: float):
+        self.kappa, self.g, self.v, self.f = kappa, float(g), float(v), float(f)
+        k = 0.0 if kappa is None else float(kappa)
+        self._k = k
+        self.tol = 1e-13 * max(abs(v), abs(g), abs(f), 1.0)
+        self.G = _Piecewise()
+        self.G.append(_ExpPoly(0.0, 2.0, [g / 2, v / 2], kappa=k))   # data, reflected at ξ=1
+        self.p = _Piecewise()
+        self.contact_intervals: list[list[float]] = []
+        self._immediate = False
+        self._march(float(tau_end) + 1.0)
+
+    # the load term f̃τ²/2 written around t0
+    def _load(self, t0, t1) -> _ExpPoly:
+        f = self.f
+        return _ExpPoly(t0, t1, [f * t0**2 / 2, f * t0, f / 2], kappa=self._k)
+
+    def _candidate(self, contact: bool, G: _ExpPoly, p0: float) -> _ExpPoly:
+        load = self._load(G.t0, G.t1)
+        if not contact:
+            return G + _ExpPoly(G.t0, G.t1, [p0 - G(G.t0)], kappa=self._k)
+        if self.kappa is None:
+            return (G + load).scale(-1.0)
+        q = G.deriv() + (G + load).scale(-self._k)
+        return _robin_solve(q, p0)
+
+    def _starts_in_contact(self, t: float, p0: float) -> bool:
+        """The law at ξ = 0 just after τ = t, from U(t) and, at U = 0, the sign of the first
+        non-zero derivative of the free motion U = 2G − G(t) + p0 + f̃τ²/2."""
+        G = self.G.piece_at(t).rebase(t)
+        U = p0 + G(t) + self.f * t**2 / 2
+        if U < -self.tol:
+            return True
+        if U > self.tol:
+            return False
+        Ufree = G.scale(2.0) + self._load(t, G.t1)
+        for _ in range(4):
+            Ufree = Ufree.deriv()
+            d = float(Ufree(t))
+            if abs(d) > self.tol:
+                return d < 0
+        return False
+
+    def _march(self, tau_end: float):
+        t, p0 = 0.0, self.g / 2          # p(0) = F(0)
+        contact = self._starts_in_contact(t, p0)
+        eps = 1e-10                      # switches closer than this are round-off
+        skip = 0.0                       # > 0: ignore events just after t (see below)
+        for _ in range(100000):
+            if t >= tau_end:
+                return
+            G = self.G.piece_at(t).rebase(t)
+            cand = self._candidate(contact, G, p0)
+            U = cand + G + self._load(t, G.t1)
+            if contact and self.kappa is None:   # rigid: leave when R = −U'_free < 0
+                Gd = G.deriv()
+                fun = lambda s, Gd=Gd: -2 * Gd(s) - self.f * s  # noqa: E731
+            elif contact:                        # elastic: leave when U > 0
+                fun = lambda s, U=U: -U(s)  # noqa: E731
+            else:                                # free: hit when U < 0
+                fun = U
+            te = _first_root(fun, t, G.t1, self._k, self.tol, skip)
+            skip = 0.0
+            if te is not None and te <= t + eps:
+                # an immediate switch; if the other law also switches at once, U and R
+                # both vanish to round-off (grazing): stay free and look past it
+                if self._immediate:
+                    contact, skip, self._immediate = False, eps, False
+                else:
+                    contact, self._immediate = not contact, True
+                continue
+            self._immediate = False
+            switched = te is not None and te < G.t1 - eps   # no sliver pieces at the end
+            te = te if switched else G.t1
+            piece = _ExpPoly(t, te, cand.P, cand.Q, self._k)
+            self.p.append(piece)
+            self.G.append(piece.moved(2.0, add=self.v))   # G(s) = p(s−2) + v
+            if contact:
+                self._mark_contact(t, te)
+            p0, t = float(piece(te)), te
+            # at an event the law switches; at the end of a piece of G it is decided again
+            contact = (not contact) if switched else self._starts_in_contact(t, p0)
+        raise RuntimeError("too many switches in the exact bar solution")
+
+    def _mark_contact(self, t0, t1):
+        if self.contact_intervals and abs(self.contact_intervals[-1][1] - t0) < 1e-15:
+            self.contact_intervals[-1][1] = t1
+        else:
+            self.contact_intervals.append([t0, t1])
+
+    # --- the solution ---------------------------------------------------------------
+    def _F(self, xi, der=0):
+        xi = np.asarray(xi, dtype=float)
+        data = [self.g / 2 - self.v * xi / 2, np.full(xi.shape, -self.v / 2),
+                np.zeros(xi.shape)][der]
+        inner = self.p(-np.minimum(xi, 0.0), der) * (-1.0) ** der
+        return np.where(xi >= 0, data, inner)
+
+    def w(self, xi, tau):
+        xi, tau = np.broadcast_arrays(np.asarray(xi, float), np.asarray(tau, float))
+        return self._F(xi - tau) + self.G(xi + tau) + self.f * tau**2 / 2
+
+    def w_tau(self, xi, tau):
+        xi, tau = np.broadcast_arrays(np.asarray(xi, float), np.asarray(tau, float))
+        return -self._F(xi - tau, 1) + self.G(xi + tau, 1) + self.f * tau
+
+    def w_xi(self, xi, tau):
+        xi, tau = np.broadcast_arrays(np.asarray(xi, float), np.asarray(tau, float))
+        return self._F(xi - tau, 1) + self.G(xi + tau, 1)
+
+    def reaction(self, tau):
+        """R = −w_ξ(0, τ), from the law at ξ = 0 (non-dimensional, units of a)."""
+        tau = np.asarray(tau, dtype=float)
+        if self.kappa is not None:
+            return self.kappa * np.maximum(-self.w(0.0, tau), 0.0)
+        R = -self.w_xi(0.0, tau)
+        inside = np.zeros(tau.shape, dtype=bool)
+        for a, b in self.contact_intervals:
+            inside |= (tau > a) & (tau < b)
+        return np.where(inside, R, 0.0)
+
+
+class BarExact:
+    """Exact solution of an elastic bar (b = 0) with uniform data, in physical units.
+
+    u(x, t) = L·w(x/L, ct/L); R(t) = −a u_x(0, t) the obstacle reaction per unit area.
+    ``obstacle``: 'rigid' or 'elastic' (spring k).  Valid for any a, ρ, L, k > 0, f,
+    v0 and gap u0 ≥ 0 (u0 < 0 is allowed for the elastic obstacle).
+    """
+
+    def __init__(self, a, rho, L, v0, T, obstacle="rigid", k=None, f=0.0, u0=0.0):
+        self.a, self.rho, self.L = float(a), float(rho), float(L)
+        self.c = np.sqrt(self.a / self.rho)
+        kappa = None if obstacle == "rigid" else float(k) * self.L / self.a
+        if obstacle == "rigid" and u0 < 0:
+            raise ValueError("u0 < 0 violates the rigid obstacle")
+        self.waves = BarWaves(kappa, u0 / self.L, v0 / self.c, f * self.L / self.a,
+                              self.c * float(T) / self.L)
+        self.obstacle, self.k = obstacle, k
+
+    @classmethod
+    def of(cls, bar, T):
+        """The exact solution of a :class:`skfem_beam.bar.Bar`, or None if not known (b > 0)."""
+        if bar.b != 0:
+            return None
+        return cls(bar.a, bar.rho, bar.L, bar.v0, T, bar.obstacle, bar.k, bar.f, bar.u0)
+
+    def _tau(self, t):
+        return self.c * np.asarray(t, dtype=float) / self.L
+
+    def u(self, x, t):
+        return self.L * self.waves.w(np.asarray(x, float) / self.L, self._tau(t))
+
+    def velocity(self, x, t):
+        return self.c * self.waves.w_tau(np.asarray(x, float) / self.L, self._tau(t))
+
+    def strain(self, x, t):
+        return self.waves.w_xi(np.asarray(x, float) / self.L, self._tau(t))
+
+    def contact_force(self, t):
+        return self.a * self.waves.reaction(self._tau(t))
+
+    def contact_intervals(self) -> list[tuple[float, float]]:
+        s = self.L / self.c
+        return [(a * s, b * s) for a, b in self.waves.contact_intervals]
+
+    def energy(self, t, points: int = 4001) -> dict:
+        """Kinetic ½∫ρu_t², strain ½∫a u_x², obstacle ½k(U⁻)² at times t (trapezoid in x
+        on ``points`` abscissae; the fields are piecewise smooth)."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        x = np.linspace(0.0, self.L, points)
+        X, Tm = np.meshgrid(x, t)
+        trapezoid = getattr(np, "trapezoid", None) or np.trapz   # numpy < 2 has trapz only
+        kin = 0.5 * self.rho * trapezoid(self.velocity(X, Tm) ** 2, x, axis=1)
+        strain = 0.5 * self.a * trapezoid(self.strain(X, Tm) ** 2, x, axis=1)
+        U = self.u(0.0, t)
+        obst = 0.5 * self.k * np.maximum(-U, 0.0) ** 2 if self.obstacle == "elastic" \
+            else np.zeros(t.shape)
+        return {"kinetic": kin, "strain": strain, "obstacle": obst,
+                "total": kin + strain + obst}
+
+
+# the paper's Example 1 (a = ρ = L = 1, v0 = −1, f = 0): closed forms --------------------
+
+def bar_rigid_u0(t):
+    """u(0, t) = max(t − 2, 0): in contact on (0, 2), then it leaves at speed 1."""
+    return np.maximum(np.asarray(t, dtype=float) - 2.0, 0.0)
+
+
+def bar_rigid_uL(t):
+    """u(1, t) = −t for t ≤ 1, t − 2 after (the reflected wave reaches the free end)."""
+    t = np.asarray(t, dtype=float)
+    return np.where(t <= 1.0, -t, t - 2.0)
+
+
+def bar_rigid_force(t):
+    """R(t) = 1 on (0, 2) (= ρc|v0|), 0 after."""
+    t = np.asarray(t, dtype=float)
+    return np.where((t > 0) & (t < 2), 1.0, 0.0)
+
+
+def bar_elastic_paper(x, t, k):
+    """The paper's regions R_I, R_II, R_III (Example 1, spring k), where they hold:
+    R_I: x > t; R_II: x < t, x + t < 2; R_III: x + t > 2, t − x < 2.  NaN elsewhere."""
+    x, t = np.broadcast_arrays(np.asarray(x, float), np.asarray(t, float))
+    with np.errstate(over="ignore"):
+        r1 = -t
+        r2 = -x + (np.exp(k * (x - t)) - 1.0) / k
+        r3 = t + (np.exp(k * (2 - x - t)) + np.exp(k * (x - t))) / k - 2 * (1 + 1 / k)
+    out = np.full(x.shape, np.nan)
+    out = np.where(x > t, r1, out)
+    out = np.where((x <= t) & (x + t < 2), r2, out)
+    out = np.where((x + t >= 2) & (t - x < 2) & (x <= t), r3, out)
+    return out

@@ -266,6 +266,222 @@ def _csr(a):
     return (a.indptr.astype(np.int64), a.indices.astype(np.int64), a.data.astype(float))
 
 
+class Run:
+    """One integration of a system: operators, the scheme's state and the saved series.
+
+    ``advance(n1)`` steps up to state n1; ``checkpoint()``/``restore()`` give the full
+    state (uⁿ⁻¹, uⁿ, step, warm starts, running diagnostics), so that a restored run
+    continues bit for bit.  :func:`solve` drives it; the case modules drive it too when
+    they stream output and write checkpoints.
+    """
+
+    def __init__(self, system: SemiDiscrete, dt: float, T: float, beta: float = 0.5,
+                 solver: str = "auto", stiffness: float | None = None, save_every: int = 1,
+                 frames: int = 200, load_window: str = "forward", growth_limit: float = 10.0):
+        dt = check_positive("dt", dt)
+        T = check_positive("T", T)
+        beta = check_beta(beta)
+        if isinstance(save_every, bool) or int(save_every) != save_every or save_every < 1:
+            raise InputError(f"save_every={save_every!r} must be a whole number ≥ 1")
+        N = int(math.ceil(T / dt - 1e-9))
+        if N < 2:
+            raise InputError(f"dt={dt:g} must be at most T/2={T / 2:g}")
+        if load_window not in ("forward", "centered"):
+            raise InputError(f"load_window={load_window!r} is not one of: forward, centered")
+        self.system, self.dt, self.beta, self.N = system, dt, beta, N
+        self.save_every = save_every = int(save_every)
+        self.frame_every = frame_every = max(1, N // max(1, int(frames)))
+        self.growth_limit = growth_limit
+        self.shift = 0.5 * dt if load_window == "centered" else 0.0
+
+        M, K, B = system.M, system.K, system.B
+        A = M + dt**2 * beta * K + (0.5 * dt * B if B is not None else 0)
+        Am = M + dt**2 * beta * K - (0.5 * dt * B if B is not None else 0)
+        self.Ab = Banded(A, factor=True)
+        self.M2b, self.Amb = Banded(2 * M - dt**2 * (1 - 2 * beta) * K), Banded(Am)
+        self.Eb, self.Kb = Banded(M / dt**2 + beta * K), Banded(K)
+
+        C = system.C.tocsr()
+        self.m = m = C.shape[0]
+        W = np.zeros((system.n, m))
+        for j in range(m):
+            col = C[j].toarray().ravel()
+            band_solve(self.Ab.chol, col)
+            W[:, j] = col
+        self.W = W
+        self.D = D = np.ascontiguousarray((C @ W).reshape(m, m))
+        if stiffness is None:
+            self.solver = choose_solver(solver, D)
+            self.mode = COMPILED.get(self.solver, -1)
+            self.kappa = 0.0
+        else:
+            self.kappa = check_positive("stiffness", stiffness)
+            self.solver, self.mode = "penalty", 3
+        self.pysolver = python_solver(self.solver, A, C, system.lo, system.hi, D, W, dt) \
+            if self.mode < 0 else None
+
+        self.nK = system.loads.shape[1]
+        self.loads = np.ascontiguousarray(system.loads, dtype=float)
+        self.Minv_norm = np.sqrt(np.array([lv @ scipy.sparse.linalg.spsolve(M.tocsc(), lv)
+                                           for lv in self.loads.T])) if self.nK else np.zeros(0)
+
+        nsave = N // save_every + 1
+        nobs = len(system.observe)
+        Orows = scipy.sparse.csr_matrix(np.vstack(list(system.observe.values()))) if nobs \
+            else scipy.sparse.csr_matrix((0, system.n))
+        self.obs = np.full((nsave, nobs), np.nan)
+        self.obsv = np.full((nsave, nobs), np.nan)
+        self.energy = np.full(nsave, np.nan)
+        self.lam = np.zeros((nsave, m))
+        self.fr = np.full((N // frame_every + 1, system.n), np.nan)
+        self.frv = np.full_like(self.fr, np.nan)
+        self.frf = np.zeros((self.fr.shape[0], m))
+        self.stats = np.zeros(4)
+        self.counters = np.zeros(4, dtype=np.int64)
+        self.state = np.zeros(m, dtype=np.int8)
+        self.active_prev = np.zeros(m, dtype=np.bool_)
+        self.O = _csr(Orows)
+        self.Cs = _csr(C)
+        if system.sample_E is not None and system.sample_E.shape[0]:
+            self.E = _csr(system.sample_E)
+            self.slo = np.ascontiguousarray(system.sample_lo, dtype=float)
+            self.shi = np.ascontiguousarray(system.sample_hi, dtype=float)
+        else:
+            self.E = (np.zeros(1, np.int64), np.zeros(0, np.int64), np.zeros(0))
+            self.slo = self.shi = np.zeros(0)
+        self.lo = np.ascontiguousarray(system.lo, dtype=float)
+        self.hi = np.ascontiguousarray(system.hi, dtype=float)
+        self.Ddiag = np.ascontiguousarray(np.diag(D)) if m else np.zeros(0)
+        self.d = np.empty(system.n)
+
+        # start: u⁰, and u¹ = u⁰ + Δt v⁰ + Δt²/2 a⁰ (second order), kept in K_h
+        self.u_prev = system.u0.astype(float).copy()
+        f0 = self.loads @ np.array([float(a(np.array([0.0]))[0]) for a in system.load_time]) \
+            if self.nK else np.zeros(system.n)
+        rhs = f0 - K @ self.u_prev - (B @ system.v0 if B is not None else 0)
+        a0 = scipy.sparse.linalg.spsolve(M.tocsc(), rhs)
+        u1 = self.u_prev + dt * system.v0 + 0.5 * dt**2 * a0
+        y1 = C @ u1
+        if m and ((y1 < system.lo).any() or (y1 > system.hi).any()):
+            # project u¹ onto K_h in the A-norm: one contact step with F = A u¹
+            mu = np.zeros(m)
+            if box_qp(D, y1, self.lo, self.hi, np.zeros(m, dtype=np.int8), mu) < 0:
+                raise SolverError("could not place u¹ inside the obstacles")
+            u1 = u1 + W @ mu
+        self.u_cur = u1
+
+        # states 0 and 1 (E_β needs two states: the energy saved at t = 0 is E_β¹)
+        self.obs[0] = Orows @ self.u_prev
+        self.obsv[0] = Orows @ system.v0
+        self._record(1, np.zeros(m), C @ self.u_cur)
+        self.fr[0], self.frv[0] = self.u_prev, system.v0
+        self.E1 = 0.5 * energy_beta(self.Eb.rows, self.Kb.rows, self.u_prev, self.u_cur, self.d)
+        self.energy[0] = self.E1
+        self.work = 0.0        # Σ‖Gⁿ‖_{M⁻¹}Δt so far: the a-priori energy bound grows with it
+        self.n = 1             # the last computed state
+        self.wall = 0.0
+        self.status, self.message = "running", ""
+        if self.pysolver is None:   # load the compiled kernel now, outside the timed loop
+            self._kernel(1, 1, np.zeros((0, self.nK)), 0.0)
+
+    def _record(self, n, mu, cy):
+        Op, Oi, Ox = self.O
+        Ep, Ei, Ex = self.E
+        record(n, self.save_every, self.frame_every, self.u_prev, self.u_cur, mu, self.dt,
+               self.Eb.rows, self.Kb.rows, self.dt**2, Op, Oi, Ox, Ep, Ei, Ex, self.slo,
+               self.shi, cy, self.lo, self.hi, self.obs, self.obsv, self.energy, self.lam,
+               self.fr, self.frv, self.frf, self.stats, self.d)
+
+    def _kernel(self, n0, n1, G, Ebound):
+        return _run(n0, n1, self.mode, self.kappa, self.save_every, self.frame_every, self.dt,
+                    self.beta, self.M2b.rows, self.Amb.rows, self.Ab.chol, self.Eb.rows,
+                    self.Kb.rows, self.loads, G, *self.Cs, self.lo, self.hi, self.W, self.D,
+                    self.Ddiag, self.state, self.active_prev, *self.E, self.slo, self.shi,
+                    *self.O, self.u_prev, self.u_cur, self.obs, self.obsv, self.energy,
+                    self.lam, self.fr, self.frv, self.frf, self.stats, self.counters, Ebound)
+
+    def load_coefficients(self, n0, n1):
+        """Gⁿ = βf^{n+1} + (1−2β)fⁿ + βf^{n−1} for n = n0..n1−1 (per chunk: flat memory)."""
+        if not self.nK:
+            return np.zeros((n1 - n0, 0))
+        dt, beta = self.dt, self.beta
+        t = np.arange(n0 - 1, n1 + 1) * dt - self.shift
+        f = np.column_stack([time_averages(a, t, dt) for a in self.system.load_time])
+        return np.ascontiguousarray(beta * f[2:] + (1 - 2 * beta) * f[1:-1] + beta * f[:-2])
+
+    @property
+    def done(self) -> bool:
+        return self.status != "running"
+
+    def advance(self, n1: int) -> None:
+        """Compute states self.n+1 .. n1; sets ``status`` to "success" at N or "unstable"."""
+        n0, n1 = self.n, min(int(n1), self.N)
+        if self.done or n1 <= n0:
+            return
+        t0 = time.perf_counter()
+        G = self.load_coefficients(n0, n1)
+        self.work += float((np.abs(G) @ self.Minv_norm).sum()) * self.dt if self.nK else 0.0
+        # the bound grows with n: its chunk-end value is the loosest for the chunk
+        Ebound = self.growth_limit * (math.sqrt(abs(self.E1)) + self.work) ** 2 + 1e-300
+        if self.pysolver is None:
+            code = self._kernel(n0, n1, G, Ebound)
+        else:
+            code = _python_chunk(self, n0, n1, G, Ebound)
+        self.wall += time.perf_counter() - t0
+        k = int(self.counters[3])
+        if code == FAILED:
+            raise SolverError(f"the {self.solver} contact solver failed at step {k} "
+                              f"(t={k * self.dt:.6g} s)")
+        if code == UNSTABLE:
+            limit = linear_limit(kappa_h(self.system), self.beta)
+            self.status = "unstable"
+            self.message = (f"unstable at step {k} (t={k * self.dt:.6g} s): energy "
+                            f"{self.energy[k // self.save_every]:.3g} exceeds {Ebound:.3g}; "
+                            f"dt={self.dt:g} s, beta={self.beta:g}, linear stability limit "
+                            f"2/√(κ_h(1−4β)) = {limit:.4g} s")
+            self.n = (k // self.save_every - 1) * self.save_every   # last good saved state
+            return
+        self.n = n1
+        if n1 == self.N:
+            self.status, self.message = "success", "the run reached T"
+
+    _STATE = ("u_prev", "u_cur", "state", "active_prev", "stats", "counters")
+
+    def checkpoint(self) -> dict:
+        """Everything needed to continue bit for bit (saved series are the caller's)."""
+        if self.pysolver is not None:
+            raise InputError(f"checkpoints need a compiled solver (projection, active-set, "
+                             f"penalty), not {self.solver!r}")
+        return {**{k: getattr(self, k).copy() for k in self._STATE},
+                "n": self.n, "work": self.work, "wall": self.wall, "E1": self.E1}
+
+    def restore(self, ck: dict) -> None:
+        for k in self._STATE:
+            getattr(self, k)[...] = ck[k]
+        self.n, self.work, self.wall, self.E1 = int(ck["n"]), float(ck["work"]), \
+            float(ck["wall"]), float(ck["E1"])
+
+    def result(self) -> Result:
+        keep = self.n // self.save_every + 1
+        nf = self.n // self.frame_every + 1
+        names = list(self.system.observe)
+        obs, obsv = self.obs[:keep], self.obsv[:keep]
+        st, c = self.stats, self.counters
+        return Result(
+            t=np.arange(keep) * self.save_every * self.dt,
+            observed={k: obs[:, i] for i, k in enumerate(names)},
+            velocity={k: obsv[:, i] for i, k in enumerate(names)}, energy=self.energy[:keep],
+            contact_force=self.lam[:keep], frames_t=np.arange(nf) * self.frame_every * self.dt,
+            frames_u=self.fr[:nf], frames_v=self.frv[:nf], frames_force=self.frf[:nf],
+            status=self.status, message=self.message, steps=self.n, dt=self.dt,
+            T=self.N * self.dt, beta=self.beta, solver=self.solver, wall_time_s=self.wall,
+            max_nodal_violation=float(max(st[0], 0.0)),
+            max_penetration=float(max(st[1], st[2], st[0], 0.0)),
+            max_penetration_below=float(st[1]), max_penetration_above=float(st[2]),
+            impacts=int(c[0]), contact_fraction=float(c[1]) / max(1, self.n - 1),
+            qp_iterations=int(c[2]), system=self.system)
+
+
 def solve(system: SemiDiscrete, dt: float, T: float, beta: float = 0.5, solver: str = "auto",
           stiffness: float | None = None, save_every: int = 1, frames: int = 200,
           progress: bool | None = None, chunk: int = 20000, load_window: str = "forward",
@@ -281,219 +497,57 @@ def solve(system: SemiDiscrete, dt: float, T: float, beta: float = 0.5, solver: 
 
     The run stops with status "unstable" when the discrete energy exceeds
     ``growth_limit`` × the a-priori bound (√E¹ + Σ‖Gⁿ‖_{M⁻¹}Δt)² or a value turns
-    non-finite; what was computed up to the last good chunk is returned.
+    non-finite; what was computed up to the last good saved state is returned.
     """
-    dt = check_positive("dt", dt)
-    T = check_positive("T", T)
-    beta = check_beta(beta)
-    if isinstance(save_every, bool) or int(save_every) != save_every or save_every < 1:
-        raise InputError(f"save_every={save_every!r} must be a whole number ≥ 1")
-    N = int(math.ceil(T / dt - 1e-9))
-    if N < 2:
-        raise InputError(f"dt={dt:g} must be at most T/2={T / 2:g}")
-    save_every = int(save_every)
-    frame_every = max(1, N // max(1, int(frames)))
+    run = Run(system, dt, T, beta, solver, stiffness, save_every, frames, load_window,
+              growth_limit)
+    drive(run, chunk, progress)
+    return run.result()
 
-    M, K, B = system.M, system.K, system.B
-    A = M + dt**2 * beta * K + (0.5 * dt * B if B is not None else 0)
-    Am = M + dt**2 * beta * K - (0.5 * dt * B if B is not None else 0)
-    M2 = 2 * M - dt**2 * (1 - 2 * beta) * K
-    Ab = Banded(A, factor=True)
-    M2b, Amb, Eb, Kb = Banded(M2), Banded(Am), Banded(M / dt**2 + beta * K), Banded(K)
 
-    C = system.C.tocsr()
-    m = C.shape[0]
-    W = np.zeros((system.n, m))
-    for j in range(m):
-        col = C[j].toarray().ravel()
-        band_solve(Ab.chol, col)
-        W[:, j] = col
-    D = np.ascontiguousarray((C @ W).reshape(m, m))
-    if stiffness is None:
-        name = choose_solver(solver, D)
-        mode = COMPILED.get(name, -1)
-        kappa = 0.0
-    else:
-        kappa = check_positive("stiffness", stiffness)
-        name, mode = "penalty", 3
-    pysolver = python_solver(name, A, C, system.lo, system.hi, D, W, dt) if mode < 0 else None
-
-    # load: time averages fⁿ for n = 0..N, then Gⁿ = βf^{n+1} + (1−2β)fⁿ + βf^{n−1}
-    nK = system.loads.shape[1]
-    if load_window not in ("forward", "centered"):
-        raise InputError(f"load_window={load_window!r} is not one of: forward, centered")
-    shift = 0.5 * dt if load_window == "centered" else 0.0
-
-    def load_coefficients(n0, n1):
-        """Gⁿ for n = n0..n1−1 (computed per chunk: memory stays flat in T)."""
-        t = np.arange(n0 - 1, n1 + 1) * dt - shift
-        f = np.column_stack([time_averages(a, t, dt) for a in system.load_time])
-        return np.ascontiguousarray(beta * f[2:] + (1 - 2 * beta) * f[1:-1] + beta * f[:-2])
-
-    # start: u⁰, and u¹ = u⁰ + Δt v⁰ + Δt²/2 a⁰ (second order), kept in K_h
-    u_prev = system.u0.astype(float).copy()
-    f0 = system.loads @ np.array([float(a(np.array([0.0]))[0]) for a in system.load_time]) \
-        if nK else np.zeros(system.n)
-    rhs = f0 - K @ u_prev - (B @ system.v0 if B is not None else 0)
-    a0 = scipy.sparse.linalg.spsolve(M.tocsc(), rhs)
-    u1 = u_prev + dt * system.v0 + 0.5 * dt**2 * a0
-    y1 = C @ u1
-    if m and ((y1 < system.lo).any() or (y1 > system.hi).any()):
-        # project u¹ onto K_h in the A-norm: one contact step with F = A u¹
-        x = u1.copy()
-        mu = np.zeros(m)
-        st = np.zeros(m, dtype=np.int8)
-        if box_qp(D, y1, system.lo, system.hi, st, mu) < 0:
-            raise SolverError("could not place u¹ inside the obstacles")
-        u1 = x + W @ mu
-    u_cur = u1
-
-    nsave = N // save_every + 1
-    nobs = len(system.observe)
-    Orows = scipy.sparse.csr_matrix(np.vstack(list(system.observe.values()))) if nobs \
-        else scipy.sparse.csr_matrix((0, system.n))
-    obs = np.full((nsave, nobs), np.nan)
-    obsv = np.full((nsave, nobs), np.nan)
-    energy = np.full(nsave, np.nan)
-    lam = np.zeros((nsave, m))
-    fr = np.full((N // frame_every + 1, system.n), np.nan)
-    frv = np.full_like(fr, np.nan)
-    frf = np.zeros((fr.shape[0], m))
-    stats = np.zeros(4)
-    counters = np.zeros(4, dtype=np.int64)
-    state = np.zeros(m, dtype=np.int8)
-    active_prev = np.zeros(m, dtype=np.bool_)
-
-    Op, Oi, Ox = _csr(Orows)
-    Cp, Ci, Cx = _csr(C)
-    if system.sample_E is not None and system.sample_E.shape[0]:
-        Ep, Ei, Ex = _csr(system.sample_E)
-        slo = np.ascontiguousarray(system.sample_lo, dtype=float)
-        shi = np.ascontiguousarray(system.sample_hi, dtype=float)
-    else:
-        Ep, Ei, Ex = np.zeros(1, np.int64), np.zeros(0, np.int64), np.zeros(0)
-        slo = shi = np.zeros(0)
-    lo = np.ascontiguousarray(system.lo, dtype=float)
-    hi = np.ascontiguousarray(system.hi, dtype=float)
-    Ddiag = np.ascontiguousarray(np.diag(D)) if m else np.zeros(0)
-    d = np.empty(system.n)
-    loads = np.ascontiguousarray(system.loads, dtype=float)
-
-    # states 0 and 1 (E_β needs two states: the energy saved at t = 0 is E_β¹)
-    obs[0] = Orows @ u_prev
-    obsv[0] = Orows @ system.v0
-    record(1, save_every, frame_every, u_prev, u_cur, np.zeros(m), dt, Eb.rows, Kb.rows,
-           dt**2, Op, Oi, Ox, Ep, Ei, Ex, slo, shi, C @ u_cur, lo, hi,
-           obs, obsv, energy, lam, fr, frv, frf, stats, d)
-    fr[0], frv[0] = u_prev, system.v0
-
-    E1 = 0.5 * energy_beta(Eb.rows, Kb.rows, u_prev, u_cur, d)
-    energy[0] = E1
-    Minv_norm = np.sqrt(np.array([lv @ scipy.sparse.linalg.spsolve(M.tocsc(), lv)
-                                  for lv in loads.T])) if nK else np.zeros(0)
-    work = 0.0   # Σ‖Gⁿ‖_{M⁻¹}Δt so far: the a-priori energy bound grows with it
-
-    status, message = "success", "the run reached T"
+def drive(run: Run, chunk: int = 20000, progress: bool | None = None, on_chunk=None) -> None:
+    """Advance ``run`` to its end in chunks, with a progress bar on a terminal and an
+    optional ``on_chunk(run)`` after each chunk (streaming output, checkpoints)."""
     show = sys.stderr.isatty() if progress is None else progress
     bar = None
-    if show and N > 10 * chunk:
+    if show and run.N - run.n > 10 * chunk:
         from tqdm import tqdm
-        bar = tqdm(total=N, unit="step", unit_scale=True, leave=False)
-    wall = 0.0
-    last_good = N
-    if pysolver is None:   # load the compiled kernel outside the timed loop (zero steps)
-        _run(1, 1, mode, kappa, save_every, frame_every, dt, beta, M2b.rows, Amb.rows, Ab.chol,
-             Eb.rows, Kb.rows, loads, np.zeros((0, nK)), Cp, Ci, Cx, lo, hi, W, D, Ddiag, state,
-             active_prev, Ep, Ei, Ex, slo, shi, Op, Oi, Ox, u_prev, u_cur, obs, obsv, energy,
-             lam, fr, frv, frf, stats, counters, 0.0)
-    for n0 in range(1, N, chunk):
-        n1 = min(N, n0 + chunk)
-        t0 = time.perf_counter()
-        G = load_coefficients(n0, n1) if nK else np.zeros((n1 - n0, 0))
-        work += float((np.abs(G) @ Minv_norm).sum()) * dt if nK else 0.0
-        # the bound grows with n: its chunk-end value is the loosest for the chunk
-        Ebound = growth_limit * (math.sqrt(abs(E1)) + work) ** 2 + 1e-300
-        if pysolver is None:
-            code = _run(n0, n1, mode, kappa, save_every, frame_every, dt, beta,
-                        M2b.rows, Amb.rows, Ab.chol, Eb.rows, Kb.rows, loads, G,
-                        Cp, Ci, Cx, lo, hi, W, D, Ddiag, state, active_prev,
-                        Ep, Ei, Ex, slo, shi, Op, Oi, Ox,
-                        u_prev, u_cur, obs, obsv, energy, lam, fr, frv, frf, stats, counters,
-                        Ebound)
-        else:
-            code = _python_chunk(pysolver, n0, n1, save_every, frame_every, dt, beta,
-                                 M2b, Amb, Ab, Eb, Kb, loads, G, Cp, Ci, Cx, lo, hi, W,
-                                 active_prev, Ep, Ei, Ex, slo, shi, Op, Oi, Ox,
-                                 u_prev, u_cur, obs, obsv, energy, lam, fr, frv, frf, stats,
-                                 counters,
-                                 Ebound)
-        wall += time.perf_counter() - t0
+        bar = tqdm(total=run.N, initial=run.n, unit="step", unit_scale=True, leave=False)
+    try:
+        while not run.done:
+            n0 = run.n
+            run.advance(n0 + chunk)
+            if bar is not None:
+                bar.update(run.n - n0)
+            if on_chunk is not None:
+                on_chunk(run)
+    finally:
         if bar is not None:
-            bar.update(n1 - n0)
-        if code == FAILED:
-            k = int(counters[3])
-            raise SolverError(f"the {name} contact solver failed at step {k} (t={k * dt:.6g} s)")
-        if code == UNSTABLE:
-            k = int(counters[3])
-            limit = linear_limit(kappa_h(system), beta)
-            status = "unstable"
-            message = (f"unstable at step {k} (t={k * dt:.6g} s): energy "
-                       f"{energy[k // save_every]:.3g} exceeds {Ebound:.3g}; dt={dt:g} s, "
-                       f"beta={beta:g}, linear stability limit 2/√(κ_h(1−4β)) = {limit:.4g} s")
-            last_good = (k // save_every - 1) * save_every
-            break
-    if bar is not None:
-        bar.close()
-
-    if status != "success":
-        keep = last_good // save_every + 1
-        obs, obsv, energy, lam = obs[:keep], obsv[:keep], energy[:keep], lam[:keep]
-        nf = last_good // frame_every + 1
-        fr, frv, frf = fr[:nf], frv[:nf], frf[:nf]
-    steps = last_good
-    t = np.arange(obs.shape[0]) * save_every * dt
-    names = list(system.observe)
-    return Result(
-        t=t, observed={k: obs[:, i] for i, k in enumerate(names)},
-        velocity={k: obsv[:, i] for i, k in enumerate(names)}, energy=energy,
-        contact_force=lam, frames_t=np.arange(fr.shape[0]) * frame_every * dt, frames_u=fr,
-        frames_v=frv, frames_force=frf,
-        status=status, message=message, steps=steps, dt=dt, T=N * dt, beta=beta, solver=name,
-        wall_time_s=wall, max_nodal_violation=float(max(stats[0], 0.0)),
-        max_penetration=float(max(stats[1], stats[2], stats[0], 0.0)),
-        max_penetration_below=float(stats[1]), max_penetration_above=float(stats[2]),
-        impacts=int(counters[0]), contact_fraction=float(counters[1]) / max(1, steps - 1),
-        qp_iterations=int(counters[2]), system=system)
+            bar.close()
 
 
-def _python_chunk(pysolver, n0, n1, save_every, frame_every, dt, beta, M2b, Amb, Ab, Eb, Kb,
-                  loads, G, Cp, Ci, Cx, lo, hi, W, active_prev, Ep, Ei, Ex, slo, shi,
-                  Op, Oi, Ox, u_prev, u_cur, obs, obsv, energy, lam, fr, frv, frf, stats,
-                  counters,
-                  Ebound):
+def _python_chunk(run: Run, n0, n1, G, Ebound):
     """The same step as `_run`, with the contact solve done by a Python-level engine."""
-    n, m = u_cur.size, lo.size
-    x, yf, d = np.empty(n), np.empty(m), np.empty(n)
+    n, m, dt = run.u_cur.size, run.m, run.dt
+    Cp, Ci, Cx = run.Cs
+    x, yf = np.empty(n), np.empty(m)
     no_spring = np.zeros(m)
-    dt2 = dt * dt
     for step in range(n0, n1):
-        free_step(M2b.rows, Amb.rows, Ab.chol, loads, G[step - n0], u_prev, u_cur, dt2,
-                  Cp, Ci, Cx, x, yf, no_spring)
+        free_step(run.M2b.rows, run.Amb.rows, run.Ab.chol, run.loads, G[step - n0], run.u_prev,
+                  run.u_cur, dt * dt, Cp, Ci, Cx, x, yf, no_spring)
         try:
-            mu, its = pysolver.solve(x, yf)
+            mu, its = run.pysolver.solve(x, yf)
         except SolverError as e:
             raise SolverError(f"step {step + 1} (t={(step + 1) * dt:.6g} s): {e}") from None
-        counters[2] += its
-        finish_step(x, W, mu, u_prev, u_cur)
+        run.counters[2] += its
+        finish_step(x, run.W, mu, run.u_prev, run.u_cur)
         active = mu != 0.0
-        counters[0] += int(np.count_nonzero(active & ~active_prev))
-        active_prev[:] = active
-        counters[1] += int(active.any())
-        cy = np.array([Cx[Cp[j]:Cp[j + 1]] @ u_cur[Ci[Cp[j]:Cp[j + 1]]] for j in range(m)])
-        record(step + 1, save_every, frame_every, u_prev, u_cur, mu, dt, Eb.rows,
-               Kb.rows, dt2, Op, Oi, Ox, Ep, Ei, Ex, slo, shi, cy, lo, hi,
-               obs, obsv, energy, lam, fr, frv, frf, stats, d)
-        if (step + 1) % save_every == 0 and not abs(energy[(step + 1) // save_every]) <= Ebound:
-            counters[3] = step + 1
+        run.counters[0] += int(np.count_nonzero(active & ~run.active_prev))
+        run.active_prev[:] = active
+        run.counters[1] += int(active.any())
+        run._record(step + 1, mu, run.system.C @ run.u_cur)
+        if (step + 1) % run.save_every == 0 and \
+                not abs(run.energy[(step + 1) // run.save_every]) <= Ebound:
+            run.counters[3] = step + 1
             return UNSTABLE
     return 0

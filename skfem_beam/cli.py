@@ -46,8 +46,20 @@ def parser(prog: str, description: str, *, J=None, dt=None, T=None, beta=0.5,
     p.add_argument("--frames", type=int, default=200, help="field snapshots kept")
     p.add_argument("--out", default=f"out/{prog.rsplit('.', 1)[-1]}", help="output folder")
     p.add_argument("--overwrite", action="store_true", help="replace an existing --out folder")
+    p.add_argument("--flush-every", type=int, default=20000,
+                   help="steps between writes of the series to disk")
+    p.add_argument("--checkpoint-every", type=float, default=None, metavar="SECONDS",
+                   help="write the full integrator state this often (atomically)")
+    p.add_argument("--resume", metavar="DIR", default=None,
+                   help="continue the killed run in DIR from its last checkpoint")
     p.add_argument("--version", action="version", version=f"skfem_beam {__version__}")
     return p
+
+
+def parse(p: Parser, argv=None):
+    """Parse the flags; with --resume, the flags stored by the run being resumed."""
+    from .runner import stored_args
+    return stored_args(p.parse_args(argv), p)
 
 
 def check_method(args) -> None:

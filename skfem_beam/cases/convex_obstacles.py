@@ -18,7 +18,7 @@ def obstacles(L: float, g0: float = 0.005, curvature: float = 0.03) -> Obstacles
 
 
 def main(argv=None) -> int:
-    args = _longitudinal.parser("skfem_beam.cases.convex_obstacles", __doc__).parse_args(argv)
+    args = cli.parse(_longitudinal.parser("skfem_beam.cases.convex_obstacles", __doc__), argv)
     check_positive("L", args.L)
     pb = _longitudinal.problem(args, obstacles(args.L))
     gL = 0.005 + 0.03 * (args.L / 2) ** 2

@@ -25,7 +25,7 @@ def main(argv=None) -> int:
     p = _longitudinal.parser("skfem_beam.cases.energy_decay", __doc__, T=1.0)
     p.add_argument("--compare-beta", type=float, default=0.25,
                    help="a second β whose energy is charted beside --beta (negative: none)")
-    args = p.parse_args(argv)
+    args = cli.parse(p, argv)
     check_positive("L", args.L)
     other = None if args.compare_beta < 0 else check_beta(args.compare_beta)
     pb = _longitudinal.problem(args, convex(args.L, 0.2, 0.3), load=Load(),
@@ -33,14 +33,14 @@ def main(argv=None) -> int:
                                                     du0=lambda x: 0.01 * x,
                                                     v0=lambda x: -x))
 
-    def energy_files(folder, result):
-        columns = {"t": result.t, f"energy_beta_{result.beta:g}": result.energy}
+    def energy_files(folder, data, run):
+        columns = {"t": data["t"], f"energy_beta_{run.beta:g}": data["energy"]}
         if other is not None:
             r2 = solve(beam_system(pb), args.dt, args.T, other, solver=args.solver,
                        save_every=args.save_every, frames=2)
-            columns[f"energy_beta_{other:g}"] = r2.energy[:result.t.size]
+            columns[f"energy_beta_{other:g}"] = r2.energy[:data["t"].size]
         write_timeseries(folder, columns, "energy.csv")
-        trajectory_chart(folder / "energy_decay.png", result.t,
+        trajectory_chart(folder / "energy_decay.png", data["t"],
                          {k: v for k, v in columns.items() if k != "t"},
                          title=f"discrete energy ½E_β, f = 0 (J={pb.J}, {pb.element}, Δt={args.dt:g} s)",
                          ylabel="energy (m³/s²)")

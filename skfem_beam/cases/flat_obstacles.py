@@ -24,7 +24,7 @@ def obstacles(L: float, gap: float = 0.01) -> Obstacles:
 def main(argv=None) -> int:
     p = _longitudinal.parser("skfem_beam.cases.flat_obstacles", __doc__)
     p.add_argument("--gap", type=float, default=0.01, help="obstacles at ±gap on [L/2, L] (m)")
-    args = p.parse_args(argv)
+    args = cli.parse(p, argv)
     check_positive("L", args.L)
     pb = _longitudinal.problem(args, obstacles(args.L, args.gap))
     config = {"f": "sin(10 t)", "u0": "0", "v0": "0", "g": "±gap on [L/2, L]"}

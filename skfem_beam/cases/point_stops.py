@@ -33,7 +33,7 @@ def main(argv=None) -> int:
     p.add_argument("--gap", type=float, default=0.1, help="stops at ±gap (m)")
     p.add_argument("--amplitude", type=float, default=0.2, help="support φ = A sin(ωt): A (m)")
     p.add_argument("--omega", type=float, default=10.0, help="support φ = A sin(ωt): ω (rad/s)")
-    args = p.parse_args(argv)
+    args = cli.parse(p, argv)
     pb = problem(args.L, args.k2, args.gap, args.amplitude, args.omega, args.J, args.element)
     config = {"u0": "0", "v0": "-amplitude*omega*h(x) (L2 projection)"}
     return run_beam_case("point_stops", pb, args, config, stops=(-args.gap, args.gap))

@@ -35,6 +35,8 @@ from .stability import kappa_h, linear_limit
 
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(4)
 FAILED, UNSTABLE = 1, 2
+MAX_STEPS = 10**10        # beyond this a run is a hang, not a computation
+MAX_SAVED = 2 * 10**7     # saved rows × constrained values kept in memory (~1 GB)
 
 
 @dataclass
@@ -288,6 +290,13 @@ class Run:
             raise InputError(f"dt={dt:g} must be at most T/2={T / 2:g}")
         if load_window not in ("forward", "centered"):
             raise InputError(f"load_window={load_window!r} is not one of: forward, centered")
+        if N > MAX_STEPS:
+            raise InputError(f"T/dt = {N:.3g} steps is more than {MAX_STEPS:.0e}: "
+                             "raise dt or shorten T")
+        if N // save_every * max(1, system.C.shape[0]) > MAX_SAVED:
+            raise InputError(f"keeping every {save_every}-th of {N:.3g} steps would store "
+                             f"{N // save_every:.3g} rows: raise --save-every to at least "
+                             f"{math.ceil(N * max(1, system.C.shape[0]) / MAX_SAVED)}")
         self.system, self.dt, self.beta, self.N = system, dt, beta, N
         self.save_every = save_every = int(save_every)
         self.frame_every = frame_every = max(1, N // max(1, int(frames)))

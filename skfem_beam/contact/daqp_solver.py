@@ -1,0 +1,64 @@
+"""daqp (a dual active-set QP solver) as a per-step contact solver.
+
+It solves the reduced problem in the contact values,
+
+    min ½(ŷ − ŷ_f)ᵀ Ĥ (ŷ − ŷ_f)   s.t.  lo/s ≤ ŷ ≤ hi/s,   ŷ = y/s,  Ĥ = d̄·D⁻¹,
+
+as a problem with simple bounds only (no general constraint rows).  s (the largest
+finite |bound|) and d̄ (mean of diag D) make ŷ and Ĥ O(1) so daqp's absolute
+tolerances are relative ones.  One ``daqp.Model`` lives for the whole run: each step
+only updates f = −Ĥŷ_f, and Model.solve starts from the previous step's active set
+(daqp keeps its working set in the workspace between solves).
+
+daqp's multipliers: Ĥ(ŷ − ŷ_f) + λ = 0 with λ < 0 at a lower and λ > 0 at an upper
+bound, so μ = −(s/d̄)λ; only the sign pattern is used, and μ is recomputed exactly on
+that active set (see ``osqp_solver.exact_finish``), so y = y_f + Dμ is on its bounds
+to round-off (`active_set.exact_finish`).
+"""
+from __future__ import annotations
+
+import daqp
+import numpy as np
+import scipy.linalg
+
+from ..errors import SolverError
+from .active_set import bound_scale, exact_finish
+
+DAQP_INF = 1e30      # daqp's "no bound"
+
+
+class DAQPSolver:
+    """Per-run daqp workspace; ``solve(x_free, y_free) -> (μ, iterations)``."""
+
+    def __init__(self, A, C, lo, hi, D, W, dt):
+        self.lo = np.ascontiguousarray(lo, dtype=float)
+        self.hi = np.ascontiguousarray(hi, dtype=float)
+        self.D = np.ascontiguousarray(D, dtype=float)
+        m = self.lo.size
+        self.s = bound_scale(self.lo, self.hi)
+        dbar = float(np.diag(self.D).mean())
+        H = dbar * scipy.linalg.cho_solve(scipy.linalg.cho_factor(self.D), np.eye(m))
+        self.H = np.ascontiguousarray(0.5 * (H + H.T))
+        self.Hs = self.H / self.s                    # f = −Ĥ y_f / s
+        self.state = np.zeros(m, dtype=np.int8)
+        self.repairs = 0
+        self.model = daqp.Model()
+        flag, _ = self.model.setup(self.H, np.zeros(m), np.zeros((0, m)),
+                                   np.minimum(self.hi / self.s, DAQP_INF),
+                                   np.maximum(self.lo / self.s, -DAQP_INF),
+                                   np.zeros(m, dtype=np.intc))
+        if flag < 0:
+            raise SolverError(f"daqp setup failed (exitflag {flag})")
+        # H is SPD: no proximal regularisation; feasibility to round-off, not 1e-6
+        self.model.settings = {"eps_prox": 0.0, "primal_tol": 1e-12, "iter_limit": 100 * m + 100}
+
+    def solve(self, x_free, y_free):
+        self.model.update(f=-(self.Hs @ y_free))
+        _, _, flag, info = self.model.solve()
+        if flag != 1:
+            raise SolverError(f"daqp returned exitflag {flag} after {info['iterations']} "
+                              f"iterations")
+        mu = np.empty(self.lo.size)
+        self.repairs += exact_finish(self.D, y_free, self.lo, self.hi, info["lam"],
+                                     self.state, mu, self.s, "daqp")
+        return mu, int(info["iterations"])

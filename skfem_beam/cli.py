@@ -44,6 +44,8 @@ def parser(prog: str, description: str, *, J=None, dt=None, T=None, beta=0.5,
     p.add_argument("--save-every", type=int, default=1,
                    help="keep every n-th step in timeseries.csv")
     p.add_argument("--frames", type=int, default=200, help="field snapshots kept")
+    p.add_argument("--format", default="both",
+                   help="field time series for ParaView: xdmf | vtu | both | none")
     p.add_argument("--out", default=f"out/{prog.rsplit('.', 1)[-1]}", help="output folder")
     p.add_argument("--overwrite", action="store_true", help="replace an existing --out folder")
     p.add_argument("--flush-every", type=int, default=20000,

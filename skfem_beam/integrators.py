@@ -454,10 +454,11 @@ class Run:
         if n1 == self.N:
             self.status, self.message = "success", "the run reached T"
 
-    _STATE = ("u_prev", "u_cur", "state", "active_prev", "stats", "counters")
+    _STATE = ("u_prev", "u_cur", "state", "active_prev", "stats", "counters", "fr", "frv", "frf")
 
     def checkpoint(self) -> dict:
-        """Everything needed to continue bit for bit (saved series are the caller's)."""
+        """Everything needed to continue bit for bit (saved series are the caller's; the
+        field frames, a few hundred at most, come along so they can be written anew)."""
         if self.pysolver is not None:
             raise InputError(f"checkpoints need a compiled solver (projection, active-set, "
                              f"penalty), not {self.solver!r}")

@@ -21,6 +21,7 @@ import numpy as np
 
 from . import cli
 from .errors import InputError, SolverError
+from .fields import FORMATS, FieldWriter
 from .integrators import Run, drive
 from .io import check_output_dir, write_summary
 
@@ -80,6 +81,8 @@ def prepare(args) -> Path:
         return out
     if getattr(args, "checkpoint_every", None) is not None and args.checkpoint_every < 0:
         raise InputError(f"--checkpoint-every={args.checkpoint_every:g} must be ≥ 0 seconds")
+    if getattr(args, "format", "none") not in FORMATS:
+        raise InputError(f"--format {args.format!r} is not one of: {', '.join(FORMATS)}")
     if getattr(args, "flush_every", 1) < 1:
         raise InputError(f"--flush-every={args.flush_every} must be a whole number ≥ 1")
     return check_output_dir(args.out, args.overwrite)
@@ -103,26 +106,39 @@ def execute(run: Run, out: Path, args, summary: dict, columns, finish, resume: b
         out.mkdir(parents=True)
         write_summary(out, {**summary, "status": "running"})
         series = SeriesFile(series_path, names)
-        series.append(columns(run, 0, 1))
     every = getattr(args, "checkpoint_every", None)
     last_ck = time.monotonic()
+    fmt = getattr(args, "format", "none")
+    # fields: on resume the frames come back with the checkpoint and are written anew
+    fields = FieldWriter(out, run.system, fmt) if fmt != "none" else None
+    frames_written = 0
 
     def on_chunk(run):
-        nonlocal last_ck
+        nonlocal last_ck, frames_written
         k1 = run.n // run.save_every + 1
         series.append(columns(run, series.rows, k1))
         series.sync()
+        if fields is not None:
+            for k in range(frames_written, run.n // run.frame_every + 1):
+                fields.write(k * run.frame_every * run.dt, run.fr[k], run.frv[k], run.frf[k])
+            frames_written = run.n // run.frame_every + 1
+            fields.flush()
         if every is not None and time.monotonic() - last_ck >= every and not run.done:
             _atomic_savez(out / CHECKPOINT, rows=series.rows, **run.checkpoint())
             last_ck = time.monotonic()
 
     try:
+        on_chunk(run)                      # state 1 (and, on resume, the frames so far)
         drive(run, chunk=getattr(args, "flush_every", 20000), on_chunk=on_chunk)
     except (SolverError, OSError) as e:
         series.close()
+        if fields is not None:
+            fields.close()
         write_summary(out, {**summary, "status": "failed", "message": str(e), "steps": run.n})
         raise
     series.close()
+    if fields is not None:
+        fields.close()
     result = run.result()
     data = np.genfromtxt(series_path, delimiter=",", names=True)
     data = {k: np.atleast_1d(data[k]) for k in data.dtype.names}

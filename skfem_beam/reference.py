@@ -1,8 +1,12 @@
 """Exact solutions the numerical results are tested against."""
 from __future__ import annotations
 
+import bisect
+
 import numpy as np
+from numpy.polynomial import polynomial as _P
 from scipy.optimize import brentq
+from scipy.special import comb
 
 # roots of 1 + cos(βL) cosh(βL) = 0: the clamped–free Euler–Bernoulli beam
 CANTILEVER_BETA_L = (1.87510407, 4.69409113, 7.85475744, 10.99554073)
@@ -55,9 +59,6 @@ def cantilever_mode(x, L: float, n: int) -> np.ndarray:
 # the paper are the first pieces (see bar_elastic_paper).
 # ---------------------------------------------------------------------------------------
 
-from numpy.polynomial import polynomial as _P  # noqa: E402
-
-
 class _ExpPoly:
     """P(s) + e^{−κs} Q(s) on [t0, t1], s = τ − t0 (ascending coefficient arrays)."""
 
@@ -101,13 +102,12 @@ class _ExpPoly:
 
 
 def _taylor(c: np.ndarray, d: float) -> np.ndarray:
-    """Coefficients of c(s + d) in s."""
-    out, fact, cur = np.empty(c.size), 1.0, c
-    for j in range(c.size):
-        out[j] = _P.polyval(d, cur) / fact
-        cur = _P.polyder(cur) if cur.size > 1 else np.zeros(1)
-        fact *= j + 1
-    return out
+    """Coefficients of c(s + d) in s: out_j = Σ_{m≥j} C(m, j) d^{m−j} c_m."""
+    n = c.size
+    m = np.arange(n)
+    e = m[None, :] - m[:, None]                     # m − j
+    B = np.where(e >= 0, comb(m[None, :], m[:, None]) * float(d) ** np.maximum(e, 0), 0.0)
+    return B @ c
 
 
 def _robin_solve(q: _ExpPoly, p0: float) -> _ExpPoly:
@@ -129,23 +129,19 @@ class _Piecewise:
 
     def __init__(self):
         self.pieces: list[_ExpPoly] = []
+        self.starts: list[float] = []
 
     def append(self, piece: _ExpPoly):
         self.pieces.append(piece)
-
-    @property
-    def end(self) -> float:
-        return self.pieces[-1].t1
+        self.starts.append(piece.t0)
 
     def piece_at(self, t: float) -> _ExpPoly:
-        starts = np.array([p.t0 for p in self.pieces])
-        i = int(np.searchsorted(starts, t, side="right")) - 1
-        return self.pieces[max(i, 0)]
+        return self.pieces[max(bisect.bisect_right(self.starts, t) - 1, 0)]
 
     def __call__(self, t, der: int = 0):
         t = np.asarray(t, dtype=float)
-        starts = np.array([p.t0 for p in self.pieces])
-        idx = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(self.pieces) - 1)
+        idx = np.clip(np.searchsorted(np.array(self.starts), t, side="right") - 1, 0,
+                      len(self.pieces) - 1)
         out = np.empty(t.shape)
         for i in np.unique(idx):
             fn = self.pieces[i]
@@ -164,7 +160,8 @@ def _first_root(fun, a: float, b: float, kappa: float, tol: float, skip: float =
         layer = np.geomspace(1e-4 / kappa, 40.0 / kappa, 200)
         grid.append(a + layer[layer < b - a])
     grid = np.unique(np.concatenate(grid))
-    grid = np.concatenate([[a], grid[grid >= a + skip]]) if skip else grid
+    if skip:   # start the search at a + skip: a switch right there is returned as such
+        grid = grid[grid >= a + skip]
     vals = fun(grid)
     bad = np.flatnonzero(vals[1:] < -tol) + 1
     if bad.size == 0:
@@ -191,7 +188,6 @@ class BarWaves:
         self.G.append(_ExpPoly(0.0, 2.0, [g / 2, v / 2], kappa=k))   # data, reflected at ξ=1
         self.p = _Piecewise()
         self.contact_intervals: list[list[float]] = []
-        self._immediate = False
         self._march(float(tau_end) + 1.0)
 
     # the load term f̃τ²/2 written around t0
@@ -213,26 +209,35 @@ class BarWaves:
         non-zero derivative of the free motion U = 2G − G(t) + p0 + f̃τ²/2."""
         G = self.G.piece_at(t).rebase(t)
         U = p0 + G(t) + self.f * t**2 / 2
-        if U < -self.tol:
+        tol = self._tol(t)
+        if U < -tol:
             return True
-        if U > self.tol:
+        if U > tol:
             return False
         Ufree = G.scale(2.0) + self._load(t, G.t1)
         for _ in range(4):
             Ufree = Ufree.deriv()
             d = float(Ufree(t))
-            if abs(d) > self.tol:
+            if abs(d) > tol:
                 return d < 0
         return False
+
+    def _tol(self, t: float) -> float:
+        """Round-off of U = p + G + f̃τ²/2: its terms grow like f̃τ²/2 and cancel."""
+        return self.tol * (1.0 + abs(self.f) * t * t)
 
     def _march(self, tau_end: float):
         t, p0 = 0.0, self.g / 2          # p(0) = F(0)
         contact = self._starts_in_contact(t, p0)
         eps = 1e-10                      # switches closer than this are round-off
         skip = 0.0                       # > 0: ignore events just after t (see below)
+        immediate = False                # the last pass switched the law without a piece
         for _ in range(100000):
             if t >= tau_end:
                 return
+            if len(self.p.pieces) > 20000:   # the count grows ~ quadratically with τ
+                raise RuntimeError(f"the exact bar solution needs more than 20000 pieces "
+                                   f"by τ = ct/L = {t:.4g}; use a shorter T")
             G = self.G.piece_at(t).rebase(t)
             cand = self._candidate(contact, G, p0)
             U = cand + G + self._load(t, G.t1)
@@ -243,19 +248,20 @@ class BarWaves:
                 fun = lambda s, U=U: -U(s)  # noqa: E731
             else:                                # free: hit when U < 0
                 fun = U
-            te = _first_root(fun, t, G.t1, self._k, self.tol, skip)
-            skip = 0.0
-            if te is not None and te <= t + eps:
+            tol = self._tol(t)
+            te = _first_root(fun, t, G.t1, self._k, tol, skip)
+            forced, skip = skip > 0, 0.0
+            if te is not None and te <= t + eps and not forced:
                 # an immediate switch; if the other law also switches at once, U and R
                 # both vanish to round-off (grazing): stay free and look past it
-                if self._immediate:
-                    contact, skip, self._immediate = False, eps, False
+                if immediate:
+                    contact, skip, immediate = False, eps, False
                 else:
-                    contact, self._immediate = not contact, True
+                    contact, immediate = not contact, True
                 continue
-            self._immediate = False
+            immediate = False
             switched = te is not None and te < G.t1 - eps   # no sliver pieces at the end
-            te = te if switched else G.t1
+            te = max(te, t + eps) if switched else G.t1
             piece = _ExpPoly(t, te, cand.P, cand.Q, self._k)
             self.p.append(piece)
             self.G.append(piece.moved(2.0, add=self.v))   # G(s) = p(s−2) + v

@@ -22,4 +22,7 @@ def make_space(element: str, nodes):
     if element == "bspline":
         from .bspline import BSplineSpace
         return BSplineSpace(nodes)
+    if element == "p1":
+        from .lagrange import LagrangeSpace
+        return LagrangeSpace(nodes)
     raise ValueError(f"unknown element {element!r}")

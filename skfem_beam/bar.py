@@ -1,0 +1,307 @@
+"""The impacting bar of Do, Raupp & Feijoo: a (visco)elastic bar, obstacle at x = 0.
+
+    ρ u_tt = (a u_x + b u_xt)_x + f   on (0, L),   σ(L) = 0,
+    σ = a u_x + b u_xt,   R = −σ(0) the obstacle's reaction on the bar,
+
+    rigid obstacle:   U = u(0, t) ≥ 0,  R ≥ 0,  R·U = 0       (paper (2.10))
+    elastic obstacle: R = k U⁻                                 (paper (2.8))
+
+Units: everything is per unit cross-section area.  The semi-discrete equation is the
+paper's (2.9) with the density kept:
+
+    ρ M₁ ü + b S u̇ + a S u = f·(1, φ_i) + e₀ R,     (M₁ = (φ_i, φ_j), S = (φ_i', φ_j'))
+
+so M carries ρ, every term is a force, f is a body force per unit volume (N/m³ for a
+bar of unit cross-section; with ρ = 1 it equals the paper's f) and the spring
+stiffness enters the shared scheme as κ = k itself, with no division by ρ.
+
+The rigid obstacle is one more constrained value for the shared contact-implicit
+scheme (``solve(system, …)``); the elastic obstacle is the same scheme with
+``stiffness=k``: the one-sided spring is weighted like the elastic force,
+β R(U^{n+1}) + (1−2β) R(Uⁿ) + β R(U^{n−1}), and the step's piecewise-linear monotone
+equation in U^{n+1} is solved exactly by a semi-smooth Newton step
+(:mod:`skfem_beam.contact.penalty`; ≤ 2 iterations for one value).
+
+Why not the paper's splitting kU⁻ = (k/2)(|U| − U), (k/2)U β-weighted and (k/2)|Uⁿ|
+explicit ((7.3)(iv)): in contact the halves add up to the linear spring
+k[(β/2)U^{n+1} + (1−β)Uⁿ + (β/2)U^{n−1}], i.e. weighted with β/2 < 1/4, which is only
+conditionally stable for a stiff spring (Δt < 2/√(ω²(1−2β)), ω² = k/m₀, m₀ the
+contact node's mass), and the explicit half keeps any discrete energy from being
+conserved.  The implicit law has no step limit for β ≥ 1/4, and the energy
+E_β + ½k(β(δU⁻)² + U⁻ⁿU⁻ⁿ⁻¹) is conserved to round-off while the spring stays
+compressed or idle (measured: 5e-12), changing only on the steps where it switches.
+
+The paper's exponential shift z = e^{−λt}u is not used: it serves the proof (a
+Gronwall argument) and the paper saw no difference between λ = 0 and 0.25; with the
+implicit spring the scheme is stable without it, and it would make the energy the
+scheme conserves a weighted one.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from .errors import InputError
+from .problem import check_finite, check_positive
+from .semidiscrete import SemiDiscrete
+from .spaces.lagrange import MASSES, LagrangeSpace
+
+OBSTACLES = ("rigid", "elastic")
+
+
+def _check_nonnegative(name: str, value: float) -> float:
+    value = check_finite(name, value)
+    if value < 0:
+        raise InputError(f"{name}={value:g} must be ≥ 0")
+    return value
+
+
+@dataclass(frozen=True)
+class Bar:
+    """The bar scene.  Defaults: the paper's Example 1 (k = 100, v0 = −1, N = 100).
+
+    ``u0`` is a uniform initial displacement: a gap to the obstacle when > 0 (the bar
+    then flies freely for u0/|v0| before it hits).  ``mass`` is the mass matrix; the
+    default ``average`` is the one that meets the accuracy targets (see
+    :mod:`skfem_beam.spaces.lagrange` and DESIGN "Bar accuracy").
+    """
+    a: float = 1.0           # Young's modulus (Pa)
+    b: float = 0.0           # Kelvin–Voigt viscosity (Pa·s)
+    rho: float = 1.0         # density (kg/m³)
+    L: float = 1.0           # length (m)
+    f: float = 0.0           # uniform body force (N/m³); Example 2: −1
+    v0: float = -1.0         # uniform initial velocity (m/s); < 0 moves towards the obstacle
+    u0: float = 0.0          # uniform initial displacement (m); the gap to the obstacle
+    obstacle: str = "rigid"  # 'rigid' (Signorini) or 'elastic' (spring R = k U⁻)
+    k: float = 100.0         # spring stiffness (Pa/m) of the elastic obstacle
+    N: int = 100             # number of elements
+    mass: str = "average"    # 'consistent' | 'lumped' | 'average'
+
+    def __post_init__(self):
+        for name in ("a", "rho", "L"):
+            object.__setattr__(self, name, check_positive(name, getattr(self, name)))
+        object.__setattr__(self, "b", _check_nonnegative("b", self.b))
+        for name in ("f", "v0", "u0"):
+            object.__setattr__(self, name, check_finite(name, getattr(self, name)))
+        if isinstance(self.N, bool) or not isinstance(self.N, (int, np.integer)) or self.N < 1:
+            raise InputError(f"N={self.N!r} must be a whole number ≥ 1")
+        object.__setattr__(self, "N", int(self.N))
+        if self.obstacle not in OBSTACLES:
+            raise InputError(f"obstacle={self.obstacle!r} is not one of: {', '.join(OBSTACLES)}")
+        if self.mass not in MASSES:
+            raise InputError(f"mass={self.mass!r} is not one of: {', '.join(MASSES)}")
+        k = _check_nonnegative("k", self.k)
+        if k == 0 and self.obstacle == "elastic":
+            raise InputError("k=0 must be > 0 for an elastic obstacle")
+        object.__setattr__(self, "k", k)
+        if self.obstacle == "rigid" and self.u0 < 0:
+            raise InputError(f"the initial state violates the rigid obstacle: "
+                             f"u(0,0)=u0={self.u0:g} < 0")
+
+    @property
+    def c(self) -> float:
+        """Wave speed √(a/ρ)."""
+        return math.sqrt(self.a / self.rho)
+
+    @property
+    def h(self) -> float:
+        return self.L / self.N
+
+
+def bar_system(bar: Bar) -> SemiDiscrete:
+    """P1 semi-discretisation of the bar: M = ρM_mass, K = aS, B = bS, constraint u(0) ≥ 0.
+
+    The constraint row is there for both obstacles: the rigid one enforces it, the
+    elastic one is a spring on the same value (``solve(…, stiffness=bar.k)``).
+    """
+    space = LagrangeSpace(np.linspace(0.0, bar.L, bar.N + 1), bar.mass)
+    n = space.n
+    e0 = sp.csr_matrix(([1.0], ([0], [0])), shape=(1, n))
+    eL = np.zeros(n)
+    eL[-1] = 1.0
+    loads = space.load_vector(lambda x: np.ones_like(x))[:, None] if bar.f != 0 \
+        else np.zeros((n, 0))
+    load_time = [lambda t, f=bar.f: np.full(np.shape(t), f)] if bar.f != 0 else []
+    return SemiDiscrete(
+        M=(bar.rho * space.M).tocsr(), K=(bar.a * space.S).tocsr(),
+        B=(bar.b * space.S).tocsr() if bar.b > 0 else None,
+        C=e0, lo=np.array([0.0]), hi=np.array([np.inf]), x_contact=np.array([0.0]),
+        loads=loads, load_time=load_time,
+        u0=np.full(n, bar.u0), v0=np.full(n, bar.v0),
+        # mean_u = (1/L)∫u dx: the centre of mass, and the load's potential −fL·mean_u
+        observe={"u0": e0.toarray().ravel(), "uL": eL,
+                 "mean_u": space.load_vector(np.ones_like) / bar.L}, space=space,
+        meta={"kind": "bar", "L": bar.L, "a": bar.a, "b": bar.b, "rho": bar.rho,
+              "obstacle": bar.obstacle, "k": bar.k, "N": bar.N, "mass": bar.mass})
+
+
+METHODS = ("contact", "penalty")
+
+
+def spring_step_ratio(bar: Bar, dt: float) -> float:
+    """ω₀Δt, ω₀ = √(k/m₀): the contact node (mass m₀ = M₀₀) on the spring.  Well above 1
+    the β-weighted one-sided spring mis-times each impact on the node and can gain
+    energy there (measured: ×36 over Example 2 with k = 1e8, Δt = 1e-3)."""
+    m0 = bar.rho * bar.h * {"consistent": 1 / 3, "lumped": 1 / 2, "average": 5 / 12}[bar.mass]
+    return math.sqrt(bar.k / m0) * dt
+
+
+@dataclass
+class BarRun:
+    """A bar run, as series at the step times tₙ (n = 0..N).
+
+    ``force`` is the obstacle reaction R at tₙ: the force of the step centred on tₙ
+    (for the spring, its β-weighted value β R^{n+1} + (1−2β) Rⁿ + β R^{n−1}).  The
+    start step (u¹ from a Taylor step, placed inside the obstacle) records no force,
+    so ``force[0]`` is the spring force at u⁰ for a spring and NaN for the rigid
+    obstacle.  Energies: ``kinetic`` ½|δu/Δt|²_M, ``strain`` ½(βδuᵀKδu + uⁿᵀKuⁿ⁻¹)
+    (the two halves of the scheme's conserved E_β), ``obstacle`` the spring's
+    ½k(β(δU⁻)² + Uⁿ⁻U^{n−1,−}) (the same quadratic form while it is compressed),
+    ``energy`` their sum; ``load_potential`` −fL·ū (ū the mean displacement), so that
+    ``energy + load_potential`` is what an elastic bar conserves.  The split needs every
+    state: for very long runs (more than ``all_states_limit`` stored values) only
+    ``energy`` is given and the split is NaN.
+    """
+    bar: Bar
+    method: str
+    t: np.ndarray
+    u0: np.ndarray
+    uL: np.ndarray
+    force: np.ndarray
+    kinetic: np.ndarray
+    strain: np.ndarray
+    obstacle: np.ndarray
+    energy: np.ndarray
+    load_potential: np.ndarray
+    result: object   # the integrator's Result (run to T + Δt, see run_bar)
+
+    @property
+    def penetration(self) -> float:
+        """max(−u(0, tₙ)) ≥ 0 over the run (the spring's compression for a spring)."""
+        return float(max(0.0, -np.min(self.u0)))
+
+    @property
+    def wall_time_s(self) -> float:
+        return self.result.wall_time_s
+
+
+def run_bar(bar: Bar, dt: float, T: float, beta: float = 0.25, method: str = "contact",
+            solver: str = "auto", all_states_limit: int = 4_000_000) -> BarRun:
+    """Integrate the bar with the shared scheme (:func:`skfem_beam.integrators.solve`).
+
+    rigid + contact: the Signorini condition u(0) ≥ 0 (one constrained value, so the
+    step is the projection of Lemma 4.1); rigid + penalty: a one-sided spring of
+    stiffness ``bar.k`` stands in for the rigid obstacle (normal compliance); elastic:
+    the obstacle *is* the spring R = kU⁻ (either method).  The run goes one step past
+    T so that the force centred on t_N is known.
+    """
+    if method not in METHODS:
+        raise InputError(f"method={method!r} is not one of: {', '.join(METHODS)}")
+    from .integrators import solve
+    system = bar_system(bar)
+    spring = bar.obstacle == "elastic" or method == "penalty"
+    if spring and bar.k == 0:
+        raise InputError("k=0 must be > 0 for a penalty spring")
+    N = int(np.ceil(check_positive("T", T) / check_positive("dt", dt) - 1e-9))
+    every_state = (N + 2) * system.n <= all_states_limit
+    r = solve(system, dt, N * dt + dt, beta=beta, solver=solver,
+              stiffness=bar.k if spring else None, frames=N + 1 if every_state else 200)
+    n = min(N + 1, r.t.size)     # an unstable run stops early
+    t = r.t[:n]
+    u0, uL = r.observed["u0"][:n], r.observed["uL"][:n]
+
+    # force at tₙ = the force of step n → n+1 (recorded with state n+1)
+    force = np.full(n, np.nan)
+    lam = r.contact_force[:, 0]
+    m = min(n, lam.size - 1)
+    force[1:m] = lam[2:m + 1]
+    if spring:
+        force[0] = bar.k * max(-u0[0], 0.0)
+
+    if spring:
+        Um = np.maximum(-u0, 0.0)
+        Um_prev = np.concatenate([Um[:1], Um[:-1]])   # at t = 0: ½k(U⁻)² of the data
+        obstacle = 0.5 * bar.k * (r.beta * (Um - Um_prev) ** 2 + Um * Um_prev)
+    else:
+        obstacle = np.zeros(n)
+    kinetic = np.full(n, np.nan)
+    strain = np.full(n, np.nan)
+    if every_state and r.frames_u.shape[0] >= n:
+        U = r.frames_u[:n]
+        d = np.diff(U, axis=0)
+        Md, Kd = (system.M @ d.T).T, (system.K @ d.T).T
+        kinetic[1:] = 0.5 * np.einsum("ij,ij->i", d, Md) / dt**2
+        strain[1:] = 0.5 * (r.beta * np.einsum("ij,ij->i", d, Kd)
+                            + np.einsum("ij,ij->i", U[1:], (system.K @ U[:-1].T).T))
+        # t = 0: the data themselves
+        v, u = system.v0, system.u0
+        kinetic[0] = 0.5 * v @ (system.M @ v)
+        strain[0] = 0.5 * u @ (system.K @ u)
+        energy = kinetic + strain + obstacle
+    else:
+        energy = r.energy[:n] + obstacle
+        energy[0] = 0.5 * system.v0 @ (system.M @ system.v0) \
+            + 0.5 * system.u0 @ (system.K @ system.u0) + obstacle[0]
+    potential = -bar.f * bar.L * r.observed["mean_u"][:n]
+    return BarRun(bar, method, t, u0, uL, force, kinetic, strain, obstacle, energy,
+                  potential, r)
+
+
+def l2_time(e: np.ndarray, dt: float) -> float:
+    """Discrete L²(0, T) norm √(Δt Σₙ eₙ²) (samples that are NaN, e.g. force[0], skipped)."""
+    e = np.asarray(e, dtype=float)
+    return float(np.sqrt(dt * np.sum(e[np.isfinite(e)] ** 2)))
+
+
+def errors(run: BarRun, exact) -> dict:
+    """L²-in-time errors of u(0,·), u(L,·) and the reaction R against ``exact``
+    (a :class:`skfem_beam.reference.BarExact`), and the largest pointwise ones."""
+    t, dt = run.t, run.result.dt
+    e = {"u0": run.u0 - exact.u(0.0, t), "uL": run.uL - exact.u(run.bar.L, t),
+         "force": run.force - exact.contact_force(t)}
+    out = {f"l2_{k}": l2_time(v, dt) for k, v in e.items()}
+    out.update({f"max_{k}": float(np.nanmax(np.abs(v))) for k, v in e.items()})
+    return out
+
+
+def contact_periods(t: np.ndarray, force: np.ndarray, merge: float = 0.0
+                    ) -> list[tuple[float, float]]:
+    """Maximal runs of steps with a positive reaction, as (first, last) times; runs
+    separated by less than ``merge`` seconds count as one (the chatter of a grazing
+    separation)."""
+    on = np.nan_to_num(force, nan=0.0) > 0
+    on[0] = on[0] or (on.size > 1 and on[1])      # the start step of an impact at t = 0
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], on.astype(int), [0]])))
+    periods: list[tuple[float, float]] = []
+    for a, b in zip(edges[::2], edges[1::2]):
+        if periods and t[a] - periods[-1][1] < merge:
+            periods[-1] = (periods[-1][0], float(t[b - 1]))
+        else:
+            periods.append((float(t[a]), float(t[b - 1])))
+    return periods
+
+
+def energy_report(run: BarRun) -> dict:
+    """Energy before the first contact and just after it ends (E + load potential).
+
+    The exact elastic bar (b = 0) conserves it, so ``loss`` is the scheme's own.  Runs
+    of contact less than a tenth of a wave transit L/c apart count as one period.
+    """
+    E = run.energy + run.load_potential
+    bar = run.bar
+    periods = contact_periods(run.t, run.force, merge=0.1 * bar.L / bar.c)
+    out = {"energy_initial": float(E[0]), "energy_final": float(E[-1]),
+           "contact_periods": periods}
+    if periods:
+        i0 = int(np.searchsorted(run.t, periods[0][0]))
+        i1 = int(np.searchsorted(run.t, periods[0][1])) + 1
+        before = float(E[max(i0 - 1, 0)])
+        out["energy_before_contact"] = before
+        if i1 < E.size:
+            after = float(E[i1])
+            out.update(energy_after_contact=after, energy_loss=before - after,
+                       energy_loss_relative=(before - after) / abs(before) if before else None)
+    return out

@@ -1,0 +1,319 @@
+"""The impacting bar (Do, Raupp & Feijoo): P1 space, exact solutions, accuracy targets,
+convergence, energy, Example 2, speed, bad input and the command-line case."""
+import csv
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from skfem_beam import InputError
+from skfem_beam.bar import Bar, bar_system, contact_periods, energy_report, errors, run_bar
+from skfem_beam.bench.bar_convergence import study
+from skfem_beam.reference import (BarExact, bar_elastic_paper, bar_rigid_force, bar_rigid_u0,
+                                  bar_rigid_uL)
+from skfem_beam.spaces.lagrange import LagrangeSpace
+
+# Example 1 at the issue's resolution: N = 100, Δt = 1e-3, T = 3
+DT, T = 1e-3, 3.0
+
+
+@pytest.fixture(scope="module")
+def rigid():
+    bar = Bar(obstacle="rigid")
+    return run_bar(bar, DT, T), BarExact.of(bar, T)
+
+
+@pytest.fixture(scope="module")
+def elastic():
+    bar = Bar(obstacle="elastic", k=100.0)
+    return run_bar(bar, DT, T), BarExact.of(bar, T)
+
+
+# --- the P1 space (scikit-fem assembly against the closed forms) -------------------------
+
+@pytest.mark.parametrize("mass", ["consistent", "lumped", "average"])
+def test_p1_matrices_equal_closed_forms(mass):
+    x = np.array([0.0, 0.1, 0.35, 0.5, 1.2])          # non-uniform on purpose
+    sp = LagrangeSpace(x, mass)
+    h = np.diff(x)
+    Mc, Ml, S = (np.zeros((5, 5)) for _ in range(3))
+    for j, hj in enumerate(h):
+        Mc[j:j + 2, j:j + 2] += hj / 6 * np.array([[2, 1], [1, 2]])
+        Ml[j:j + 2, j:j + 2] += hj / 2 * np.eye(2)
+        S[j:j + 2, j:j + 2] += np.array([[1, -1], [-1, 1]]) / hj
+    want = {"consistent": Mc, "lumped": Ml, "average": (Mc + Ml) / 2}[mass]
+    assert np.abs(sp.M.toarray() - want).max() < 1e-15
+    assert np.abs(sp.S.toarray() - S).max() < 1e-13
+    assert sp.load_vector(lambda z: z) == pytest.approx(Mc @ x, abs=1e-15)
+    assert sp.project(lambda z: 3 * z - 1) == pytest.approx(3 * x - 1, abs=1e-13)
+    assert sp.sampler([0.25]).E0 @ x == pytest.approx(x[:-1] + 0.25 * h, abs=1e-15)
+
+
+def test_bar_system_units():
+    """M carries ρ, K = a·S, B = b·S; constraint u(0) ≥ 0; uniform data."""
+    bar = Bar(a=3.0, b=0.2, rho=2.0, L=2.0, f=-1.5, v0=-0.5, u0=0.1, N=4, mass="lumped")
+    s = bar_system(bar)
+    assert s.M.sum() == pytest.approx(bar.rho * bar.L)           # total mass ρL
+    assert s.K.toarray()[0, :2] == pytest.approx([3.0 / 0.5, -3.0 / 0.5])
+    assert s.B.toarray()[0, 0] == pytest.approx(0.2 / 0.5)
+    assert s.C.toarray().tolist() == [[1, 0, 0, 0, 0]] and s.lo[0] == 0 and s.hi[0] == np.inf
+    assert (s.loads[:, 0] * s.load_time[0](np.array([0.3]))).sum() == pytest.approx(-3.0)
+    assert s.u0 == pytest.approx(0.1) and s.v0 == pytest.approx(-0.5)
+    assert s.observe["mean_u"] @ np.linspace(0, 2, 5) == pytest.approx(1.0)
+
+
+# --- exact solutions ---------------------------------------------------------------------
+
+def test_exact_rigid_equals_the_closed_forms():
+    ex = BarExact(1, 1, 1, -1, 4.0, "rigid")
+    t = np.linspace(0, 4, 4001)
+    assert np.abs(ex.u(0, t) - bar_rigid_u0(t)).max() < 1e-15
+    assert np.abs(ex.u(1, t) - bar_rigid_uL(t)).max() < 1e-15
+    assert np.abs(ex.contact_force(t[1:]) - bar_rigid_force(t[1:])).max() == 0.0
+    assert ex.contact_intervals() == [(0.0, 2.0)]
+
+
+@pytest.mark.parametrize("k", [100.0, 7.0, 1.0])
+def test_exact_elastic_equals_the_papers_regions(k):
+    """R_I, R_II, R_III of the paper, wherever they hold (t ≤ 2 + x)."""
+    ex = BarExact(1, 1, 1, -1, 3.0, "elastic", k)
+    X, Tm = np.meshgrid(np.linspace(0, 1, 101), np.linspace(0, 3, 301))
+    ref = bar_elastic_paper(X, Tm, k)
+    known = np.isfinite(ref)
+    assert known.mean() > 0.8
+    assert np.abs(ex.u(X, Tm) - ref)[known].max() < 1e-14
+
+
+@pytest.mark.parametrize("kw", [dict(obstacle="elastic", k=100.0), dict(obstacle="elastic", k=3.0),
+                                dict(obstacle="rigid"),
+                                dict(obstacle="elastic", k=50.0, a=4.0, rho=2.0, L=1.5, v0=-0.3)])
+def test_exact_conserves_energy(kw):
+    """b = 0, f = 0: ½∫ρu_t² + ½∫a u_x² + ½k(U⁻)² is constant (quadrature error only)."""
+    kw = {"a": 1.0, "rho": 1.0, "L": 1.0, "v0": -1.0, **kw}
+    ex = BarExact(T=6.0, **kw)
+    E = ex.energy(np.linspace(0, 6, 25), points=20001)["total"]
+    E0 = 0.5 * kw["rho"] * kw["v0"] ** 2 * kw["L"]
+    assert np.abs(E - E0).max() < 2e-5 * E0
+
+
+@pytest.mark.parametrize("obstacle", ["rigid", "elastic"])
+def test_exact_example2_long_horizon_conserves_energy(obstacle):
+    """f = −1 over 15 round trips (7 and 18 contacts): E − ∫f u dx stays constant."""
+    ex = BarExact(1, 1, 1, -1, 30.0, obstacle, k=100.0, f=-1.0)
+    assert len(ex.contact_intervals()) == {"rigid": 7, "elastic": 18}[obstacle]
+    t, x = np.linspace(0, 30, 13), np.linspace(0, 1, 8001)
+    X, Tm = np.meshgrid(x, t)
+    u = ex.u(X, Tm)
+    total = ex.energy(t, points=8001)["total"] + (u[:, 1:] + u[:, :-1]).sum(axis=1) / 2 * (x[1])
+    # the rigid bar carries velocity jumps: the trapezoid rule is first order there
+    assert np.ptp(total) < {"rigid": 1e-3, "elastic": 1e-5}[obstacle]
+
+
+def test_exact_scaling_gap_and_stiff_limit():
+    # a gap u0: free flight for u0/|v0|, then contact for 2L/c (c = √(a/ρ) = 2)
+    ex = BarExact(a=8.0, rho=2.0, L=1.5, v0=-0.5, T=5.0, obstacle="rigid", u0=0.1)
+    (t0, t1), = ex.contact_intervals()
+    assert t0 == pytest.approx(0.2, abs=1e-14) and t1 == pytest.approx(0.2 + 1.5, abs=1e-14)
+    assert ex.contact_force(1.0) == pytest.approx(np.sqrt(8.0 * 2.0) * 0.5)   # ρc|v0|
+    # a stiff spring tends to the rigid obstacle, with U ≈ −ρc|v0|/k in contact
+    t = np.linspace(0, 3, 601)
+    stiff = BarExact(1, 1, 1, -1, 3.0, "elastic", k=1e6)
+    assert np.abs(stiff.u(0, t) - bar_rigid_u0(t)).max() < 3e-6     # O(1/k)
+    assert stiff.u(0, 1.0) == pytest.approx(-1e-6, rel=1e-9)
+    # moving away: no contact, rigid translation
+    away = BarExact(1, 1, 1, +0.7, 3.0, "rigid")
+    assert away.contact_intervals() == [] and away.u(0.3, 2.0) == pytest.approx(1.4)
+
+
+def test_exact_elastic_against_a_very_fine_numerical_solution():
+    """The characteristics solution and the scheme agree, better and better with h."""
+    bar = Bar(obstacle="elastic", k=100.0, N=400)
+    e = errors(run_bar(bar, 0.1 * bar.h, T), BarExact.of(bar, T))
+    assert e["l2_u0"] < 1.5e-3 and e["l2_uL"] < 3e-4 and e["l2_force"] < 0.05
+
+
+def test_exact_example2_second_impact():
+    """f = −1: separation at t = 3, a second impact at 3 + √2 (rigid; the scheme finds
+    it too, test_example2_second_impact)."""
+    ex = BarExact(1, 1, 1, -1, 6.0, "rigid", f=-1.0)
+    iv = ex.contact_intervals()
+    assert iv[0] == pytest.approx((0.0, 3.0), abs=1e-12)
+    assert iv[1][0] == pytest.approx(3 + np.sqrt(2), abs=1e-12)
+
+
+# --- the issue's accuracy targets (rigid obstacle, Example 1) ------------------------------
+
+def test_rigid_targets_no_penetration_and_errors(rigid):
+    run, ex = rigid
+    assert run.t.size == 3001 and run.t[-1] == pytest.approx(3.0)
+    assert run.u0.min() >= -1e-12                      # at every step
+    e = errors(run, ex)
+    assert e["l2_u0"] <= 8e-3 and e["l2_u0"] < 1.38e-2      # Siconos: 1.38e-2
+    assert e["l2_uL"] <= 2.5e-3 and e["l2_uL"] < 4.09e-3    # Siconos: 4.09e-3
+
+
+def test_consistent_mass_misses_the_target():
+    """Why ``average`` is the default: consistent mass has Siconos' dispersion error."""
+    bar = Bar(mass="consistent")
+    e = errors(run_bar(bar, DT, T), BarExact.of(bar, T))
+    assert e["l2_u0"] > 1.2e-2 and e["l2_uL"] > 3.5e-3
+
+
+def test_rigid_convergence_rates_positive_and_stable():
+    rows = study("rigid", Ns=(25, 50, 100, 200))
+    for key, low in (("l2_u0", 0.6), ("l2_uL", 0.9), ("l2_force", 0.3)):
+        rates = np.array([r[f"rate_{key}"] for r in rows[1:]])
+        assert rates.min() > low, (key, rates)
+        assert np.ptp(rates) < 0.1, (key, rates)                 # stable under refinement
+    assert all(r["penetration"] <= 1e-12 for r in rows)
+
+
+def test_elastic_convergence_rates_positive():
+    rows = study("elastic", Ns=(50, 100, 200, 400))
+    for key in ("l2_u0", "l2_uL", "l2_force"):
+        assert min(r[f"rate_{key}"] for r in rows[1:]) > 0.5, key
+
+
+# --- energy ----------------------------------------------------------------------------------
+
+def test_rigid_energy_loss_is_the_contact_node(rigid):
+    """The Signorini step stops the contact node: it loses ½ m₀ v0² (m₀ = 5h/12 with the
+    average mass), nothing else; conserved (to round-off) before and after."""
+    run, _ = rigid
+    rep = energy_report(run)
+    assert rep["energy_before_contact"] == pytest.approx(0.5, abs=1e-15)
+    assert rep["energy_loss"] == pytest.approx(0.5 * 5 * run.bar.h / 12, rel=0.02)
+    assert np.ptp(run.energy[1:]) < 1e-9
+
+
+def test_elastic_energy_report(elastic):
+    """The exact solution conserves energy; the discrete loss is reported and small.  The
+    scheme's energy (with the spring's β-form) is exactly conserved while the spring
+    stays compressed and while it is idle: it changes only on the switching steps."""
+    run, _ = elastic
+    rep = energy_report(run)
+    assert abs(rep["energy_loss_relative"]) < 5e-3
+    for a, b in ((0.1, 1.9), (2.05, 3.0)):       # in contact; free flight
+        phase = (run.t > a) & (run.t < b)
+        assert np.ptp(run.energy[phase]) < 1e-10
+    # the split adds up to the scheme's own ½E_β
+    n = run.t.size
+    assert np.abs(run.kinetic[1:] + run.strain[1:] - run.result.energy[1:n]).max() < 1e-12
+
+
+def test_viscosity_dissipates():
+    run = run_bar(Bar(obstacle="elastic", b=0.01), DT, T)
+    assert BarExact.of(run.bar, T) is None
+    assert np.all(np.diff(run.energy[2200:]) <= 1e-12)      # free flight: damped vibration
+    assert run.energy[-1] < run.energy[0] - 1e-3
+
+
+def test_penalty_penetrates_the_rigid_obstacle():
+    """Normal compliance stands in for the rigid obstacle: it penetrates, at least by the
+    continuum spring's compression ρc|v0|/k (the contact node's own rebound adds to it),
+    less as k grows; the contact method has no penetration at all."""
+    pen = {k: run_bar(Bar(obstacle="rigid", k=k), DT, T, method="penalty").penetration
+           for k in (1e4, 1e6)}
+    assert pen[1e4] > 0.5e-4 and pen[1e6] > 0.5e-6
+    assert pen[1e6] < pen[1e4] / 10
+
+
+# --- Example 2 (f = −1): the bar separates and hits again ---------------------------------
+
+@pytest.mark.parametrize("obstacle", ["rigid", "elastic"])
+def test_example2_second_impact(obstacle):
+    bar = Bar(obstacle=obstacle, f=-1.0)
+    run, ex = run_bar(bar, DT, 6.0), BarExact.of(bar, 6.0)
+    periods = contact_periods(run.t, run.force, merge=0.1)
+    assert len(periods) == 2
+    assert periods[1][0] == pytest.approx(ex.contact_intervals()[1][0], abs=3e-3)
+    e = errors(run, ex)
+    assert e["l2_u0"] < 5e-3 and e["l2_uL"] < 5e-3
+
+
+# --- speed ---------------------------------------------------------------------------------
+
+def test_time_loop_speed():
+    bar = Bar(obstacle="rigid")
+    wall = min(run_bar(bar, DT, T).wall_time_s for _ in range(3))
+    assert wall <= 0.03, wall
+
+
+# --- bad input ---------------------------------------------------------------------------
+
+@pytest.mark.parametrize("kw, word", [
+    (dict(N=0), "N=0"), (dict(N=2.5), "N=2.5"), (dict(a=0), "a=0"), (dict(a=-1), "a=-1"),
+    (dict(rho=0), "rho=0"), (dict(L=-2), "L=-2"), (dict(b=-0.1), "b=-0.1"),
+    (dict(k=-5), "k=-5"), (dict(obstacle="elastic", k=0), "k=0"), (dict(u0=-0.01), "u0=-0.01"),
+    (dict(obstacle="soft"), "obstacle='soft'"), (dict(mass="diag"), "mass='diag'"),
+    (dict(v0=float("nan")), "v0=nan"), (dict(a=float("inf")), "a=inf"),
+])
+def test_bar_refuses_bad_input(kw, word):
+    with pytest.raises(InputError, match=word.replace("(", r"\(")) as e:
+        Bar(**kw)
+    assert "\n" not in str(e.value)
+
+
+def test_run_refuses_bad_steps():
+    with pytest.raises(InputError, match="dt"):
+        run_bar(Bar(), 0.0, 1.0)
+    with pytest.raises(InputError, match="T"):
+        run_bar(Bar(), 1e-3, -1.0)
+    with pytest.raises(InputError, match="method"):
+        run_bar(Bar(), 1e-3, 1.0, method="magic")
+
+
+# --- the command-line case -------------------------------------------------------------------
+
+CASE = [sys.executable, "-m", "skfem_beam.cases.impacting_bar"]
+
+
+def test_case_end_to_end(tmp_path):
+    out = tmp_path / "run"
+    p = subprocess.run(CASE + ["--T", "2.5", "--out", str(out)], capture_output=True,
+                       text=True, timeout=120)
+    assert p.returncode == 0, p.stderr
+    files = {f.name for f in out.iterdir()}
+    assert {"summary.json", "timeseries.csv", "displacement.png"} <= files
+    s = json.loads((out / "summary.json").read_text())
+    for key in ("case", "J", "dt", "T", "beta", "element", "solver", "steps", "wall_time_s",
+                "max_penetration", "max_nodal_violation", "energy_final", "impacts"):
+        assert key in s, key
+    assert s["steps"] == 2500 and s["max_penetration"] <= 1e-12
+    assert s["errors"]["l2_uL"] < 2.5e-3
+    rows = list(csv.DictReader(open(out / "timeseries.csv")))
+    assert len(rows) == 2501
+    uL = np.array([float(r["u_L"]) for r in rows])
+    uL_ex = np.array([float(r["u_L_exact"]) for r in rows])
+    assert np.abs(uL - uL_ex).max() < 1e-2
+    assert {"t", "u_0", "contact_force", "energy", "energy_kinetic", "energy_strain",
+            "energy_obstacle", "contact_force_exact"} <= set(rows[0])
+
+
+@pytest.mark.parametrize("args, word", [
+    (["--N", "0"], "N=0"), (["--a", "0"], "a=0"), (["--rho", "-1"], "rho=-1"),
+    (["--L", "0"], "L=0"), (["--dt", "0"], "dt=0"), (["--T", "-1"], "T=-1"),
+    (["--b", "-1"], "b=-1"), (["--k", "-1"], "k=-1"), (["--u0", "-0.1"], "u0=-0.1"),
+    (["--obstacle", "soft"], "soft"), (["--mass", "x"], "mass='x'"),
+])
+def test_case_bad_input_one_line_no_output(tmp_path, capsys, args, word):
+    """In-process through the same guard as ``python -m`` (a subprocess each is slow)."""
+    from skfem_beam.cases import impacting_bar
+    from skfem_beam.cli import main_guard
+    out = tmp_path / "run"
+    with pytest.raises(SystemExit) as e:
+        main_guard(lambda: impacting_bar.main(args + ["--out", str(out)]))
+    assert e.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and word in err, err
+    assert not out.exists() and list(tmp_path.iterdir()) == []
+
+
+def test_case_bad_input_subprocess(tmp_path):
+    out = tmp_path / "run"
+    p = subprocess.run(CASE + ["--N", "0", "--out", str(out)], capture_output=True, text=True,
+                       timeout=120)
+    assert p.returncode == 2 and p.stderr.strip() == "error: N=0 must be a whole number ≥ 1"
+    assert p.stdout == "" and not out.exists()

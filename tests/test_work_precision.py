@@ -25,4 +25,4 @@ def test_quick_work_precision(tmp_path):
     # convex scene: the finest rung is several times better than the coarsest, both elements
     for m in ("contact β=1/2 hermite active-set", "contact β=1/2 bspline active-set"):
         assert err("convex", m)[-1] < err("convex", m)[0] / 4
-    assert viol("point_stops", "contact β=1/2 hermite") == 0.0
+    assert viol("point_stops", "contact β=1/2 hermite") <= 1e-15   # round-off of the cubic at L

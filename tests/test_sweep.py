@@ -1,0 +1,167 @@
+"""Parameter sweeps: same outputs on a Dask cluster and serially, resume, bad input."""
+import json
+import math
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from skfem_beam import beam_system, solve
+from skfem_beam.cases import point_stops
+from skfem_beam.cli import main_guard
+from skfem_beam.sweep import (dask_client, main, make_settings, parse_values,
+                              run_value, sweep)
+
+SWEEP = [sys.executable, "-m", "skfem_beam.sweep"]
+# short runs: 3 forcing periods after 0.2 s, the paper's Δt
+SHORT = dict(transient=0.2, periods=3)
+OUTPUTS = ("poincare.csv", "runs.csv", "bifurcation.png")
+
+
+def results_without_timing(out):
+    runs = {}
+    for f in sorted((out / "runs").glob("*.json")):
+        r = json.loads(f.read_text())
+        r.pop("timing")
+        runs[f.name] = r
+    return runs
+
+
+def test_two_workers_match_serial_exactly(tmp_path):
+    settings = make_settings("point_stops", "omega", **SHORT)
+    values = parse_values("8:30:20")
+    serial = sweep(settings, values, tmp_path / "serial", client=None, progress=False)
+    pytest.importorskip("distributed")
+    with dask_client(workers=2) as client:
+        assert len(client.nthreads()) == 2
+        parallel = sweep(settings, values, tmp_path / "dask", client=client, progress=False)
+    assert serial["timing"]["workers"] == 0 and parallel["timing"]["workers"] == 2
+    for name in OUTPUTS:   # byte for byte, the chart included
+        assert (tmp_path / "serial" / name).read_bytes() == (tmp_path / "dask" / name).read_bytes()
+    a, b = results_without_timing(tmp_path / "serial"), results_without_timing(tmp_path / "dask")
+    assert len(a) == 20 and a == b
+    pids = {json.loads(f.read_text())["timing"]["pid"] for f in (tmp_path / "dask/runs").iterdir()}
+    assert len(pids) == 2   # both workers ran values
+    rows = (tmp_path / "dask" / "poincare.csv").read_text().splitlines()
+    assert rows[0] == "omega,k,t,tip_displacement,tip_velocity" and len(rows) == 1 + 20 * 3
+
+
+def test_section_is_sampled_exactly_once_per_period(pipe):
+    """The saved states are the section: t = k·2π/ω, the same as a plain run's state there."""
+    settings = make_settings("point_stops", "omega", transient=0.3, periods=4)
+    r = run_value(settings, 11.0)
+    P = 2 * math.pi / 11.0
+    assert r["status"] == "success" and r["dt"] * r["steps_per_period"] == pytest.approx(P, 1e-15)
+    assert r["steps_per_period"] == round(P / 5e-5) and r["transient_periods"] == 1
+    assert r["k"] == [2, 3, 4, 5] and np.allclose(r["t"], np.arange(2, 6) * P, rtol=1e-14)
+    full = solve(beam_system(point_stops.problem(omega=11.0)), r["dt"],
+                 5 * r["steps_per_period"] * r["dt"], 0.5, progress=False, frames=1)
+    idx = np.arange(2, 6) * r["steps_per_period"]
+    assert r["tip_displacement"] == full.observed["tip_displacement"][idx].tolist()
+    assert r["tip_velocity"] == full.velocity["tip_displacement"][idx].tolist()
+    assert 0 < r["contact_fraction"] < 1 and 0 <= r["impacts"] <= r["impacts_total"]
+
+
+def test_interrupted_sweep_resumes_without_redoing(tmp_path):
+    out = tmp_path / "sweep"
+    args = ["--values", "8:30:10", "--transient", "0.2", "--periods", "3", "--workers", "0",
+            "--no-progress", "--out", str(out)]
+    p = subprocess.Popen(SWEEP + args, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                         text=True)
+    deadline = time.time() + 120
+    while not list((out / "runs").glob("*.json")) and time.time() < deadline:
+        time.sleep(0.02)
+    p.send_signal(signal.SIGINT)
+    _, err = p.communicate(timeout=60)
+    assert p.returncode == 130 and "run the same command again to resume" in err, err
+    done = {f.name: f.stat().st_mtime_ns for f in (out / "runs").glob("*.json")}
+    assert 1 <= len(done) < 10
+    assert not list((out / "runs").glob(".*")) and not (out / "runs.csv").exists()
+
+    assert main_guard_code(args) == 0   # in process: the same command, resumed
+    s = json.loads((out / "sweep.json").read_text())
+    assert s["timing"]["values_resumed"] == len(done)
+    assert s["timing"]["values_run"] == 10 - len(done)
+    assert {f.name: f.stat().st_mtime_ns for f in (out / "runs").glob("*.json")
+            if f.name in done} == done   # finished values were not run again
+
+    clean = tmp_path / "clean"
+    assert main_guard_code(args[:-1] + [str(clean)]) == 0
+    for name in OUTPUTS:
+        assert (out / name).read_bytes() == (clean / name).read_bytes()
+
+    # the same folder with other settings is refused, --overwrite starts over
+    assert main_guard_code(args[:4] + ["--periods", "4"] + args[6:]) == 2
+    assert main_guard_code(args[:4] + ["--periods", "4"] + args[6:] + ["--overwrite"]) == 0
+    assert json.loads((out / "sweep.json").read_text())["timing"]["values_resumed"] == 0
+
+
+def main_guard_code(args):
+    with pytest.raises(SystemExit) as exit_:
+        main_guard(lambda: main(args))
+    return exit_.value.code
+
+
+@pytest.mark.parametrize("args, word", [
+    (["--scene", "moon"], "--scene 'moon'"),
+    (["--param", "mass"], "--param 'mass'"),
+    (["--values", "5:40"], "a:b:n"),
+    (["--values", "5:40:2.5"], "a:b:n"),
+    (["--values", "a:b:3"], "a:b:n"),
+    (["--values", "5,x"], "a:b:n"),
+    (["--values", "5:40:0"], "n=0 must be at least 1"),
+    (["--values", "5:40:-3"], "n=-3 must be at least 1"),
+    (["--values", "5,nan"], "nan is not a finite number"),
+    (["--values", "5,5"], "repeat"),
+    (["--values=-2,5"], "omega=-2 must be > 0"),
+    (["--param", "gap", "--values", "0:0.1:3"], "gap=0 must be > 0"),
+    (["--param", "amplitude", "--omega", "0"], "omega=0 must be > 0"),
+    (["--periods", "0"], "periods=0"),
+    (["--transient", "-1"], "transient=-1"),
+    (["--dt", "0"], "dt=0"),
+    (["--beta", "0.7"], "beta=0.7"),
+    (["--J", "0"], "J=0"),
+    (["--workers", "-1"], "--workers -1"),
+    (["--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], "not both"),
+    (["--periods", "x"], "--periods"),
+])
+def test_bad_input_one_line_no_output(tmp_path, capsys, args, word):
+    out = tmp_path / "sweep"
+    base = ["--values", "8,9", "--out", str(out)]
+    assert main_guard_code(base + args) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and word in lines[0], lines
+    assert not list(tmp_path.iterdir())
+
+
+def test_bad_input_through_python_m(tmp_path):
+    p = subprocess.run(SWEEP + ["--values", "5:40:0", "--out", str(tmp_path / "s")],
+                       capture_output=True, text=True, timeout=120)
+    assert p.returncode == 2
+    assert p.stderr.strip() == "error: --values '5:40:0': n=0 must be at least 1"
+    assert not list(tmp_path.iterdir())
+
+
+def test_refuses_a_folder_that_is_not_a_sweep(tmp_path, capsys):
+    (tmp_path / "mine.txt").write_text("keep me")
+    assert main_guard_code(["--values", "8", "--workers", "0", "--out", str(tmp_path)]) == 2
+    assert "--overwrite" in capsys.readouterr().err
+    assert (tmp_path / "mine.txt").read_text() == "keep me"
+
+
+def test_scheduler_address_sends_the_same_work(tmp_path):
+    """--scheduler: an existing cluster (here one started on loopback by the test)."""
+    distributed = pytest.importorskip("distributed")
+    args = ["--values", "9,13,17", "--transient", "0.2", "--periods", "3", "--no-progress"]
+    assert main_guard_code(args + ["--workers", "0", "--out", str(tmp_path / "serial")]) == 0
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, host="127.0.0.1",
+                                  dashboard_address=None) as cluster:
+        out = tmp_path / "remote"
+        assert main_guard_code(args + ["--scheduler", cluster.scheduler_address,
+                                       "--out", str(out)]) == 0
+    assert json.loads((out / "sweep.json").read_text())["timing"]["workers"] == 1
+    for name in OUTPUTS:
+        assert (out / name).read_bytes() == (tmp_path / "serial" / name).read_bytes()

@@ -30,6 +30,9 @@ def parser(prog: str, description: str, *, J=None, dt=None, T=None, beta=0.5,
                formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     if J is not None:
         p.add_argument("--J", type=int, default=J, help="number of elements")
+        p.add_argument("--mesh", default=None, metavar="FILE",
+                       help="a 1-D line mesh meshio reads (non-uniform allowed; replaces --J); "
+                            "the papers' meshes are in meshes/")
     p.add_argument("--dt", type=float, default=dt, help="time step (s)")
     p.add_argument("--T", type=float, default=T, help="final time (s)")
     p.add_argument("--beta", type=float, default=beta, help="Newmark β in [0, 1/2]")
@@ -62,6 +65,14 @@ def parse(p: Parser, argv=None):
     """Parse the flags; with --resume, the flags stored by the run being resumed."""
     from .runner import stored_args
     return stored_args(p.parse_args(argv), p)
+
+
+def mesh_nodes(args):
+    """The nodes of ``--mesh FILE`` (checked, from 0 to L), or None for a uniform --J mesh."""
+    if getattr(args, "mesh", None) is None:
+        return None
+    from .meshes import load_mesh
+    return load_mesh(args.mesh, args.L)
 
 
 def check_method(args) -> None:

@@ -53,3 +53,26 @@ def shape_chart(path, result, count=14, title=""):
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
+
+
+def penetration_chart(path, rows: list[dict], title=""):
+    """Maximum penetration between nodes against J (log–log), one line per scene/element/side."""
+    fig, ax = plt.subplots(figsize=(7, 4.5), dpi=110)
+    keys = dict.fromkeys((r["scene"], r["element"]) for r in rows)
+    for scene, element in keys:
+        sel = [r for r in rows if r["scene"] == scene and r["element"] == element]
+        J = [r["J"] for r in sel]
+        for side, ls in (("below_g1", "-"), ("above_g2", "--")):
+            ax.loglog(J, [r[side] for r in sel], ls, marker="o", ms=4,
+                      label=f"{scene} {element}: max ({'g1−u' if side == 'below_g1' else 'u−g2'})⁺")
+        paper = [r.get(f"paper_{side}") for r in sel]
+        if all(p is not None for p in paper):
+            ax.loglog(J, [r["paper_below_g1"] for r in sel], ":", color="gray", lw=0.8)
+    ax.set_xlabel("J (elements)")
+    ax.set_ylabel("penetration between nodes (m)")
+    ax.set_title(title, fontsize=9)
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=6.5)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)

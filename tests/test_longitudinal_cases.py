@@ -56,3 +56,30 @@ def test_energy_decay_only_at_impacts(tmp_path):
         assert E[-1] < 0.99 * E[0]               # and drops at impacts
         steady = np.abs(dE) <= 1e-10 * E[0]
         assert steady.mean() > 0.5               # constant between impacts
+
+
+MESHES = __import__("pathlib").Path(__file__).parents[1] / "meshes"
+
+
+def test_mesh_files_and_non_uniform_meshes(tmp_path, capsys):
+    import meshio
+    code, out = run_case(flat_obstacles, tmp_path, "--mesh", str(MESHES / "pipe10_J80.msh"),
+                         "--T", "0.1")
+    assert code == 0 and json.loads((out / "summary.json").read_text())["J"] == 80
+    # non-uniform, refined towards the clamp, with the break point x = 5 as a node
+    x = np.r_[10 * np.linspace(0, 0.5, 16) ** 1.5 / 0.5 ** 0.5, np.linspace(5, 10, 21)[1:]]
+    path = tmp_path / "graded.vtu"
+    meshio.write(path, meshio.Mesh(np.c_[x, 0 * x, 0 * x],
+                                   [("line", np.c_[np.arange(x.size - 1), np.arange(1, x.size)])]))
+    (tmp_path / "g").mkdir()
+    code, out = run_case(flat_obstacles, tmp_path / "g", "--mesh", str(path), "--T", "0.1")
+    s = json.loads((out / "summary.json").read_text())
+    assert code == 0 and s["J"] == x.size - 1 and s["max_nodal_violation"] <= 1e-12
+    # the same mesh without the break point is refused, in one line
+    y = x[np.abs(x - 5) > 1e-9]
+    meshio.write(path, meshio.Mesh(np.c_[y, 0 * y, 0 * y],
+                                   [("line", np.c_[np.arange(y.size - 1), np.arange(1, y.size)])]))
+    (tmp_path / "h").mkdir()
+    code, out = run_case(flat_obstacles, tmp_path / "h", "--mesh", str(path))
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and "break point x=5" in err[-1] and not out.exists()

@@ -18,4 +18,5 @@ def problem(args, obstacles: Obstacles, load=None, initial=None) -> BeamProblem:
     from .point_stops import PIPE_RHO_S
     return BeamProblem(Beam(args.L, args.k2, PIPE_RHO_S), obstacles,
                        load=load if load is not None else Load.uniform(lambda t: np.sin(10 * t)),
-                       initial=initial or InitialState(), J=args.J, element=args.element)
+                       initial=initial or InitialState(), J=args.J, element=args.element,
+                       nodes=cli.mesh_nodes(args))

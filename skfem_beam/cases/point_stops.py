@@ -13,7 +13,7 @@ PIPE_RHO_S = 8000.0 * 3.141592653589793 / 4 * (0.01**2 - 0.009**2)   # ≈ 0.119
 
 
 def problem(L=1.501, k2=282.84, gap=0.1, amplitude=0.2, omega=10.0, J=19,
-            element="hermite", rho_S=PIPE_RHO_S) -> BeamProblem:
+            element="hermite", rho_S=PIPE_RHO_S, nodes=None) -> BeamProblem:
     """u0 = 0, v0 = −2h(x): the beam is at rest in the fixed frame (ũ = ũ_t = 0) at t = 0."""
     from ..problem import check_positive
     gap = check_positive("gap", gap)
@@ -22,7 +22,7 @@ def problem(L=1.501, k2=282.84, gap=0.1, amplitude=0.2, omega=10.0, J=19,
         beam=beam, obstacles=Obstacles.point_stops(beam.L, -gap, gap),
         support=Support(amplitude, omega),
         initial=InitialState(v0=lambda x: -amplitude * omega * lifting(x, beam.L)),
-        J=J, element=element)
+        J=J, element=element, nodes=nodes)
 
 
 def main(argv=None) -> int:
@@ -34,7 +34,8 @@ def main(argv=None) -> int:
     p.add_argument("--amplitude", type=float, default=0.2, help="support φ = A sin(ωt): A (m)")
     p.add_argument("--omega", type=float, default=10.0, help="support φ = A sin(ωt): ω (rad/s)")
     args = cli.parse(p, argv)
-    pb = problem(args.L, args.k2, args.gap, args.amplitude, args.omega, args.J, args.element)
+    pb = problem(args.L, args.k2, args.gap, args.amplitude, args.omega, args.J, args.element,
+                 nodes=cli.mesh_nodes(args))
     config = {"u0": "0", "v0": "-amplitude*omega*h(x) (L2 projection)"}
     return run_beam_case("point_stops", pb, args, config, stops=(-args.gap, args.gap))
 

@@ -83,12 +83,17 @@ def beam_system(problem: BeamProblem, samples_per_element: int = 20) -> SemiDisc
         raise InputError(f"u0 violates the obstacles at x={x_nodes[finite][i]:g}: "
                          f"u0={y0[i]:g} not in [{lo[i]:g}, {hi[i]:g}]")
 
+    with np.errstate(over="ignore", invalid="ignore"):
+        K = (k2 * space.S).tocsr()
+    if not np.isfinite(K.data).all():
+        raise InputError(f"k2={k2:g} on this mesh gives a stiffness outside floating-point range")
+
     sampler = space.sampler(np.linspace(0.0, 1.0, samples_per_element + 1))
     s_lo, s_hi = problem.obstacles.bounds(sampler.x)
     keep = np.isfinite(s_lo) | np.isfinite(s_hi)
     observe = {"tip_displacement": np.asarray(space.C[-1].toarray()).ravel()}
     return SemiDiscrete(
-        M=space.M, K=(k2 * space.S).tocsr(), C=sp.csr_matrix(C), lo=lo, hi=hi,
+        M=space.M, K=K, C=sp.csr_matrix(C), lo=lo, hi=hi,
         x_contact=x_nodes[finite], loads=loads, load_time=times, u0=u0, v0=v0,
         observe=observe, space=space,
         sample_x=sampler.x[keep], sample_E=sampler.E0[np.flatnonzero(keep)].tocsr(),

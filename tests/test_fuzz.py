@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from skfem_beam import InputError, SolverError, beam_system, solve
@@ -39,6 +39,13 @@ def parameters(draw):
 @SETTINGS
 @given(parameters(), st.sampled_from(["hermite", "bspline", "p1", ""]),
        st.one_of(st.floats(0, 0.5), hostile))
+# found by hypothesis: scales outside floating-point range, round-off of B-spline coefficients
+@example(p={"L": 1.0, "k2": 3.4455121638609e-294, "gap": 1.0, "amplitude": 0.0, "omega": 0.0,
+            "J": 1}, element="hermite", beta=0.0)
+@example(p={"L": 1.0, "k2": 1.498077612385263e307, "gap": 1.0, "amplitude": 0.0, "omega": 0.0,
+            "J": 1}, element="hermite", beta=0.0)
+@example(p={"L": 1.0, "k2": 1.0, "gap": 0.001, "amplitude": 3.0, "omega": 96.0, "J": 1},
+         element="bspline", beta=0.0)
 def test_api_runs_or_refuses(p, element, beta):
     try:
         pb = point_stops.problem(p["L"], p["k2"], p["gap"], p["amplitude"], p["omega"], p["J"],
@@ -53,8 +60,10 @@ def test_api_runs_or_refuses(p, element, beta):
     assert r.status in ("success", "unstable")
     assert np.isfinite(r.energy).all() and np.isfinite(r.observed["tip_displacement"]).all()
     if r.status == "success":
+        # the stop holds to round-off of the coefficients (a B-spline nodal value sums three)
         gap = abs(float(p["gap"]))
-        assert np.abs(r.observed["tip_displacement"]).max() <= gap * (1 + 1e-12)
+        scale = max(gap, np.abs(r.frames_u[np.isfinite(r.frames_u)]).max(initial=0.0))
+        assert np.abs(r.observed["tip_displacement"]).max() <= gap + 1e-13 * scale
 
 
 flags = st.sampled_from(["--J", "--dt", "--T", "--beta", "--L", "--k2", "--gap", "--amplitude",

@@ -26,14 +26,19 @@ CONFIGS = [
     ("convex J=160 bspline dt=1e-3 T=1", "convex", dict(J=160, dt=1e-3, T=1.0, element="bspline"), 0.5),
     ("convex J=40 hermite dt=1e-4 T=1", "convex", dict(J=40, dt=1e-4, T=1.0), 0.5),
     ("flat J=40 hermite dt=1e-3 T=1", "flat", dict(J=40, dt=1e-3, T=1.0), None),
+    ("bar rigid N=100 dt=1e-3 T=3 (β=1/4)", "bar", dict(N=100, dt=1e-3, T=3.0, beta=0.25), 0.03),
 ]
 SOLVERS = {"point_stops": ["projection", "active-set", "daqp", "osqp"],
-           "convex": ["active-set", "daqp", "osqp"], "flat": ["active-set", "daqp", "osqp"]}
+           "convex": ["active-set", "daqp", "osqp"], "flat": ["active-set", "daqp", "osqp"],
+           "bar": ["projection", "daqp", "osqp"]}
 SLOW = {"osqp", "daqp"}   # Python-level engines: only on the short configurations
 
 
 def build(scene: str, p: dict):
+    from ..bar import Bar, bar_system
     from ..cases import convex_obstacles, flat_obstacles, point_stops
+    if scene == "bar":
+        return bar_system(Bar(N=p["N"]))
     from ..problem import Beam, BeamProblem, Load
     import numpy as np
     if scene == "point_stops":
@@ -49,14 +54,16 @@ def child(scene: str, p: dict, solver: str, repeat: int) -> dict:
     from ..integrators import solve
     from ..semidiscrete import beam_system
     from ._floor import banded_solve_floor
-    system = beam_system(build(scene, p))
-    kw = dict(dt=p["dt"], T=p["T"], beta=0.5, solver=solver,
+    system = build(scene, p)
+    system = beam_system(system) if scene != "bar" else system
+    beta = p.get("beta", 0.5)
+    kw = dict(dt=p["dt"], T=p["T"], beta=beta, solver=solver,
               save_every=p.get("save_every", 1), frames=50, progress=False)
     best = None
     for _ in range(repeat):
         r = solve(system, **kw)
         best = r if best is None or r.wall_time_s < best.wall_time_s else best
-    A = system.M + p["dt"] ** 2 * 0.5 * system.K
+    A = system.M + p["dt"] ** 2 * beta * system.K
     floor = banded_solve_floor(A, best.steps)
     return {"solver": best.solver, "steps": best.steps, "wall_time_s": best.wall_time_s,
             "us_per_step": 1e6 * best.wall_time_s / best.steps,
@@ -82,7 +89,7 @@ def main(argv=None) -> int:
           f"{'floor µs':>8s} {'target s':>8s} {'MB':>6s}")
     for label, scene, p, target in CONFIGS:
         for solver in SOLVERS[scene]:
-            long = p["dt"] < 1e-3 and scene != "point_stops" or p["dt"] < 5e-5
+            long = p["dt"] < 1e-3 and scene in ("convex", "flat") or p["dt"] < 5e-5
             if solver in SLOW and (args.quick or long):
                 continue
             if scene == "point_stops" and solver == "active-set" and args.quick:

@@ -1,11 +1,10 @@
 """Charts a person looks at first (matplotlib, headless)."""
 from __future__ import annotations
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+# no matplotlib.use(): without a display matplotlib falls back to Agg by itself, and
+# forcing it here would switch off inline figures in the notebooks that import us
+import matplotlib.pyplot as plt
+import numpy as np
 
 
 def trajectory_chart(path, t, series: dict, stops=(), title="", ylabel="displacement (m)"):

@@ -413,6 +413,9 @@ class Run:
         self._record(1, np.zeros(m), C @ self.u_cur)
         self.fr[0], self.frv[0] = self.u_prev, system.v0
         self.E1 = 0.5 * energy_beta(self.Eb.rows, self.Kb.rows, self.u_prev, self.u_cur, self.d)
+        if not (np.isfinite(self.u_cur).all() and math.isfinite(self.E1)):
+            raise InputError("the initial state and load are too large for floating point: "
+                             f"the first step's energy is {self.E1:g}")
         self.energy[0] = self.E1
         self.work = 0.0        # Σ‖Gⁿ‖_{M⁻¹}Δt so far: the a-priori energy bound grows with it
         self.n = 1             # the last computed state
@@ -460,6 +463,9 @@ class Run:
         self.work += float((np.abs(G) @ self.Minv_norm).sum()) * self.dt if self.nK else 0.0
         # the bound grows with n: its chunk-end value is the loosest for the chunk
         Ebound = self.growth_limit * (math.sqrt(abs(self.E1)) + self.work) ** 2 + 1e-300
+        if not math.isfinite(Ebound):
+            raise InputError(f"the load is too large for floating point: its work by step {n1} "
+                             f"is {self.work:g}")
         if self.pysolver is None:
             code = self._kernel(n0, n1, G, Ebound)
         else:

@@ -46,6 +46,8 @@ def parameters(draw):
             "J": 1}, element="hermite", beta=0.0)
 @example(p={"L": 1.0, "k2": 1.0, "gap": 0.001, "amplitude": 3.0, "omega": 96.0, "J": 1},
          element="bspline", beta=0.0)
+@example(p={"L": 1.0, "k2": 1.0, "gap": 1.0, "amplitude": 1.9087441698701214e153, "omega": 11.0,
+            "J": 6}, element="hermite", beta=0.0)
 def test_api_runs_or_refuses(p, element, beta):
     try:
         pb = point_stops.problem(p["L"], p["k2"], p["gap"], p["amplitude"], p["omega"], p["J"],

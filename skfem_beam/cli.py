@@ -23,7 +23,7 @@ class Parser(argparse.ArgumentParser):
         self.exit(EXIT_INPUT, f"{self.prog}: error: {message}\n")
 
 
-def parser(prog: str, description: str, *, J=None, dt=None, T=None, beta=0.5,
+def parser(prog: str, description: str, *, J=None, dt=None, T=None, beta=None,
            element=True, solver=True) -> Parser:
     """The flags every scene takes; a scene adds its own."""
     p = Parser(prog=prog, description=description,
@@ -35,7 +35,9 @@ def parser(prog: str, description: str, *, J=None, dt=None, T=None, beta=0.5,
                             "the papers' meshes are in meshes/")
     p.add_argument("--dt", type=float, default=dt, help="time step (s)")
     p.add_argument("--T", type=float, default=T, help="final time (s)")
-    p.add_argument("--beta", type=float, default=beta, help="Newmark β in [0, 1/2]")
+    p.add_argument("--beta", type=float, default=beta,
+                   help="Newmark β in [0, 1/2]" if beta is not None else
+                   "Newmark β in [0, 1/2] (default 1/2; 1/4 with --method penalty, the papers' choice)")
     if element:
         p.add_argument("--element", default="hermite", help="hermite | bspline")
     if solver:
@@ -64,7 +66,10 @@ def parser(prog: str, description: str, *, J=None, dt=None, T=None, beta=0.5,
 def parse(p: Parser, argv=None):
     """Parse the flags; with --resume, the flags stored by the run being resumed."""
     from .runner import stored_args
-    return stored_args(p.parse_args(argv), p)
+    args = stored_args(p.parse_args(argv), p)
+    if getattr(args, "beta", 0.5) is None:   # the papers: β = 1/2 for contact, 1/4 for penalty
+        args.beta = 0.25 if getattr(args, "method", "contact") == "penalty" else 0.5
+    return args
 
 
 def mesh_nodes(args):

@@ -103,3 +103,16 @@ def test_api_refuses_bad_obstacles_and_initial_state():
                                 initial=InitialState(u0=lambda x: 0.1 * x**2), J=4))
     with pytest.raises(InputError, match="break point"):
         BeamProblem(Beam(1.0, 1.0), Obstacles.point_stops(0.55, -0.01, 0.01), J=4)
+
+
+def test_penalty_defaults_to_the_papers_beta(tmp_path):
+    """β = 1/2 for the contact scheme, 1/4 (trapezoidal) for penalty, unless given."""
+    for method, beta in (("contact", 0.5), ("penalty", 0.25)):
+        out = tmp_path / method
+        with pytest.raises(SystemExit) as e:
+            main_guard(lambda: point_stops.main(["--T", "0.15", "--dt", "1e-5", "--method", method,
+                                                 "--out", str(out)]))
+        s = json.loads((out / "summary.json").read_text())
+        assert e.value.code == 0 and s["beta"] == beta and s["method"] == method
+    pen = json.loads((tmp_path / "penalty" / "summary.json").read_text())
+    assert pen["impacts"] > 0 and pen["max_penetration"] > 1e-6     # a spring penetrates

@@ -8,7 +8,7 @@ from ..problem import Beam, BeamProblem, InitialState, Load, Obstacles
 
 
 def parser(prog: str, doc: str, T: float = 1.0):
-    p = cli.parser(prog, doc.strip().splitlines()[0], J=40, dt=1e-3, T=T, beta=0.5)
+    p = cli.parser(prog, doc.strip().splitlines()[0], J=40, dt=1e-3, T=T)
     p.add_argument("--L", type=float, default=10.0, help="beam length (m)")
     p.add_argument("--k2", type=float, default=282.84, help="k² = EI/(ρS) (m⁴/s²)")
     return p

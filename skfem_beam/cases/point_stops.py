@@ -27,7 +27,7 @@ def problem(L=1.501, k2=282.84, gap=0.1, amplitude=0.2, omega=10.0, J=19,
 
 def main(argv=None) -> int:
     p = cli.parser("skfem_beam.cases.point_stops", __doc__.splitlines()[0],
-                   J=19, dt=5e-5, T=2.0, beta=0.5)
+                   J=19, dt=5e-5, T=2.0)
     p.add_argument("--L", type=float, default=1.501, help="beam length (m)")
     p.add_argument("--k2", type=float, default=282.84, help="k² = EI/(ρS) (m⁴/s²)")
     p.add_argument("--gap", type=float, default=0.1, help="stops at ±gap (m)")

@@ -25,10 +25,14 @@ def check_output_dir(out: str | os.PathLike, overwrite: bool = False) -> Path:
         raise InputError(f"--out {out} exists and is not a folder")
     if out.is_dir() and any(out.iterdir()) and not overwrite:
         raise InputError(f"--out {out} already holds files; pass --overwrite to replace them")
+    # missing parents are made when the run starts (after every check); probe the
+    # nearest folder that exists: permission bits say little (root, read-only mounts, /proc)
     parent = out.resolve().parent
+    while not parent.exists():
+        parent = parent.parent
     if not parent.is_dir():
-        raise InputError(f"--out {out}: parent folder {parent} does not exist")
-    try:   # a real probe: permission bits say little (root, read-only mounts, /proc)
+        raise InputError(f"--out {out}: {parent} is not a folder")
+    try:
         os.rmdir(tempfile.mkdtemp(prefix=f".{out.name}.", dir=parent))
     except OSError as e:
         raise InputError(f"--out {out}: folder {parent} is not writable ({e.strerror})") from None
@@ -39,6 +43,7 @@ def check_output_dir(out: str | os.PathLike, overwrite: bool = False) -> Path:
 def output_dir(out: str | os.PathLike, overwrite: bool = False):
     """Yield a temporary folder; on success it replaces ``out`` in one rename."""
     out = check_output_dir(out, overwrite)
+    out.resolve().parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.resolve().parent))
     try:
         yield tmp

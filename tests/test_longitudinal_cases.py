@@ -83,3 +83,13 @@ def test_mesh_files_and_non_uniform_meshes(tmp_path, capsys):
     code, out = run_case(flat_obstacles, tmp_path / "h", "--mesh", str(path))
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and "break point x=5" in err[-1] and not out.exists()
+
+
+def test_readme_main_job_from_an_empty_folder(tmp_path, monkeypatch):
+    """The README's first command: no flags, run where no out/ exists yet."""
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as e:
+        main_guard(lambda: flat_obstacles.main([]))
+    assert e.value.code == 0
+    s = json.loads((tmp_path / "out" / "flat_obstacles" / "summary.json").read_text())
+    assert s["case"] == "flat_obstacles" and s["steps"] == 1000 and s["status"] == "success"

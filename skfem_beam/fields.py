@@ -194,6 +194,13 @@ class _XdmfSeries(meshio.xdmf.TimeSeriesWriter):
         self.h5_file.flush()
 
 
+def check_format(fmt: str, flag: str = "--format ") -> str:
+    """``fmt`` if it is one of FORMATS; else one clear error line."""
+    if fmt not in FORMATS:
+        raise InputError(f"{flag}{fmt!r} is not one of: {', '.join(FORMATS)}")
+    return fmt
+
+
 class FieldWriter:
     """Write field frames of ``system`` into ``folder`` as ``name.xdmf`` (+ ``name.h5``)
     and/or ``name.pvd`` (+ ``name_vtu/name_NNNNNN.vtu``).
@@ -204,8 +211,7 @@ class FieldWriter:
 
     def __init__(self, folder, system, fmt: str = "both", samples_per_element: int = 8,
                  name: str = "fields"):
-        if fmt not in FORMATS:
-            raise InputError(f"format={fmt!r} is not one of: {', '.join(FORMATS)}")
+        check_format(fmt, "format=")
         self.folder = Path(folder)
         if not self.folder.is_dir():
             raise InputError(f"field output folder {self.folder} does not exist")

@@ -21,7 +21,7 @@ import numpy as np
 
 from . import cli
 from .errors import InputError, SolverError
-from .fields import FORMATS, FieldWriter
+from .fields import FieldWriter, check_format
 from .integrators import Run, drive
 from .io import check_output_dir, write_summary
 
@@ -81,8 +81,7 @@ def prepare(args) -> Path:
         return out
     if getattr(args, "checkpoint_every", None) is not None and args.checkpoint_every < 0:
         raise InputError(f"--checkpoint-every={args.checkpoint_every:g} must be ≥ 0 seconds")
-    if getattr(args, "format", "none") not in FORMATS:
-        raise InputError(f"--format {args.format!r} is not one of: {', '.join(FORMATS)}")
+    check_format(getattr(args, "format", "none"))
     if getattr(args, "flush_every", 1) < 1:
         raise InputError(f"--flush-every={args.flush_every} must be a whole number ≥ 1")
     return check_output_dir(args.out, args.overwrite)

@@ -27,7 +27,7 @@ from .. import cli
 from ..bar import (Bar, contact_periods, energy_report, errors, run_bar,
                    spring_step_ratio)
 from ..errors import InputError
-from ..fields import FORMATS, write_fields
+from ..fields import check_format, write_fields
 from ..io import check_output_dir, output_dir, write_summary, write_timeseries
 from ..plotting import plt
 from ..problem import check_beta, check_positive
@@ -55,8 +55,7 @@ def main(argv=None) -> int:
     if args.resume or args.checkpoint_every is not None:
         raise InputError("--resume and --checkpoint-every are for the streamed beam cases; "
                          "a bar run keeps every state for the exact comparison")
-    if args.format not in FORMATS:
-        raise InputError(f"--format {args.format!r} is not one of: {', '.join(FORMATS)}")
+    check_format(args.format)
 
     cli.check_method(args)
     check_beta(args.beta)

@@ -6,6 +6,10 @@ Each step solves  u^{n+1} = argmin_{lo ≤ Cu ≤ hi} ½uᵀAu − Fⁿᵀu  wit
     Fⁿ = (2M − Δt²(1−2β)K) uⁿ − (M − Δt/2 B + Δt² β K) uⁿ⁻¹ + Δt² Gⁿ
     Gⁿ = β f^{n+1} + (1−2β) fⁿ + β f^{n−1},   fⁿ = (1/Δt)∫_{tₙ}^{tₙ+Δt} f dt
 
+The free step is computed as the increment  Δ² = u − 2uⁿ + uⁿ⁻¹  of
+    A Δ² = Fⁿ − A(2uⁿ − uⁿ⁻¹) = Δt²(Gⁿ − K uⁿ) − Δt B (uⁿ − uⁿ⁻¹):
+one banded product instead of two, and the solve's round-off scales with Δ², not u.
+
 (B = 0 for the beam: the papers' scheme; B is Kelvin–Voigt damping for the bar).
 One implementation: the compiled loop `_run` is made of `free_step`, a compiled
 contact solve and `finish_step`; solvers that live in Python (OSQP, daqp) call the
@@ -28,7 +32,7 @@ from .contact.active_set import box_qp
 from .contact.penalty import compliance_solve, spring_force
 from .contact.projection import project
 from .errors import InputError, SolverError
-from .linalg import Banded, band_solve, rows_dot, rows_matvec2
+from .linalg import Banded, band_solve, rows_dot, rows_matvec
 from .problem import check_beta, check_positive
 from .semidiscrete import SemiDiscrete
 from .stability import kappa_h, linear_limit
@@ -82,22 +86,31 @@ class Result:
 
 
 @njit(cache=True)
-def free_step(M2, Am, Achol, loads, g, u_prev, u_cur, dt2, Cp, Ci, Cx, x, yf, r_expl):
-    """x ← A⁻¹Fⁿ (the step without contact) and yf ← C x.
+def free_step(Kb, Bb, Achol, loads, g, u_prev, u_cur, dt, Cp, Ci, Cx, x, yf, r_expl, Ku, d):
+    """x ← the step without contact, yf ← C x, Ku ← K uⁿ (reused by the energy).
 
     ``r_expl``: explicit part of a penalty force on the constrained values (zero for
-    Signorini), added to the load as Δt² Cᵀ r_expl.
+    Signorini), added to the load as Cᵀ r_expl.  ``Bb``: damping rows, or none (0 rows);
+    ``d``: scratch.
     """
-    rows_matvec2(M2, u_cur, Am, u_prev, x)
-    for k in range(g.size):
-        c = dt2 * g[k]
-        for i in range(x.size):
-            x[i] += c * loads[i, k]
+    dt2 = dt * dt
+    rows_matvec(Kb, u_cur, Ku)
+    for i in range(x.size):
+        s = -Ku[i]
+        for k in range(g.size):
+            s += g[k] * loads[i, k]
+        x[i] = dt2 * s
     for r in range(r_expl.size):
         if r_expl[r] != 0.0:
             for p in range(Cp[r], Cp[r + 1]):
                 x[Ci[p]] += dt2 * Cx[p] * r_expl[r]
+    if Bb.shape[0]:
+        for i in range(d.size):
+            d[i] = u_cur[i] - u_prev[i]
+        rows_matvec(Bb, d, x, -dt, True)
     band_solve(Achol, x)
+    for i in range(x.size):
+        x[i] += 2.0 * u_cur[i] - u_prev[i]
     for r in range(yf.size):
         s = 0.0
         for p in range(Cp[r], Cp[r + 1]):
@@ -117,18 +130,21 @@ def finish_step(x, W, mu, u_prev, u_cur):
 
 
 @njit(cache=True)
-def energy_beta(Eb, Kb, u_prev, u_cur, d):
+def energy_beta(Eb, u_prev, u_cur, Ku, d):
     """E_β = δᵀ(M/Δt² + βK)δ + uⁿᵀ K uⁿ⁻¹,  δ = uⁿ − uⁿ⁻¹ (exactly conserved without contact).
 
-    ``Eb`` is M/Δt² + βK and ``Kb`` is K, both in row layout.
+    ``Eb`` is M/Δt² + βK in row layout; ``Ku`` is K uⁿ⁻¹, left by the step.
     """
     for i in range(d.size):
         d[i] = u_cur[i] - u_prev[i]
-    return rows_dot(Eb, d, d) + rows_dot(Kb, u_cur, u_prev)
+    s = rows_dot(Eb, d, d)
+    for i in range(d.size):
+        s += u_cur[i] * Ku[i]
+    return s
 
 
 @njit(cache=True)
-def record(n, save_every, frame_every, u_prev, u_cur, mu, dt, Eb, Kb, dt2,
+def record(n, save_every, frame_every, u_prev, u_cur, mu, dt, Eb, Ku, dt2,
            Op, Oi, Ox, Ep, Ei, Ex, slo, shi, C_y, lo, hi,
            obs, obsv, energy, lam, frames, frames_v, frames_f, stats, d):
     """Diagnostics after state n: penetration (every step), saved series, frames.
@@ -157,7 +173,7 @@ def record(n, save_every, frame_every, u_prev, u_cur, mu, dt, Eb, Kb, dt2,
                 sv += Ox[p] * (u_cur[Oi[p]] - u_prev[Oi[p]])
             obs[k, r] = s
             obsv[k, r] = sv / dt
-        energy[k] = 0.5 * energy_beta(Eb, Kb, u_prev, u_cur, d)
+        energy[k] = 0.5 * energy_beta(Eb, u_prev, u_cur, Ku, d)
         for j in range(mu.size):
             lam[k, j] = mu[j] / dt2
     if n % frame_every == 0:
@@ -180,7 +196,7 @@ def _penalty_explicit(beta, kappa, y_cur, y_prev, lo, hi, r_cur, r_prev, r_expl)
 
 @njit(cache=True)
 def _run(n0, n1, mode, kappa, save_every, frame_every, dt, beta,
-         M2, Am, Achol, Eb, Kb, loads, G,
+         Kb, Bb, Achol, Eb, loads, G,
          Cp, Ci, Cx, lo, hi, W, D, Ddiag, state, active_prev,
          Ep, Ei, Ex, slo, shi, Op, Oi, Ox,
          u_prev, u_cur, obs, obsv, energy, lam, frames, frames_v, frames_f, stats, counters,
@@ -200,6 +216,7 @@ def _run(n0, n1, mode, kappa, save_every, frame_every, dt, beta,
     mu = np.zeros(m)
     cy = np.empty(m)
     d = np.empty(n)
+    Ku = np.empty(n)
     r_expl = np.zeros(m)
     r_a = np.empty(m)
     r_b = np.empty(m)
@@ -209,8 +226,8 @@ def _run(n0, n1, mode, kappa, save_every, frame_every, dt, beta,
             _values(Cp, Ci, Cx, u_cur, cy)
             _values(Cp, Ci, Cx, u_prev, y_prev)
             _penalty_explicit(beta, kappa, cy, y_prev, lo, hi, r_a, r_b, r_expl)
-        free_step(M2, Am, Achol, loads, G[step - n0], u_prev, u_cur, dt2, Cp, Ci, Cx, x, yf,
-                  r_expl)
+        free_step(Kb, Bb, Achol, loads, G[step - n0], u_prev, u_cur, dt, Cp, Ci, Cx, x, yf,
+                  r_expl, Ku, d)
         if mode == 3:
             its = compliance_solve(D, yf, lo, hi, dt2 * beta * kappa, state, mu)
             if its < 0:
@@ -239,7 +256,7 @@ def _run(n0, n1, mode, kappa, save_every, frame_every, dt, beta,
                 mu[j] += dt2 * r_expl[j]
         if any_active:
             counters[1] += 1
-        record(step + 1, save_every, frame_every, u_prev, u_cur, mu, dt, Eb, Kb, dt2,
+        record(step + 1, save_every, frame_every, u_prev, u_cur, mu, dt, Eb, Ku, dt2,
                Op, Oi, Ox, Ep, Ei, Ex, slo, shi, cy, lo, hi,
                obs, obsv, energy, lam, frames, frames_v, frames_f, stats, d)
         if (step + 1) % save_every == 0 and not abs(energy[(step + 1) // save_every]) <= Ebound:
@@ -255,12 +272,6 @@ def _values(Cp, Ci, Cx, u, y):
         for p in range(Cp[r], Cp[r + 1]):
             s += Cx[p] * u[Ci[p]]
         y[r] = s
-
-
-def time_averages(fun, t0: np.ndarray, dt: float) -> np.ndarray:
-    """(1/Δt)∫_{t0}^{t0+Δt} a(s) ds by 4-point Gauss–Legendre (exact to O((ωΔt)⁸))."""
-    s = t0[:, None] + 0.5 * dt * (1.0 + _GAUSS_X[None, :])
-    return (np.asarray(fun(s), dtype=float) * _GAUSS_W).sum(axis=1) / 2.0
 
 
 def _csr(a):
@@ -307,18 +318,16 @@ class Run:
         try:
             with np.errstate(over="raise", invalid="raise"):
                 A = M + dt**2 * beta * K + (0.5 * dt * B if B is not None else 0)
-                Am = M + dt**2 * beta * K - (0.5 * dt * B if B is not None else 0)
-                M2 = 2 * M - dt**2 * (1 - 2 * beta) * K
                 E = M / dt**2 + beta * K
                 _ = dt**3 * K   # used by the first step
-            if not all(np.isfinite(a.data).all() for a in (M, K, A, M2, E)):
+            if not all(np.isfinite(a.data).all() for a in (M, K, A, E)):
                 raise FloatingPointError("non-finite entries")
             self.Ab = Banded(A, factor=True)
         except (OverflowError, FloatingPointError, ValueError, np.linalg.LinAlgError) as e:
             raise InputError(f"dt={dt:g} with this system's M and K gives step matrices outside "
                              f"floating-point range ({e}): check the scales of k2, L, dt") from None
-        self.M2b, self.Amb = Banded(M2), Banded(Am)
         self.Eb, self.Kb = Banded(E), Banded(K)
+        self.Bb = Banded(B).rows if B is not None else np.zeros((0, 1))
 
         C = system.C.tocsr()
         self.m = m = C.shape[0]
@@ -410,9 +419,11 @@ class Run:
         # states 0 and 1 (E_β needs two states: the energy saved at t = 0 is E_β¹)
         self.obs[0] = Orows @ self.u_prev
         self.obsv[0] = Orows @ system.v0
+        self.Ku = np.empty(system.n)   # K uⁿ⁻¹ for the energy (the step leaves it here)
+        rows_matvec(self.Kb.rows, self.u_prev, self.Ku)
         self._record(1, np.zeros(m), C @ self.u_cur)
         self.fr[0], self.frv[0] = self.u_prev, system.v0
-        self.E1 = 0.5 * energy_beta(self.Eb.rows, self.Kb.rows, self.u_prev, self.u_cur, self.d)
+        self.E1 = 0.5 * energy_beta(self.Eb.rows, self.u_prev, self.u_cur, self.Ku, self.d)
         if not (np.isfinite(self.u_cur).all() and math.isfinite(self.E1)):
             raise InputError("the initial state and load are too large for floating point: "
                              f"the first step's energy is {self.E1:g}")
@@ -428,14 +439,14 @@ class Run:
         Op, Oi, Ox = self.O
         Ep, Ei, Ex = self.E
         record(n, self.save_every, self.frame_every, self.u_prev, self.u_cur, mu, self.dt,
-               self.Eb.rows, self.Kb.rows, self.dt**2, Op, Oi, Ox, Ep, Ei, Ex, self.slo,
+               self.Eb.rows, self.Ku, self.dt**2, Op, Oi, Ox, Ep, Ei, Ex, self.slo,
                self.shi, cy, self.lo, self.hi, self.obs, self.obsv, self.energy, self.lam,
                self.fr, self.frv, self.frf, self.stats, self.d)
 
     def _kernel(self, n0, n1, G, Ebound):
         return _run(n0, n1, self.mode, self.kappa, self.save_every, self.frame_every, self.dt,
-                    self.beta, self.M2b.rows, self.Amb.rows, self.Ab.chol, self.Eb.rows,
-                    self.Kb.rows, self.loads, G, *self.Cs, self.lo, self.hi, self.W, self.D,
+                    self.beta, self.Kb.rows, self.Bb, self.Ab.chol, self.Eb.rows,
+                    self.loads, G, *self.Cs, self.lo, self.hi, self.W, self.D,
                     self.Ddiag, self.state, self.active_prev, *self.E, self.slo, self.shi,
                     *self.O, self.u_prev, self.u_cur, self.obs, self.obsv, self.energy,
                     self.lam, self.fr, self.frv, self.frf, self.stats, self.counters, Ebound)
@@ -446,7 +457,14 @@ class Run:
             return np.zeros((n1 - n0, 0))
         dt, beta = self.dt, self.beta
         t = np.arange(n0 - 1, n1 + 1) * dt - self.shift
-        f = np.column_stack([time_averages(a, t, dt) for a in self.system.load_time])
+        s = t + 0.5 * dt * (1.0 + _GAUSS_X[:, None])   # 4 Gauss points on each [tₙ, tₙ+Δt]
+        f = np.empty((t.size, self.nK))
+        for k, a in enumerate(self.system.load_time):
+            # fⁿ = (1/Δt)∫ f dt, exact to O((ωΔt)⁸); summed elementwise, so that a value
+            # does not depend on where the chunk starts (a resumed run continues bit for bit)
+            v = np.asarray(a(s), dtype=float)
+            f[:, k] = (_GAUSS_W[0] * v[0] + _GAUSS_W[1] * v[1] + _GAUSS_W[2] * v[2]
+                       + _GAUSS_W[3] * v[3]) / 2.0
         return np.ascontiguousarray(beta * f[2:] + (1 - 2 * beta) * f[1:-1] + beta * f[:-2])
 
     @property
@@ -577,8 +595,8 @@ def _python_chunk(run: Run, n0, n1, G, Ebound):
     x, yf = np.empty(n), np.empty(m)
     no_spring = np.zeros(m)
     for step in range(n0, n1):
-        free_step(run.M2b.rows, run.Amb.rows, run.Ab.chol, run.loads, G[step - n0], run.u_prev,
-                  run.u_cur, dt * dt, Cp, Ci, Cx, x, yf, no_spring)
+        free_step(run.Kb.rows, run.Bb, run.Ab.chol, run.loads, G[step - n0], run.u_prev,
+                  run.u_cur, dt, Cp, Ci, Cx, x, yf, no_spring, run.Ku, run.d)
         try:
             mu, its = run.pysolver.solve(x, yf)
         except SolverError as e:

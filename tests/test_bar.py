@@ -233,12 +233,35 @@ def test_example2_second_impact(obstacle):
     assert e["l2_u0"] < 5e-3 and e["l2_uL"] < 5e-3
 
 
-# --- speed ---------------------------------------------------------------------------------
+# --- β = 0, lumped mass, Courant number 1 ---------------------------------------------------
 
-def test_time_loop_speed():
-    bar = Bar(obstacle="rigid")
-    wall = min(run_bar(bar, DT, T).wall_time_s for _ in range(3))
-    assert wall <= 0.03, wall
+def test_explicit_courant_one_equals_a_plain_leapfrog():
+    """At its stability limit the explicit scheme keeps every state it is given: the run
+    reaches T with E_β constant, equals a ten-line leapfrog with the contact node clamped
+    (to round-off), and so reproduces the exact u(L,t) and reaction, while
+    the released end node steps in pairs (0, 2h, 2h, 4h, …) after t = 2."""
+    bar = Bar(obstacle="rigid", mass="lumped")
+    dt, T3 = bar.h / bar.c, 3.0
+    run = run_bar(bar, dt, T3, beta=0.0)
+    assert run.result.status == "success" and run.t[-1] == pytest.approx(T3)
+    assert np.ptp(run.result.energy) < 1e-12
+
+    s = bar_system(bar)
+    m, K = s.M.diagonal(), s.K
+    U = [s.u0, s.u0 + dt * s.v0 - 0.5 * dt**2 * (K @ s.u0) / m]
+    U[1][0] = max(U[1][0], 0.0)
+    for _ in range(run.t.size - 2):
+        x = 2 * U[-1] - U[-2] - dt**2 * (K @ U[-1]) / m
+        x[0] = max(x[0], 0.0)          # Signorini at x = 0: a clamp, as M is diagonal
+        U.append(x)
+    U = np.array(U)
+    assert np.abs(run.u0 - U[:, 0]).max() < 1e-13
+    assert np.abs(run.uL - U[:, -1]).max() < 1e-13
+
+    e = errors(run, BarExact.of(bar, T3))
+    assert e["l2_uL"] < 1e-12 and e["l2_force"] < 1e-12
+    assert e["max_u0"] == pytest.approx(bar.h, rel=1e-9)
+    assert np.all(np.abs(run.u0 - BarExact.of(bar, T3).u(0.0, run.t))[run.t < 2.0 - dt / 2] < 1e-13)
 
 
 # --- bad input ---------------------------------------------------------------------------

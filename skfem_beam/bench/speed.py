@@ -75,7 +75,9 @@ def child(scene: str, p: dict, solver: str, repeat: int) -> dict:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="skfem_beam.bench.speed", description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="one repeat, fast solvers only")
-    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--repeat", type=int, default=5,
+                    help="time loops per configuration; the best counts (this VM's speed "
+                         "drifts by ±30%% over seconds)")
     ap.add_argument("--out", default="speed.json")
     ap.add_argument("--child", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)

@@ -23,7 +23,7 @@ from . import cli
 from .errors import InputError, SolverError
 from .fields import FieldWriter, check_format
 from .integrators import Run, drive
-from .io import check_output_dir, write_summary
+from .io import check_output_dir, csv_rows, write_summary
 
 CHECKPOINT = "checkpoint.npz"
 
@@ -50,10 +50,9 @@ class SeriesFile:
         self.sync()
 
     def append(self, columns: dict) -> None:
-        data = np.column_stack([np.asarray(columns[k], dtype=float) for k in self.names])
-        if data.size:
-            self.fh.write("\n".join(",".join(f"{v:.17g}" for v in row) for row in data) + "\n")
-        self.rows += data.shape[0]
+        text = csv_rows(columns, self.names)
+        self.fh.write(text)
+        self.rows += text.count("\n")
 
     def sync(self) -> None:
         self.fh.flush()

@@ -12,8 +12,8 @@ one banded product instead of two, and the solve's round-off scales with Δ², n
 
 (B = 0 for the beam: the papers' scheme; B is Kelvin–Voigt damping for the bar).
 One implementation: the compiled loop `_run` is made of `free_step`, a compiled
-contact solve and `finish_step`; solvers that live in Python (OSQP, daqp) call the
-same two compiled functions around their own solve.
+contact solve, `finish_step` and the diagnostics; with a solver that lives in Python
+(OSQP, daqp) each step is `free_step`, that solver, and `_run` for the rest (mode −1).
 """
 from __future__ import annotations
 
@@ -200,23 +200,20 @@ def _run(n0, n1, mode, kappa, save_every, frame_every, dt, beta,
          Cp, Ci, Cx, lo, hi, W, D, Ddiag, state, active_prev,
          Ep, Ei, Ex, slo, shi, Op, Oi, Ox,
          u_prev, u_cur, obs, obsv, energy, lam, frames, frames_v, frames_f, stats, counters,
-         Ebound):
+         Ebound, x, mu, Ku, d):
     """Steps n = n0..n1−1 (computing u^{n+1}).
 
-    mode: 0 no constraint, 1 projection, 2 active set, 3 penalty (stiffness kappa).
+    mode: 0 no constraint, 1 projection, 2 active set, 3 penalty (stiffness kappa);
+    −1: one step whose free step x (with Ku, d) and multipliers μ were computed by the
+    caller (a contact solver that lives in Python), so that only the rest is done here.
     counters: [impacts, steps in contact, QP iterations, step where it stopped].
     Returns 0, FAILED (a contact solve failed at counters[3]) or UNSTABLE (the energy
     saved at state counters[3] is non-finite or above Ebound).
     """
-    n = u_cur.size
     m = lo.size
     dt2 = dt * dt
-    x = np.empty(n)
     yf = np.empty(m)
-    mu = np.zeros(m)
     cy = np.empty(m)
-    d = np.empty(n)
-    Ku = np.empty(n)
     r_expl = np.zeros(m)
     r_a = np.empty(m)
     r_b = np.empty(m)
@@ -226,8 +223,9 @@ def _run(n0, n1, mode, kappa, save_every, frame_every, dt, beta,
             _values(Cp, Ci, Cx, u_cur, cy)
             _values(Cp, Ci, Cx, u_prev, y_prev)
             _penalty_explicit(beta, kappa, cy, y_prev, lo, hi, r_a, r_b, r_expl)
-        free_step(Kb, Bb, Achol, loads, G[step - n0], u_prev, u_cur, dt, Cp, Ci, Cx, x, yf,
-                  r_expl, Ku, d)
+        if mode >= 0:
+            free_step(Kb, Bb, Achol, loads, G[step - n0], u_prev, u_cur, dt, Cp, Ci, Cx, x, yf,
+                      r_expl, Ku, d)
         if mode == 3:
             its = compliance_solve(D, yf, lo, hi, dt2 * beta * kappa, state, mu)
             if its < 0:
@@ -381,6 +379,8 @@ class Run:
         self.hi = np.ascontiguousarray(system.hi, dtype=float)
         self.Ddiag = np.ascontiguousarray(np.diag(D)) if m else np.zeros(0)
         self.d = np.empty(system.n)
+        self.x = np.empty(system.n)   # the step's free solution, then u^{n+1}
+        self.mu = np.zeros(m)         # the step's multipliers (Δt² λ)
 
         # start: u¹ is one step of the scheme itself, from u⁰ and the fictitious
         # u⁻¹ = u¹ − 2Δt v⁰ (central difference at t = 0).  Substituted, it reads
@@ -432,8 +432,7 @@ class Run:
         self.n = 1             # the last computed state
         self.wall = 0.0
         self.status, self.message = "running", ""
-        if self.pysolver is None:   # load the compiled kernel now, outside the timed loop
-            self._kernel(1, 1, np.zeros((0, self.nK)), 0.0)
+        self._kernel(1, 1, np.zeros((0, self.nK)), 0.0)   # load it now, outside the timed loop
 
     def _record(self, n, mu, cy):
         Op, Oi, Ox = self.O
@@ -443,13 +442,14 @@ class Run:
                self.shi, cy, self.lo, self.hi, self.obs, self.obsv, self.energy, self.lam,
                self.fr, self.frv, self.frf, self.stats, self.d)
 
-    def _kernel(self, n0, n1, G, Ebound):
-        return _run(n0, n1, self.mode, self.kappa, self.save_every, self.frame_every, self.dt,
+    def _kernel(self, n0, n1, G, Ebound, mode=None):
+        return _run(n0, n1, self.mode if mode is None else mode, self.kappa, self.save_every, self.frame_every, self.dt,
                     self.beta, self.Kb.rows, self.Bb, self.Ab.chol, self.Eb.rows,
                     self.loads, G, *self.Cs, self.lo, self.hi, self.W, self.D,
                     self.Ddiag, self.state, self.active_prev, *self.E, self.slo, self.shi,
                     *self.O, self.u_prev, self.u_cur, self.obs, self.obsv, self.energy,
-                    self.lam, self.fr, self.frv, self.frf, self.stats, self.counters, Ebound)
+                    self.lam, self.fr, self.frv, self.frf, self.stats, self.counters, Ebound,
+                    self.x, self.mu, self.Ku, self.d)
 
     def load_coefficients(self, n0, n1):
         """Gⁿ = βf^{n+1} + (1−2β)fⁿ + βf^{n−1} for n = n0..n1−1 (per chunk: flat memory)."""
@@ -590,27 +590,20 @@ def drive(run: Run, chunk: int = 20000, progress: bool | None = None, on_chunk=N
 
 
 def _python_chunk(run: Run, n0, n1, G, Ebound):
-    """The same step as `_run`, with the contact solve done by a Python-level engine."""
-    n, m, dt = run.u_cur.size, run.m, run.dt
-    Cp, Ci, Cx = run.Cs
-    x, yf = np.empty(n), np.empty(m)
-    no_spring = np.zeros(m)
+    """The same step as `_run`, with the contact solve done by a Python-level engine:
+    the compiled free step, the engine's μ, then `_run` in mode −1 for the rest."""
+    yf = np.empty(run.m)
+    no_spring = np.zeros(run.m)
     for step in range(n0, n1):
         free_step(run.Kb.rows, run.Bb, run.Ab.chol, run.loads, G[step - n0], run.u_prev,
-                  run.u_cur, dt, Cp, Ci, Cx, x, yf, no_spring, run.Ku, run.d)
+                  run.u_cur, run.dt, *run.Cs, run.x, yf, no_spring, run.Ku, run.d)
         try:
-            mu, its = run.pysolver.solve(x, yf)
+            mu, its = run.pysolver.solve(run.x, yf)
         except SolverError as e:
-            raise SolverError(f"step {step + 1} (t={(step + 1) * dt:.6g} s): {e}") from None
+            raise SolverError(f"step {step + 1} (t={(step + 1) * run.dt:.6g} s): {e}") from None
         run.counters[2] += its
-        finish_step(x, run.W, mu, run.u_prev, run.u_cur)
-        active = mu != 0.0
-        run.counters[0] += int(np.count_nonzero(active & ~run.active_prev))
-        run.active_prev[:] = active
-        run.counters[1] += int(active.any())
-        run._record(step + 1, mu, run.system.C @ run.u_cur)
-        if (step + 1) % run.save_every == 0 and \
-                not abs(run.energy[(step + 1) // run.save_every]) <= Ebound:
-            run.counters[3] = step + 1
-            return UNSTABLE
+        run.mu[:] = mu
+        code = run._kernel(step, step + 1, G[step - n0:step - n0 + 1], Ebound, mode=-1)
+        if code:
+            return code
     return 0

@@ -2,6 +2,7 @@ import numpy as np
 import pytest
 
 from skfem_beam.cases import point_stops
+from skfem_beam.cli import main_guard
 
 
 @pytest.fixture(scope="session")
@@ -13,3 +14,11 @@ def pipe():
 def rate(errors, hs):
     """Least-squares slope of log(error) against log(h)."""
     return np.polyfit(np.log(hs), np.log(errors), 1)[0]
+
+
+def exit_code(main, argv) -> int:
+    """Run a case's ``main(argv)`` in process through the same guard as ``python -m``
+    (one error line, exit codes) and return its exit code."""
+    with pytest.raises(SystemExit) as exit_:
+        main_guard(lambda: main(argv))
+    return exit_.value.code

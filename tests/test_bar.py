@@ -8,6 +8,7 @@ import sys
 import numpy as np
 import pytest
 
+from conftest import exit_code
 from skfem_beam import InputError
 from skfem_beam.bar import Bar, bar_system, contact_periods, energy_report, errors, run_bar
 from skfem_beam.bench.bar_convergence import study
@@ -324,11 +325,8 @@ def test_case_end_to_end(tmp_path):
 def test_case_bad_input_one_line_no_output(tmp_path, capsys, args, word):
     """In-process through the same guard as ``python -m`` (a subprocess each is slow)."""
     from skfem_beam.cases import impacting_bar
-    from skfem_beam.cli import main_guard
     out = tmp_path / "run"
-    with pytest.raises(SystemExit) as e:
-        main_guard(lambda: impacting_bar.main(args + ["--out", str(out)]))
-    assert e.value.code == 2
+    assert exit_code(impacting_bar.main, args + ["--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and word in err, err
     assert not out.exists() and list(tmp_path.iterdir()) == []

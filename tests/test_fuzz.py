@@ -9,9 +9,9 @@ import pytest
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
+from conftest import exit_code
 from skfem_beam import InputError, SolverError, beam_system, solve
 from skfem_beam.cases import point_stops
-from skfem_beam.cli import main_guard
 
 SETTINGS = settings(max_examples=200, deadline=None, derandomize=True,
                     suppress_health_check=list(HealthCheck))
@@ -85,17 +85,16 @@ def test_cli_runs_or_refuses_in_one_line(tmp_path_factory, capsys, pairs):
         argv += [f"{flag}={value}"]
     if any(f in ("--dt", "--T") for f, _ in pairs):   # keep runs short: cap the step count
         argv += ["--T", "0.002"] if not any(f == "--T" for f, _ in pairs) else []
-    with pytest.raises(SystemExit) as e:
-        main_guard(lambda: point_stops.main(argv))
+    code = exit_code(point_stops.main, argv)
     err = capsys.readouterr().err.strip().splitlines()
     errors = [line for line in err if not line.startswith("warning:")]
-    if e.value.code == 0:
+    if code == 0:
         s = json.loads((out / "summary.json").read_text())
         assert s["status"] == "success" and s["max_nodal_violation"] <= 1e-12
         data = np.genfromtxt(out / "timeseries.csv", delimiter=",", names=True)
         assert np.isfinite(data.view((float, len(data.dtype)))).all()
-    elif e.value.code == 4:
+    elif code == 4:
         assert json.loads((out / "summary.json").read_text())["status"] == "unstable"
     else:
-        assert e.value.code in (2, 3) and len(errors) == 1, err
-        assert not out.exists() or e.value.code == 3
+        assert code in (2, 3) and len(errors) == 1, err
+        assert not out.exists() or code == 3

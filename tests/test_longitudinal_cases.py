@@ -5,15 +5,13 @@ import json
 import numpy as np
 import pytest
 
+from conftest import exit_code
 from skfem_beam.cases import convex_obstacles, energy_decay, flat_obstacles
-from skfem_beam.cli import main_guard
 
 
 def run_case(module, tmp_path, *args):
     out = tmp_path / "run"
-    with pytest.raises(SystemExit) as exit_:
-        main_guard(lambda: module.main(["--out", str(out), *args]))
-    return exit_.value.code, out
+    return exit_code(module.main, ["--out", str(out), *args]), out
 
 
 @pytest.mark.parametrize("element", ["hermite", "bspline"])
@@ -88,8 +86,6 @@ def test_mesh_files_and_non_uniform_meshes(tmp_path, capsys):
 def test_readme_main_job_from_an_empty_folder(tmp_path, monkeypatch):
     """The README's first command: no flags, run where no out/ exists yet."""
     monkeypatch.chdir(tmp_path)
-    with pytest.raises(SystemExit) as e:
-        main_guard(lambda: flat_obstacles.main([]))
-    assert e.value.code == 0
+    assert exit_code(flat_obstacles.main, []) == 0
     s = json.loads((tmp_path / "out" / "flat_obstacles" / "summary.json").read_text())
     assert s["case"] == "flat_obstacles" and s["steps"] == 1000 and s["status"] == "success"

@@ -7,8 +7,8 @@ import sys
 import numpy as np
 import pytest
 
+from conftest import exit_code
 from skfem_beam.cases import point_stops
-from skfem_beam.cli import main_guard
 from skfem_beam import Beam, BeamProblem, InitialState, InputError, Obstacles, beam_system, solve
 
 CASE = [sys.executable, "-m", "skfem_beam.cases.point_stops"]
@@ -58,9 +58,7 @@ def test_case_matches_the_api(tmp_path, pipe):
 def test_bad_input_one_line_no_output(tmp_path, capsys, args, word):
     """In-process through the same guard as ``python -m`` (a subprocess each is slow)."""
     out = tmp_path / "run"
-    with pytest.raises(SystemExit) as exit_:
-        main_guard(lambda: point_stops.main(["--T", "0.01", "--out", str(out)] + args))
-    assert exit_.value.code == 2
+    assert exit_code(point_stops.main, ["--T", "0.01", "--out", str(out)] + args) == 2
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and word in lines[0], lines
     assert not out.exists()
@@ -109,10 +107,9 @@ def test_penalty_defaults_to_the_papers_beta(tmp_path):
     """β = 1/2 for the contact scheme, 1/4 (trapezoidal) for penalty, unless given."""
     for method, beta in (("contact", 0.5), ("penalty", 0.25)):
         out = tmp_path / method
-        with pytest.raises(SystemExit) as e:
-            main_guard(lambda: point_stops.main(["--T", "0.15", "--dt", "1e-5", "--method", method,
-                                                 "--out", str(out)]))
+        code = exit_code(point_stops.main, ["--T", "0.15", "--dt", "1e-5", "--method", method,
+                                            "--out", str(out)])
         s = json.loads((out / "summary.json").read_text())
-        assert e.value.code == 0 and s["beta"] == beta and s["method"] == method
+        assert code == 0 and s["beta"] == beta and s["method"] == method
     pen = json.loads((tmp_path / "penalty" / "summary.json").read_text())
     assert pen["impacts"] > 0 and pen["max_penetration"] > 1e-6     # a spring penetrates

@@ -11,9 +11,9 @@ import time
 import numpy as np
 import pytest
 
+from conftest import exit_code
 from skfem_beam import runner
 from skfem_beam.cases import point_stops
-from skfem_beam.cli import main_guard
 
 ARGS = ["--dt", "1e-5", "--T", "1.0", "--flush-every", "2000", "--frames", "10"]
 CASE = [sys.executable, "-m", "skfem_beam.cases.point_stops"]
@@ -81,31 +81,25 @@ def test_disk_full_mid_run_stops_clearly_and_checkpoint_resumes(tmp_path, monkey
         real(self, columns)
 
     monkeypatch.setattr(runner.SeriesFile, "append", full)
-    with pytest.raises(SystemExit) as e:
-        main_guard(lambda: point_stops.main(argv))
+    code = exit_code(point_stops.main, argv)
     err = capsys.readouterr().err.strip().splitlines()
-    assert e.value.code == 3 and len(err) == 1 and "No space left" in err[0]
+    assert code == 3 and len(err) == 1 and "No space left" in err[0]
     assert json.loads((out / "summary.json").read_text())["status"] == "failed"
     monkeypatch.setattr(runner.SeriesFile, "append", real)
-    with pytest.raises(SystemExit) as e:
-        main_guard(lambda: point_stops.main(["--resume", str(out)]))
-    assert e.value.code == 0
+    assert exit_code(point_stops.main, ["--resume", str(out)]) == 0
     ref = tmp_path / "ref"
-    with pytest.raises(SystemExit):
-        main_guard(lambda: point_stops.main(base + ["--out", str(ref)]))
+    exit_code(point_stops.main, base + ["--out", str(ref)])
     assert rows(out) == rows(ref)
 
 
 def test_resume_needs_a_checkpoint(tmp_path, capsys):
-    with pytest.raises(SystemExit) as e:
-        main_guard(lambda: point_stops.main(["--resume", str(tmp_path)]))
-    assert e.value.code == 2 and "checkpoint.npz" in capsys.readouterr().err
+    assert exit_code(point_stops.main, ["--resume", str(tmp_path)]) == 2
+    assert "checkpoint.npz" in capsys.readouterr().err
 
 
 def test_summary_records_configuration_and_version(tmp_path):
     out = tmp_path / "run"
-    with pytest.raises(SystemExit):
-        main_guard(lambda: point_stops.main(["--T", "0.01", "--gap", "0.05", "--out", str(out)]))
+    exit_code(point_stops.main, ["--T", "0.01", "--gap", "0.05", "--out", str(out)])
     s = json.loads((out / "summary.json").read_text())
     assert s["config"]["gap"] == 0.05 and s["config"]["T"] == 0.01
     assert s["package_version"] and s["status"] == "success"

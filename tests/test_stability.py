@@ -4,10 +4,10 @@ import json
 import numpy as np
 import pytest
 
+from conftest import exit_code
 from skfem_beam import beam_system, solve
 from skfem_beam.cases import point_stops, stability_map
 from skfem_beam.cases.point_stops import PIPE_RHO_S
-from skfem_beam.cli import main_guard
 from skfem_beam.semidiscrete import beam_system as system_of
 from skfem_beam.stability import (PAPER_KAPPA_BOUNDS, kappa_h, linear_limit, prop31_limit,
                                   stability_table)
@@ -69,10 +69,8 @@ def test_penalty_penetrates_less_as_stiffness_grows(pipe_system):
 
 def test_stability_map_small_grid(tmp_path):
     out = tmp_path / "map"
-    with pytest.raises(SystemExit) as e:
-        main_guard(lambda: stability_map.main(["--betas", "0,0.5", "--ratios", "0.9,1.2",
-                                               "--T", "0.05", "--out", str(out)]))
-    assert e.value.code == 0
+    assert exit_code(stability_map.main, ["--betas", "0,0.5", "--ratios", "0.9,1.2",
+                                          "--T", "0.05", "--out", str(out)]) == 0
     rows = (out / "stability_map.csv").read_text().splitlines()
     assert len(rows) == 1 + 2 * 2 * 2
     s = json.loads((out / "summary.json").read_text())
@@ -80,10 +78,8 @@ def test_stability_map_small_grid(tmp_path):
 
 
 def test_stability_map_refuses_a_grid_over_budget(tmp_path, capsys):
-    with pytest.raises(SystemExit) as e:
-        main_guard(lambda: stability_map.main(["--ratios", "0.01", "--T", "2",
-                                               "--max-seconds", "1", "--out", str(tmp_path / "m")]))
-    assert e.value.code == 2
+    assert exit_code(stability_map.main, ["--ratios", "0.01", "--T", "2", "--max-seconds", "1",
+                                          "--out", str(tmp_path / "m")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--max-seconds=1" in err[0]
     assert not (tmp_path / "m").exists()

@@ -9,9 +9,9 @@ import time
 import numpy as np
 import pytest
 
+from conftest import exit_code
 from skfem_beam import beam_system, solve
 from skfem_beam.cases import point_stops
-from skfem_beam.cli import main_guard
 from skfem_beam.sweep import (dask_client, main, make_settings, parse_values,
                               run_value, sweep)
 
@@ -83,7 +83,7 @@ def test_interrupted_sweep_resumes_without_redoing(tmp_path):
     assert 1 <= len(done) < 10
     assert not list((out / "runs").glob(".*")) and not (out / "runs.csv").exists()
 
-    assert main_guard_code(args) == 0   # in process: the same command, resumed
+    assert exit_code(main, args) == 0   # in process: the same command, resumed
     s = json.loads((out / "sweep.json").read_text())
     assert s["timing"]["values_resumed"] == len(done)
     assert s["timing"]["values_run"] == 10 - len(done)
@@ -91,20 +91,14 @@ def test_interrupted_sweep_resumes_without_redoing(tmp_path):
             if f.name in done} == done   # finished values were not run again
 
     clean = tmp_path / "clean"
-    assert main_guard_code(args[:-1] + [str(clean)]) == 0
+    assert exit_code(main, args[:-1] + [str(clean)]) == 0
     for name in OUTPUTS:
         assert (out / name).read_bytes() == (clean / name).read_bytes()
 
     # the same folder with other settings is refused, --overwrite starts over
-    assert main_guard_code(args[:4] + ["--periods", "4"] + args[6:]) == 2
-    assert main_guard_code(args[:4] + ["--periods", "4"] + args[6:] + ["--overwrite"]) == 0
+    assert exit_code(main, args[:4] + ["--periods", "4"] + args[6:]) == 2
+    assert exit_code(main, args[:4] + ["--periods", "4"] + args[6:] + ["--overwrite"]) == 0
     assert json.loads((out / "sweep.json").read_text())["timing"]["values_resumed"] == 0
-
-
-def main_guard_code(args):
-    with pytest.raises(SystemExit) as exit_:
-        main_guard(lambda: main(args))
-    return exit_.value.code
 
 
 @pytest.mark.parametrize("args, word", [
@@ -133,7 +127,7 @@ def main_guard_code(args):
 def test_bad_input_one_line_no_output(tmp_path, capsys, args, word):
     out = tmp_path / "sweep"
     base = ["--values", "8,9", "--out", str(out)]
-    assert main_guard_code(base + args) == 2
+    assert exit_code(main, base + args) == 2
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and word in lines[0], lines
     assert not list(tmp_path.iterdir())
@@ -149,7 +143,7 @@ def test_bad_input_through_python_m(tmp_path):
 
 def test_refuses_a_folder_that_is_not_a_sweep(tmp_path, capsys):
     (tmp_path / "mine.txt").write_text("keep me")
-    assert main_guard_code(["--values", "8", "--workers", "0", "--out", str(tmp_path)]) == 2
+    assert exit_code(main, ["--values", "8", "--workers", "0", "--out", str(tmp_path)]) == 2
     assert "--overwrite" in capsys.readouterr().err
     assert (tmp_path / "mine.txt").read_text() == "keep me"
 
@@ -158,11 +152,11 @@ def test_scheduler_address_sends_the_same_work(tmp_path):
     """--scheduler: an existing cluster (here one started on loopback by the test)."""
     distributed = pytest.importorskip("distributed")
     args = ["--values", "9,13,17", "--transient", "0.2", "--periods", "3", "--no-progress"]
-    assert main_guard_code(args + ["--workers", "0", "--out", str(tmp_path / "serial")]) == 0
+    assert exit_code(main, args + ["--workers", "0", "--out", str(tmp_path / "serial")]) == 0
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, host="127.0.0.1",
                                   dashboard_address=None) as cluster:
         out = tmp_path / "remote"
-        assert main_guard_code(args + ["--scheduler", cluster.scheduler_address,
+        assert exit_code(main, args + ["--scheduler", cluster.scheduler_address,
                                        "--out", str(out)]) == 0
     assert json.loads((out / "sweep.json").read_text())["timing"]["workers"] == 1
     for name in OUTPUTS:

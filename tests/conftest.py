@@ -22,3 +22,12 @@ def exit_code(main, argv) -> int:
     with pytest.raises(SystemExit) as exit_:
         main_guard(lambda: main(argv))
     return exit_.value.code
+
+
+def assert_refused(main, argv, word, capsys, folder) -> None:
+    """``main`` refuses ``argv``: exit code 2, one stderr line naming ``word``, and
+    ``folder`` (the output's parent) left empty: no partial or hidden output folder."""
+    assert exit_code(main, argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and word in err, err
+    assert not list(folder.iterdir())

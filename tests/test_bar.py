@@ -8,7 +8,7 @@ import sys
 import numpy as np
 import pytest
 
-from conftest import exit_code
+from conftest import assert_refused
 from skfem_beam import InputError
 from skfem_beam.bar import Bar, bar_system, contact_periods, energy_report, errors, run_bar
 from skfem_beam.bench.bar_convergence import study
@@ -325,11 +325,8 @@ def test_case_end_to_end(tmp_path):
 def test_case_bad_input_one_line_no_output(tmp_path, capsys, args, word):
     """In-process through the same guard as ``python -m`` (a subprocess each is slow)."""
     from skfem_beam.cases import impacting_bar
-    out = tmp_path / "run"
-    assert exit_code(impacting_bar.main, args + ["--out", str(out)]) == 2
-    err = capsys.readouterr().err
-    assert err.count("\n") == 1 and word in err, err
-    assert not out.exists() and list(tmp_path.iterdir()) == []
+    assert_refused(impacting_bar.main, args + ["--out", str(tmp_path / "run")], word, capsys,
+                   tmp_path)
 
 
 def test_case_bad_input_subprocess(tmp_path):

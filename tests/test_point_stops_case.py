@@ -7,7 +7,7 @@ import sys
 import numpy as np
 import pytest
 
-from conftest import exit_code
+from conftest import assert_refused, exit_code
 from skfem_beam.cases import point_stops
 from skfem_beam import Beam, BeamProblem, InitialState, InputError, Obstacles, beam_system, solve
 
@@ -57,12 +57,8 @@ def test_case_matches_the_api(tmp_path, pipe):
 ])
 def test_bad_input_one_line_no_output(tmp_path, capsys, args, word):
     """In-process through the same guard as ``python -m`` (a subprocess each is slow)."""
-    out = tmp_path / "run"
-    assert exit_code(point_stops.main, ["--T", "0.01", "--out", str(out)] + args) == 2
-    lines = capsys.readouterr().err.strip().splitlines()
-    assert len(lines) == 1 and word in lines[0], lines
-    assert not out.exists()
-    assert not list(tmp_path.iterdir())   # no hidden partial folder either
+    assert_refused(point_stops.main, ["--T", "0.01", "--out", str(tmp_path / "run")] + args,
+                   word, capsys, tmp_path)
 
 
 def test_bad_input_through_python_m(tmp_path):

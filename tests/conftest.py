@@ -10,6 +10,10 @@ def pipe():
     """The first paper's scene as a problem object (J=19 Hermite)."""
     return point_stops.problem()
 
+# summary.json keys every case writes (the output contract of DESIGN.md)
+SUMMARY_KEYS = {"case", "J", "dt", "T", "beta", "element", "solver", "steps", "wall_time_s",
+                "max_penetration", "max_nodal_violation", "energy_final", "impacts"}
+
 
 def rate(errors, hs):
     """Least-squares slope of log(error) against log(h)."""

@@ -1,6 +1,6 @@
 """skfem_beam: beams and bars vibrating between obstacles, contact-implicit β-schemes."""
 from .errors import InputError, SolverError
-from .integrators import Result, solve
+from .scheme import Result, Stepping, solve
 from .problem import Beam, BeamProblem, InitialState, Load, Obstacles, Support
 from .semidiscrete import SemiDiscrete, beam_system
 

@@ -123,7 +123,7 @@ def test_lemma_4_1_single_constraint_is_a_projection(seed):
         active += mu_p[0] != 0
         mu_b = np.zeros(1)
         assert box_qp(D, yf, lo, hi, np.zeros(1, np.int8), mu_b) > 0
-        mu_d, _ = DAQPSolver(sp.csr_matrix(Ad), sp.csr_matrix(c), lo, hi, D, W, 1e-3) \
+        mu_d, _ = DAQPSolver(lo, hi, D) \
             .solve(x_free, yf)
         mu_e = enumerate_reference(D, yf, lo, hi)
         x_q, _, flag, _ = daqp.solve(Ad, -F, c, np.minimum(hi, 1e30), np.maximum(lo, -1e30),
@@ -211,8 +211,8 @@ def test_engines_agree_on_random_step_sequences(m, kind):
     μ agree to 1e-8 relative and each satisfies the KKT conditions to 1e-10."""
     rng = np.random.default_rng(100 * m + len(kind))
     A, C, lo, hi, D, W = step_problem(rng, m, kind)
-    osqp_s = OSQPSolver(A, C, lo, hi, D, W, 1e-3)
-    daqp_s = DAQPSolver(A, C, lo, hi, D, W, 1e-3)
+    osqp_s = OSQPSolver(A, C, lo, hi, D)
+    daqp_s = DAQPSolver(lo, hi, D)
     st = np.zeros(m, np.int8)
     x_free, _, _ = free_data(rng, A, C, 2.0)
     worst_diff, worst_kkt, active = 0.0, 0.0, 0
@@ -262,10 +262,10 @@ def test_grazing_contacts_are_decided_exactly():
         n += 1
         mu_b = np.zeros(m)
         assert box_qp(D, yf, lo, hi, np.zeros(m, np.int8), mu_b) > 0
-        mu_d, _ = DAQPSolver(A, C, lo, hi, D, W, 1e-3).solve(x_free, yf)
+        mu_d, _ = DAQPSolver(lo, hi, D).solve(x_free, yf)
         results = [mu_b, mu_d]
         try:
-            results.append(OSQPSolver(A, C, lo, hi, D, W, 1e-3).solve(x_free, yf)[0])
+            results.append(OSQPSolver(A, C, lo, hi, D).solve(x_free, yf)[0])
             osqp_ok += 1
         except SolverError:
             pass
@@ -281,7 +281,7 @@ def test_osqp_is_quiet_and_free_steps_are_exact(capfd):
     """No "Polishing not needed" on the terminal; a step without contact gives μ = 0."""
     rng = np.random.default_rng(5)
     A, C, lo, hi, D, W = step_problem(rng, 10, one_sided=0.0)
-    s = OSQPSolver(A, C, lo, hi, D, W, 1e-3)
+    s = OSQPSolver(A, C, lo, hi, D)
     x_free, _, yf = free_data(rng, A, C, 1e-3)      # well inside the box
     mu, its = s.solve(x_free, yf)
     assert its > 0 and np.count_nonzero(mu) == 0
@@ -293,11 +293,11 @@ def test_engine_failures_raise_solver_error():
     rng = np.random.default_rng(6)
     A, C, lo, hi, D, W = step_problem(rng, 20)
     x_free, _, yf = free_data(rng, A, C, 2.0)
-    s = OSQPSolver(A, C, lo, hi, D, W, 1e-3)
+    s = OSQPSolver(A, C, lo, hi, D)
     s.prob.update_settings(max_iter=1)
     with pytest.raises(SolverError, match="OSQP"):
         s.solve(x_free, yf)
-    d = DAQPSolver(A, C, lo, hi, D, W, 1e-3)
+    d = DAQPSolver(lo, hi, D)
     d.model.settings = {"iter_limit": 1}
     with pytest.raises(SolverError, match="daqp"):
         d.solve(x_free, yf)

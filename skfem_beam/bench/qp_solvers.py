@@ -54,7 +54,7 @@ def _replay_box_qp(D, YF, lo, hi):
 
 def replay(system, r, solver: str, dt: float, repeat: int) -> float:
     """µs per call of the solver alone over the run's steps (states n = 2..N)."""
-    from ..contact import python_solver
+    from ..contact import StepData, resolve
     A = (system.M + dt**2 * 0.5 * system.K).tocsr()
     C = system.C.tocsr()
     W = np.linalg.solve(A.toarray(), C.T.toarray())
@@ -70,7 +70,7 @@ def replay(system, r, solver: str, dt: float, repeat: int) -> float:
             t0 = time.perf_counter()
             _replay_box_qp(D, YF, lo, hi)
         else:
-            s = python_solver(solver, A, C, lo, hi, D, W, dt)
+            s = resolve(solver).solver(StepData(A, C, D, lo, hi, dt, 0.5))
             t0 = time.perf_counter()
             for n in range(YF.shape[0]):
                 s.solve(X[n], YF[n])

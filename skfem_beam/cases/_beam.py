@@ -6,7 +6,8 @@ from pathlib import Path
 import numpy as np
 
 from .. import cli
-from ..integrators import Run
+from ..contact import resolve
+from ..scheme import Run, Stepping
 from ..plotting import energy_chart, shape_chart, trajectory_chart
 from ..problem import check_beta, check_positive
 from ..runner import execute, prepare
@@ -36,8 +37,8 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
     if args.method == "penalty":
         # physical N/m → the mass-normalised equation u_tt + k²u'''' = f needs N/m per kg/m
         stiffness = check_positive("stiffness", args.stiffness) / (rho_S or 1.0)
-    run = Run(system, args.dt, args.T, args.beta, solver=args.solver, stiffness=stiffness,
-              save_every=args.save_every, frames=args.frames)
+    run = Run(system, Stepping(args.dt, args.T, args.beta, args.save_every, args.frames),
+              resolve(args.solver, stiffness))
 
     def columns(run, k0, k1):
         force = run.lam[k0:k1].sum(axis=1)   # net force on the beam, m²/s² = N/(kg/m)
@@ -62,7 +63,7 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
             extra(folder, data, run)
 
     summary = {
-        "case": case, "J": problem.J, "dt": run.dt, "T": run.N * run.dt, "beta": run.beta,
+        "case": case, "J": problem.J, "dt": run.dt, "T": run.n_steps * run.dt, "beta": run.beta,
         "element": problem.element, "method": args.method,
         "kappa_h": kappa, "linear_stability_limit_dt": limit,
         "units": {"displacement": "m", "energy": "½E_β, m³/s² (per unit mass per length)",

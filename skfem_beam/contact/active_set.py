@@ -26,6 +26,7 @@ import numpy as np
 from numba import njit
 
 from ..errors import SolverError
+from .base import ContactLaw, compiled_law
 
 # tolerances in units of y, relative to the data's scale: the round-off of
 # y = y_f + Dμ is a few ulps of max(|y_f|, |b|); 1e-13 leaves ~500 ulps of margin.
@@ -326,3 +327,17 @@ def exact_finish(D, yf, lo, hi, duals, state, mu, scale, engine) -> int:
     if box_qp(D, yf, lo, hi, state, mu) < 0:
         raise SolverError(f"the exact finish after {engine} failed")
     return 1
+
+
+@compiled_law
+def active_set_kernel(D, yf, y_cur, y_prev, lo, hi, params, state, mu, active):
+    its = box_qp(D, yf, lo, hi, state, mu)
+    for i in range(mu.size):
+        active[i] = mu[i] != 0.0
+    return its
+
+
+class ActiveSet(ContactLaw):
+    """The exact compiled dual active set (any m, coupled or not)."""
+    name = "active-set"
+    kernel = active_set_kernel

@@ -23,6 +23,7 @@ import scipy.linalg
 
 from ..errors import SolverError
 from .active_set import bound_scale, exact_finish
+from .base import ContactLaw
 
 DAQP_INF = 1e30      # daqp's "no bound"
 
@@ -30,7 +31,7 @@ DAQP_INF = 1e30      # daqp's "no bound"
 class DAQPSolver:
     """Per-run daqp workspace; ``solve(x_free, y_free) -> (μ, iterations)``."""
 
-    def __init__(self, A, C, lo, hi, D, W, dt):
+    def __init__(self, lo, hi, D):
         self.lo = np.ascontiguousarray(lo, dtype=float)
         self.hi = np.ascontiguousarray(hi, dtype=float)
         self.D = np.ascontiguousarray(D, dtype=float)
@@ -62,3 +63,11 @@ class DAQPSolver:
         self.repairs += exact_finish(self.D, y_free, self.lo, self.hi, info["lam"],
                                      self.state, mu, self.s, "daqp")
         return mu, int(info["iterations"])
+
+
+class DAQP(ContactLaw):
+    """daqp's exact dual active set, called from Python each step."""
+    name = "daqp"
+
+    def solver(self, step):
+        return DAQPSolver(step.lo, step.hi, step.D)

@@ -34,6 +34,7 @@ import scipy.sparse as sp
 
 from ..errors import SolverError
 from .active_set import bound_scale, exact_finish
+from .base import ContactLaw
 
 EPS = 1e-10          # OSQP's eps_abs = eps_rel, in scaled units
 _POLISH_OK = (1, 2)  # OSQP_POLISH_SUCCESS, OSQP_POLISH_NO_ACTIVE_SET_FOUND
@@ -53,7 +54,7 @@ _NULL = _NullWriter()
 class OSQPSolver:
     """Per-run OSQP workspace; ``solve(x_free, y_free) -> (μ, ADMM iterations)``."""
 
-    def __init__(self, A, C, lo, hi, D, W, dt):
+    def __init__(self, A, C, lo, hi, D):
         A = sp.csc_matrix(A, dtype=float)
         C = sp.csc_matrix(C, dtype=float)
         self.lo = np.ascontiguousarray(lo, dtype=float)
@@ -94,3 +95,11 @@ class OSQPSolver:
         self.repairs += exact_finish(self.D, y_free, self.lo, self.hi, duals, self.state, mu,
                                      self.s, "OSQP")
         return mu, int(info.iter)
+
+
+class OSQP(ContactLaw):
+    """The general QP engine, called from Python each step (set up once per run)."""
+    name = "osqp"
+
+    def solver(self, step):
+        return OSQPSolver(step.A, step.C, step.lo, step.hi, step.D)

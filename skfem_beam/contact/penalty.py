@@ -1,19 +1,25 @@
 """Normal compliance (penalty): the obstacles are one-sided springs of stiffness κ = 1/ε.
 
 Inside the β-scheme the spring force r(y) = −κ[(y − hi)⁺ − (lo − y)⁺] is weighted like
-the elastic force: β r(y^{n+1}) + (1−2β) r(yⁿ) + β r(y^{n−1}).  The explicit part is
-added to the load; the implicit part makes the step a piecewise-linear monotone
-equation in y:  y = y_free + D μ,  μ = Δt² β r(y),  solved exactly by a semi-smooth
-Newton iteration (finite for piecewise-linear monotone maps; one step when m = 1).
+the elastic force: β r(y^{n+1}) + (1−2β) r(yⁿ) + β r(y^{n−1}).  The explicit part
+(1−2β) r(yⁿ) + β r(y^{n−1}) is the law's ``explicit``: it enters the step's load; the
+implicit part makes the step a piecewise-linear monotone equation in y:
+y = y_free + D μ,  μ = Δt² β r(y),  solved exactly by a semi-smooth Newton iteration
+(finite for piecewise-linear monotone maps; one step when m = 1).  The contact force
+recorded is the whole β-weighted spring force.
+
+The start step weights the spring at u⁰ by ½(1−2β) instead (see scheme.run).
 """
 import numpy as np
 from numba import njit
 
+from .base import ContactLaw, compiled_explicit, compiled_law
+
 
 @njit(cache=True)
-def spring_force(y, lo, hi, kappa, r):
-    for i in range(y.size):
-        r[i] = -kappa * (max(y[i] - hi[i], 0.0) - max(lo[i] - y[i], 0.0))
+def spring(y, lo, hi, kappa):
+    """The one-sided springs' force r(y) = −κ[(y − hi)⁺ − (lo − y)⁺] on one value."""
+    return -kappa * (max(y - hi, 0.0) - max(lo - y, 0.0))
 
 
 @njit(cache=True)
@@ -50,3 +56,46 @@ def compliance_solve(D, yf, lo, hi, c, state, mu):
     for j in range(m):
         mu[j] = -c * (max(y[j] - hi[j], 0.0) - max(lo[j] - y[j], 0.0))
     return it
+
+
+@compiled_explicit
+def penalty_explicit(y_cur, y_prev, lo, hi, params, r):
+    """r = w_cur r(yⁿ) + w_prev r(yⁿ⁻¹): (1−2β) and β in a step, ½(1−2β) and 0 at the start."""
+    kappa, w_cur, w_prev = params[0], params[2], params[3]
+    for j in range(r.size):
+        r[j] = w_cur * spring(y_cur[j], lo[j], hi[j], kappa) \
+            + w_prev * spring(y_prev[j], lo[j], hi[j], kappa)
+    return 0
+
+
+@compiled_law
+def penalty_kernel(D, yf, y_cur, y_prev, lo, hi, params, state, mu, active):
+    """The implicit springs: y = yf + Dμ, μ = Δt²βκ·r(y)/κ (params[1] = Δt²βκ)."""
+    its = compliance_solve(D, yf, lo, hi, params[1], state, mu)
+    m = yf.size
+    for i in range(m):   # in contact: the spring is compressed at y^{n+1}
+        y = yf[i]
+        for j in range(m):
+            y += D[i, j] * mu[j]
+        active[i] = y < lo[i] or y > hi[i]
+    return its
+
+
+class Penalty(ContactLaw):
+    """Normal compliance: the obstacles are one-sided springs of stiffness ``stiffness``
+    (in the units of the semi-discrete equation: per unit mass for the beam)."""
+    name = "penalty"
+    kernel = penalty_kernel
+    explicit = penalty_explicit
+
+    def __init__(self, stiffness: float):
+        from ..problem import check_positive
+        self.stiffness = check_positive("stiffness", stiffness)
+
+    def setup(self, step, first=False):
+        beta, k = step.beta, self.stiffness
+        w_cur, w_prev = (0.5 * (1 - 2 * beta), 0.0) if first else (1 - 2 * beta, beta)
+        return np.array([k, step.dt ** 2 * beta * k, w_cur, w_prev])
+
+    def __repr__(self) -> str:
+        return f"Penalty(stiffness={self.stiffness:g})"

@@ -1,5 +1,9 @@
-"""Write tests/reference/reference.npz from the code as it is (run once, before a
-change that must not alter results; see scenes.py)."""
+"""Write tests/reference/reference.npz (see scenes.py for what is pinned).
+
+It was run at commit b43bbf0, before the redesign of issue 15, and builds the scenes as
+the code did then; it is kept as the record of how the reference was made.  To make it
+again from that code:  git worktree add /tmp/old b43bbf0 && cd /tmp/old &&
+python /path/to/tests/reference/make.py  (with PYTHONPATH=/tmp/old)."""
 import sys
 from pathlib import Path
 

@@ -1,0 +1,108 @@
+"""The contact-law protocol: how one step's multipliers μ follow from its free step.
+
+Every step the scheme computes the step without contact, x_free, and its constrained
+values y_f = C x_free.  A contact law maps them to multipliers μ (Δt² × the nodal
+contact forces); the step is then u^{n+1} = x_free + W μ, with W = A⁻¹Cᵀ and the
+Delassus matrix D = C A⁻¹ Cᵀ, so that y^{n+1} = y_f + D μ.
+
+A law is an object with
+
+- ``name``: how it is found in the registry and reported (summary.json "solver");
+- ``setup(step) -> params``: once per run, from the step's data (:class:`StepData`);
+  refuses a scene it cannot solve (InputError) and returns the law's constants as a
+  float array (``first=True``: the constants of the start step, if they differ);
+- ``kernel``: a compiled law, ``compiled_law``-decorated, all with ONE signature
+
+      kernel(D, yf, y_cur, y_prev, lo, hi, params, state, mu, active) -> iterations
+
+  (y_cur, y_prev: the constrained values of uⁿ and uⁿ⁻¹; ``state``: int8 warm start
+  kept across steps; writes ``mu`` and ``active``, the values in contact; returns
+  the iterations, < 0 on failure), or ``None`` for a law solved in Python, which then
+  has ``solver(step)`` returning an object with ``solve(x_free, y_free) -> (μ, its)``;
+- ``explicit`` (optional): a compiled part of the contact force known before the step,
+
+      explicit(y_cur, y_prev, lo, hi, params, r) -> 0
+
+  added to the step's load as Δt² Cᵀr (and to μ as Δt² r): the penalty's springs at
+  uⁿ and uⁿ⁻¹, weighted (1−2β) and β like the elastic force.
+
+Compiled laws are numba C callbacks of one signature, so the time loop is compiled
+and cached once for all of them and calls the law through a pointer.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from numba import cfunc, types
+
+_vec = types.float64[::1]
+LAW_SIGNATURE = types.int64(types.float64[:, ::1], _vec, _vec, _vec, _vec, _vec, _vec,
+                            types.int8[::1], _vec, types.boolean[::1])
+
+
+EXPLICIT_SIGNATURE = types.int64(_vec, _vec, _vec, _vec, _vec, _vec)
+
+
+def compiled_law(func):
+    """Compile ``func`` as a contact-law kernel (the one signature above, cached)."""
+    return cfunc(LAW_SIGNATURE, cache=True)(func)
+
+
+def compiled_explicit(func):
+    """Compile ``func`` as the explicit part of a law (the signature above, cached)."""
+    return cfunc(EXPLICIT_SIGNATURE, cache=True)(func)
+
+
+@compiled_explicit
+def no_explicit(y_cur, y_prev, lo, hi, params, r):
+    return 0
+
+
+@dataclass(frozen=True)
+class StepData:
+    """What a law sees of the scheme, once per run."""
+    A: sp.csr_matrix      # the step matrix M + Δt/2 B + Δt²βK
+    C: sp.csr_matrix      # constrained values y = C u
+    D: np.ndarray         # Delassus matrix C A⁻¹ Cᵀ (m × m)
+    lo: np.ndarray        # bounds of y (±inf: none)
+    hi: np.ndarray
+    dt: float
+    beta: float
+
+    @property
+    def decoupled(self) -> bool:
+        """D diagonal: each constrained value is its own one-dimensional problem."""
+        D = self.D
+        return bool(np.allclose(D, np.diag(np.diag(D)), rtol=0,
+                                atol=1e-14 * np.abs(D).max(initial=0.0)))
+
+
+class ContactLaw:
+    """Base of the laws (see the module docstring); a law sets ``name`` and ``kernel``
+    and overrides what it needs."""
+    name = "law"
+    kernel = None
+    explicit = None
+
+    def setup(self, step: StepData, first: bool = False) -> np.ndarray:
+        return np.zeros(0)
+
+    def solver(self, step: StepData):
+        raise NotImplementedError(f"the {self.name} law has no Python solver")
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self.name!r})"
+
+
+@compiled_law
+def no_contact_kernel(D, yf, y_cur, y_prev, lo, hi, params, state, mu, active):
+    return 0
+
+
+class NoContact(ContactLaw):
+    """No constrained value (m = 0); also the loop's law for steps whose μ was set by a
+    law solved in Python."""
+    name = "none"
+    kernel = no_contact_kernel

@@ -1,0 +1,47 @@
+"""The contact laws by name: one line per law."""
+from __future__ import annotations
+
+from ..errors import InputError
+from .active_set import ActiveSet
+from .base import ContactLaw, StepData
+from .daqp_solver import DAQP
+from .osqp_solver import OSQP
+from .penalty import Penalty
+from .projection import Projection
+
+LAWS = {
+    "projection": Projection,
+    "active-set": ActiveSet,
+    "osqp": OSQP,
+    "daqp": DAQP,
+    "penalty": Penalty,      # needs stiffness=
+}
+SOLVERS = ("auto", *LAWS)
+
+
+def resolve(law: str | ContactLaw = "auto", stiffness: float | None = None) -> ContactLaw:
+    """A law object from a name in LAWS, ``"auto"`` (decided at setup: the cheapest exact
+    law for the scene) or a law object of the user's; ``stiffness`` means penalty."""
+    if stiffness is not None:
+        if law not in ("auto", "penalty"):
+            raise InputError(f"solver={law!r} cannot be combined with stiffness= (the penalty "
+                             f"law): pass one of them")
+        return Penalty(stiffness)
+    if isinstance(law, ContactLaw):
+        return law
+    if law == "auto":
+        return Auto()
+    if law == "penalty":
+        raise InputError("solver='penalty' needs stiffness= (the spring stiffness 1/ε)")
+    if law not in LAWS:
+        raise InputError(f"solver={law!r} is not one of: {', '.join(SOLVERS)}")
+    return LAWS[law]()
+
+
+class Auto(ContactLaw):
+    """Projection when the constraints are decoupled, else the exact active set."""
+    name = "auto"
+
+    @staticmethod
+    def choose(step: StepData) -> ContactLaw:
+        return Projection() if step.decoupled else ActiveSet()

@@ -1,0 +1,50 @@
+"""The one entry point: ``solve(system, dt, T, beta)`` → :class:`Result`."""
+from __future__ import annotations
+
+import sys
+
+from ..contact import ContactLaw, resolve
+from .run import Run
+from .stepping import Result, Stepping
+
+
+def solve(system, dt: float, T: float, beta: float = 0.5, solver: str | ContactLaw = "auto",
+          stiffness: float | None = None, save_every: int = 1, frames: int = 200,
+          progress: bool | None = None, chunk: int = 20000, load_window: str = "forward",
+          growth_limit: float = 10.0) -> Result:
+    """Integrate ``system`` over [0, T] with step ``dt``.
+
+    ``solver``: the contact law, by name (see :mod:`skfem_beam.contact`) or a law object;
+    with ``stiffness`` = κ the obstacles are instead one-sided springs (normal compliance,
+    κ in the units of the semi-discrete equation, i.e. per unit mass for the beam).
+    ``save_every``, ``frames``, ``load_window``, ``growth_limit``: see :class:`Stepping`.
+
+    The run stops with status "unstable" when the discrete energy exceeds
+    ``growth_limit`` × the a-priori bound (√E¹ + Σ‖Gⁿ‖_{M⁻¹}Δt)² or a value turns
+    non-finite; what was computed up to the last good saved state is returned.
+    """
+    stepping = Stepping(dt, T, beta, save_every, frames, load_window, growth_limit)
+    run = Run(system, stepping, resolve(solver, stiffness))
+    drive(run, chunk, progress)
+    return run.result()
+
+
+def drive(run: Run, chunk: int = 20000, progress: bool | None = None, on_chunk=None) -> None:
+    """Advance ``run`` to its end in chunks, with a progress bar on a terminal and an
+    optional ``on_chunk(run)`` after each chunk (streaming output, checkpoints)."""
+    show = sys.stderr.isatty() if progress is None else progress
+    bar = None
+    if show and run.n_steps - run.n > 10 * chunk:
+        from tqdm import tqdm
+        bar = tqdm(total=run.n_steps, initial=run.n, unit="step", unit_scale=True, leave=False)
+    try:
+        while not run.done:
+            n0 = run.n
+            run.advance(n0 + chunk)
+            if bar is not None:
+                bar.update(run.n - n0)
+            if on_chunk is not None:
+                on_chunk(run)
+    finally:
+        if bar is not None:
+            bar.close()

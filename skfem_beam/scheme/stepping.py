@@ -1,0 +1,110 @@
+"""The time grid of a run and what a run returns: plain data, checked once."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import InputError
+from ..problem import check_beta, check_positive
+
+MAX_STEPS = 10**10        # beyond this a run is a hang, not a computation
+LOAD_WINDOWS = ("forward", "centered")
+
+
+def check_count(name: str, value, least: int = 1) -> int:
+    """A whole number ≥ ``least`` (bools refused)."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < least:
+        raise InputError(f"{name}={value!r} must be a whole number ≥ {least}")
+    return int(value)
+
+
+@dataclass(frozen=True)
+class Stepping:
+    """Δt, T and β of the scheme, and what is kept of the run.
+
+    ``save_every``: keep every n-th state in the series; ``frames``: field frames kept
+    (about); ``load_window``: fⁿ averages f over [tₙ, tₙ+Δt] ("forward", the papers'
+    choice, first order) or [tₙ−Δt/2, tₙ+Δt/2] ("centered", second order);
+    ``growth_limit``: the run is unstable when its energy exceeds this many times the
+    a-priori bound (√E¹ + Σ‖Gⁿ‖_{M⁻¹}Δt)².
+    """
+    dt: float
+    T: float
+    beta: float = 0.5
+    save_every: int = 1
+    frames: int = 200
+    load_window: str = "forward"
+    growth_limit: float = 10.0
+
+    def __post_init__(self):
+        dt, T = check_positive("dt", self.dt), check_positive("T", self.T)
+        object.__setattr__(self, "dt", dt)
+        object.__setattr__(self, "T", T)
+        object.__setattr__(self, "beta", check_beta(self.beta))
+        object.__setattr__(self, "save_every", check_count("save_every", self.save_every))
+        object.__setattr__(self, "frames", check_count("frames", self.frames))
+        object.__setattr__(self, "growth_limit", check_positive("growth_limit",
+                                                                 self.growth_limit))
+        if self.load_window not in LOAD_WINDOWS:
+            raise InputError(f"load_window={self.load_window!r} is not one of: "
+                             f"{', '.join(LOAD_WINDOWS)}")
+        if self.steps < 2:
+            raise InputError(f"dt={dt:g} must be at most T/2={T / 2:g}")
+        if self.steps > MAX_STEPS:
+            raise InputError(f"T/dt = {self.steps:.3g} steps is more than {MAX_STEPS:.0e}: "
+                             "raise dt or shorten T")
+
+    @property
+    def steps(self) -> int:
+        """N = ⌈T/Δt⌉: the run computes u¹ … u^N."""
+        return int(math.ceil(self.T / self.dt - 1e-9))
+
+    @property
+    def frame_every(self) -> int:
+        return max(1, self.steps // self.frames)
+
+
+@dataclass
+class Result:
+    """What a run returns, in the spirit of ``scipy.integrate.solve_ivp``.
+
+    ``t``: saved times; ``observed[name]`` and ``velocity[name]``: observed values and
+    their backward-difference velocities (uⁿ − uⁿ⁻¹)/Δt; ``energy``: ½E_β^n (the
+    scheme's discrete energy, halved so that it tends to ½|u̇|² + ½a(u,u));
+    ``contact_force``: nodal contact forces λ (saved × m, force per unit mass per
+    length, m²/s² for the beam); ``frames_t``, ``frames_u``, ``frames_v`` (backward
+    difference velocity), ``frames_force`` (λ): decimated coefficient vectors;
+    ``status``: "success" or "unstable"; ``message`` says why; ``solver``: the contact
+    law's name.
+    """
+    t: np.ndarray
+    observed: dict
+    velocity: dict
+    energy: np.ndarray
+    contact_force: np.ndarray
+    frames_t: np.ndarray
+    frames_u: np.ndarray
+    frames_v: np.ndarray
+    frames_force: np.ndarray
+    status: str
+    message: str
+    steps: int
+    dt: float
+    T: float
+    beta: float
+    solver: str
+    wall_time_s: float
+    max_nodal_violation: float
+    max_penetration: float
+    max_penetration_below: float
+    max_penetration_above: float
+    impacts: int
+    contact_fraction: float
+    qp_iterations: int
+    system: object = field(repr=False)
+
+    @property
+    def success(self) -> bool:
+        return self.status == "success"

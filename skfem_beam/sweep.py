@@ -40,14 +40,14 @@ from pathlib import Path
 
 import numpy as np
 
-from . import cli
+from . import cli, scenes
 from .errors import InputError, SolverError
 from .io import check_output_dir
 from .problem import check_beta, check_positive
 
 # scene name -> (problem factory, parameters that may be swept or set)
 SCENES = {
-    "point_stops": ("skfem_beam.cases.point_stops", ("omega", "amplitude", "gap", "k2", "L")),
+    "point_stops": (scenes.point_stops, ("omega", "amplitude", "gap", "k2", "L")),
 }
 SECTION = "tip_displacement"   # the observed value whose section is kept
 
@@ -55,12 +55,11 @@ SECTION = "tip_displacement"   # the observed value whose section is kept
 # ---------------------------------------------------------------- inputs
 
 def scene_defaults(scene: str) -> dict:
-    """The scene's parameters and their default values (from ``problem``'s signature)."""
+    """The scene's parameters and their default values (from its factory's signature)."""
     if scene not in SCENES:
         raise InputError(f"--scene {scene!r} is not one of: {', '.join(SCENES)}")
-    import importlib
-    module, names = SCENES[scene]
-    sig = inspect.signature(importlib.import_module(module).problem)
+    factory, names = SCENES[scene]
+    sig = inspect.signature(factory)
     return {n: sig.parameters[n].default for n in names}
 
 
@@ -115,10 +114,8 @@ def make_settings(scene="point_stops", param="omega", transient=2.0, periods=50,
 
 
 def build_problem(settings: dict, value: float):
-    import importlib
-    module = importlib.import_module(SCENES[settings["scene"]][0])
     kw = {**settings["fixed"], settings["param"]: float(value)}
-    return module.problem(J=settings["J"], element=settings["element"], **kw)
+    return SCENES[settings["scene"]][0](J=settings["J"], element=settings["element"], **kw)
 
 
 def section_plan(settings: dict, value: float) -> tuple[float, int, int, float]:

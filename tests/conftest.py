@@ -1,14 +1,14 @@
 import numpy as np
 import pytest
 
-from skfem_beam.cases import point_stops
+from skfem_beam import scenes
 from skfem_beam.cli import main_guard
 
 
 @pytest.fixture(scope="session")
 def pipe():
     """The first paper's scene as a problem object (J=19 Hermite)."""
-    return point_stops.problem()
+    return scenes.point_stops()
 
 # summary.json keys every case writes (the output contract of DESIGN.md)
 SUMMARY_KEYS = {"case", "J", "dt", "T", "beta", "element", "solver", "steps", "wall_time_s",

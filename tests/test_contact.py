@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from skfem_beam import Beam, BeamProblem, Load, Obstacles, SolverError, beam_system, solve
+from skfem_beam import SolverError, beam_system, scenes, solve
 from skfem_beam.contact.active_set import box_qp
 from skfem_beam.contact.daqp_solver import DAQPSolver
 from skfem_beam.contact.osqp_solver import OSQPSolver
@@ -307,12 +307,7 @@ def test_engine_failures_raise_solver_error():
 @pytest.mark.parametrize("element", ["hermite", "bspline"])
 def test_all_solvers_give_the_same_run(element):
     """200 steps of the convex-obstacle scene: every solver, every step, to 1e-8."""
-    L = 10.0
-    obst = Obstacles(g1=lambda x: -(0.005 + 0.03 * (x - L / 2) ** 2),
-                     g2=lambda x: 0.005 + 0.03 * (x - L / 2) ** 2)
-    pb = BeamProblem(Beam(L, 282.84), obst, load=Load.uniform(lambda t: np.sin(10 * t)),
-                     J=40, element=element)
-    sysm = beam_system(pb)
+    sysm = beam_system(scenes.convex_obstacles(J=40, element=element))
     runs = {s: solve(sysm, dt=1e-3, T=0.2, beta=0.5, solver=s, frames=200)
             for s in ["active-set", "osqp", "daqp"]}
     ref = runs["active-set"]

@@ -10,9 +10,8 @@ import meshio
 import numpy as np
 import pytest
 
-from skfem_beam import beam_system, solve
+from skfem_beam import beam_system, scenes, solve
 from skfem_beam.bar import Bar, bar_system
-from skfem_beam.cases import point_stops
 from skfem_beam.errors import InputError
 from skfem_beam.fields import FieldWriter, lifting_dd, sample_line, write_fields
 from skfem_beam.meshes import PAPER_MESHES, load_mesh, write_mesh
@@ -26,7 +25,7 @@ S = 8   # sub-points per element (the default)
 @pytest.fixture(scope="module")
 def run():
     """The first paper's scene up to the first impacts (frames 0.09 and 0.11 s hold contact)."""
-    return solve(beam_system(point_stops.problem()), dt=5e-5, T=0.15, beta=0.5, frames=30)
+    return solve(beam_system(scenes.point_stops()), dt=5e-5, T=0.15, beta=0.5, frames=30)
 
 
 @pytest.fixture(scope="module")

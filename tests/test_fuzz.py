@@ -10,7 +10,7 @@ from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from conftest import exit_code
-from skfem_beam import InputError, SolverError, beam_system, solve
+from skfem_beam import InputError, SolverError, beam_system, scenes, solve
 from skfem_beam.cases import point_stops
 
 SETTINGS = settings(max_examples=200, deadline=None, derandomize=True,
@@ -50,8 +50,8 @@ def parameters(draw):
             "J": 6}, element="hermite", beta=0.0)
 def test_api_runs_or_refuses(p, element, beta):
     try:
-        pb = point_stops.problem(p["L"], p["k2"], p["gap"], p["amplitude"], p["omega"], p["J"],
-                                 element)
+        pb = scenes.point_stops(L=p["L"], k2=p["k2"], gap=p["gap"], amplitude=p["amplitude"],
+                                omega=p["omega"], J=p["J"], element=element)
         system = beam_system(pb)
         L = pb.beam.L
         dt = 1e-4 * L**2 / math.sqrt(pb.beam.k2)    # some steps, fewer than 150

@@ -5,9 +5,8 @@ import numpy as np
 import pytest
 
 from conftest import assert_refused, exit_code
-from skfem_beam import beam_system, solve
-from skfem_beam.cases import point_stops, stability_map
-from skfem_beam.cases.point_stops import PIPE_RHO_S
+from skfem_beam import beam_system, scenes, solve
+from skfem_beam.cases import stability_map
 from skfem_beam.semidiscrete import beam_system as system_of
 from skfem_beam.stability import (PAPER_KAPPA_BOUNDS, kappa_h, linear_limit, prop31_limit,
                                   stability_table)
@@ -15,7 +14,7 @@ from skfem_beam.stability import (PAPER_KAPPA_BOUNDS, kappa_h, linear_limit, pro
 
 @pytest.fixture(scope="module")
 def pipe_system():
-    return beam_system(point_stops.problem())
+    return beam_system(scenes.point_stops())
 
 
 def test_papers_bounds_hold_and_how_pessimistic(pipe_system):
@@ -27,7 +26,7 @@ def test_papers_bounds_hold_and_how_pessimistic(pipe_system):
     assert 27 < ratios["first paper (5.2), 24·420·19²/37"] < 28
     # the first paper's Δt for J=19, β=1/4: 2√(2/κ̄) = 3.3469e-6 s
     assert prop31_limit(rows[1]["kappa"], 0.25) == pytest.approx(3.3469e-6, rel=1e-4)
-    bs = system_of(point_stops.problem(element="bspline"))
+    bs = system_of(scenes.point_stops(element="bspline"))
     kb = kappa_h(bs)
     assert kb <= PAPER_KAPPA_BOUNDS["bspline"]["second paper, 5040"] * k2 / (L / J) ** 4
 
@@ -58,7 +57,7 @@ def test_penalty_penetrates_less_as_stiffness_grows(pipe_system):
     """Normal compliance penetrates (the contact scheme does not), less for stiffer springs."""
     pen = []
     for stiffness in (1e6, 1e7, 1e8):
-        r = solve(pipe_system, 5e-6, 0.25, 0.25, stiffness=stiffness / PIPE_RHO_S,
+        r = solve(pipe_system, 5e-6, 0.25, 0.25, stiffness=stiffness / scenes.PIPE_RHO_S,
                   save_every=5, frames=2)
         assert r.status == "success"
         pen.append(np.abs(r.observed["tip_displacement"]).max() - 0.1)

@@ -10,8 +10,7 @@ import numpy as np
 import pytest
 
 from conftest import assert_refused, exit_code
-from skfem_beam import beam_system, solve
-from skfem_beam.cases import point_stops
+from skfem_beam import beam_system, scenes, solve
 from skfem_beam.sweep import (dask_client, main, make_settings, parse_values,
                               run_value, sweep)
 
@@ -57,7 +56,7 @@ def test_section_is_sampled_exactly_once_per_period(pipe):
     assert r["status"] == "success" and r["dt"] * r["steps_per_period"] == pytest.approx(P, 1e-15)
     assert r["steps_per_period"] == round(P / 5e-5) and r["transient_periods"] == 1
     assert r["k"] == [2, 3, 4, 5] and np.allclose(r["t"], np.arange(2, 6) * P, rtol=1e-14)
-    full = solve(beam_system(point_stops.problem(omega=11.0)), r["dt"],
+    full = solve(beam_system(scenes.point_stops(omega=11.0)), r["dt"],
                  5 * r["steps_per_period"] * r["dt"], 0.5, progress=False, frames=1)
     idx = np.arange(2, 6) * r["steps_per_period"]
     assert r["tip_displacement"] == full.observed["tip_displacement"][idx].tolist()

@@ -13,7 +13,8 @@ from __future__ import annotations
 import argparse
 import math
 
-from ..bar import Bar, energy_report, errors, run_bar
+from .. import scenes
+from ..bar import energy_report, errors, run_bar
 from ..reference import BarExact
 
 KEYS = ("l2_u0", "l2_uL", "l2_force")
@@ -25,7 +26,7 @@ def study(obstacle: str = "rigid", Ns=(25, 50, 100, 200, 400), courant: float = 
     """One row per mesh N, with Δt = courant·h/c; rates against the previous row."""
     rows = []
     for N in Ns:
-        bar = Bar(obstacle=obstacle, N=N, mass=mass, k=k, **bar_kw)
+        bar = scenes.impacting_bar(obstacle=obstacle, N=N, mass=mass, k=k, **bar_kw)
         dt = courant * bar.h / bar.c
         run = run_bar(bar, dt, T, beta=beta, method=method)
         row = {"N": N, "dt": dt, **errors(run, BarExact.of(bar, T)),

@@ -18,9 +18,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..cases.point_stops import PIPE_RHO_S, problem
 from ..integrators import solve
 from ..semidiscrete import beam_system
+from ..scenes import PIPE_RHO_S, point_stops
 from ..stability import kappa_h
 
 
@@ -31,7 +31,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    system = beam_system(problem())
+    system = beam_system(point_stops())
     T = 0.3 if args.quick else 2.0
     dts = [5e-6, 1e-6] if args.quick else [5e-6, 1e-6, 5e-7]
     rows = []

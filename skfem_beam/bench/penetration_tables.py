@@ -13,14 +13,15 @@ from __future__ import annotations
 
 import argparse
 import csv
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
-from ..cases import convex_obstacles, flat_obstacles
+from .. import scenes
 from ..integrators import solve
 from ..plotting import penetration_chart
-from ..problem import Beam, BeamProblem, Load, Obstacles
+from ..problem import Obstacles
 from ..semidiscrete import beam_system
 
 PAPER = {  # (scene, element): {J: (max (g1−u)⁺, max (u−g2)⁺)}
@@ -31,10 +32,8 @@ PAPER = {  # (scene, element): {J: (max (g1−u)⁺, max (u−g2)⁺)}
 }
 
 
-def run(obstacles, J, element):
-    L = 10.0
-    pb = BeamProblem(Beam(L, 282.84), obstacles, load=Load.uniform(lambda t: np.sin(10 * t)),
-                     J=J, element=element)
+def run(scene, J, element):
+    pb = scene(J=J, element=element)
     return solve(beam_system(pb), 1e-3, 1.0, 0.5, frames=2, progress=False)
 
 
@@ -44,15 +43,15 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    L = 10.0
-    scenes = {"convex": convex_obstacles.obstacles(L), "flat": flat_obstacles.obstacles(L)}
+    L = scenes.PIPE10_L
+    tables = {"convex": scenes.convex_obstacles, "flat": scenes.flat_obstacles}
     rows = []
     print(f"{'scene':7s} {'element':8s} {'J':>4s} {'(g1-u)+':>10s} {'paper':>10s} "
           f"{'(u-g2)+':>10s} {'paper':>10s} {'nodal':>8s}")
-    for scene, obst in scenes.items():
+    for scene, make in tables.items():
         for element in ("hermite", "bspline"):
             for J in (40, 80, 160):
-                r = run(obst, J, element)
+                r = run(make, J, element)
                 pb, pa = PAPER[(scene, element)][J]
                 rows.append({"scene": scene, "element": element, "J": J,
                              "below_g1": r.max_penetration_below,
@@ -64,11 +63,10 @@ def main(argv=None) -> int:
     # the node at L/2 left free: what the paper's P3 flat numbers look like
     strict = Obstacles(g1=lambda x: np.where(x > L / 2 + 1e-9, -0.01, -np.inf),
                        g2=lambda x: np.where(x > L / 2 + 1e-9, 0.01, np.inf))
-    closed = flat_obstacles.obstacles(L)
+    closed = scenes.flat_profile(L)
     print("flat, hermite, node x = L/2 NOT constrained (penetration measured on [L/2, L]):")
     for J in (40, 80, 160):
-        r_all = solve(beam_system(BeamProblem(Beam(L, 282.84), strict,
-                                              load=Load.uniform(lambda t: np.sin(10 * t)), J=J)),
+        r_all = solve(beam_system(replace(scenes.flat_obstacles(J=J), obstacles=strict)),
                       1e-3, 1.0, 0.5, frames=1000, progress=False)
         s = r_all.system.space.sampler(np.linspace(0, 1, 21))
         lo, hi = closed.bounds(s.x)

@@ -26,14 +26,14 @@ SOLVERS = ("active-set", "daqp", "osqp")
 
 
 def scene(J: int, element: str, obstacles: bool = True):
-    from ..cases.convex_obstacles import obstacles as convex
-    from ..problem import Beam, BeamProblem, Load, Obstacles
+    """The convex-obstacle scene (``obstacles=False``: the same beam without them)."""
+    from dataclasses import replace
+
+    from .. import scenes
+    from ..problem import Obstacles
     from ..semidiscrete import beam_system
-    L = 10.0
-    obst = convex(L) if obstacles else Obstacles()
-    return beam_system(BeamProblem(Beam(L, 282.84), obst,
-                                   load=Load.uniform(lambda t: np.sin(10 * t)),
-                                   J=J, element=element))
+    pb = scenes.convex_obstacles(J=J, element=element)
+    return beam_system(pb if obstacles else replace(pb, obstacles=Obstacles()))
 
 
 def best_run(system, solver: str, dt: float, T: float, repeat: int):

@@ -15,23 +15,16 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-import numpy as np
-
-from .. import beam_system, solve
-from ..cases import flat_obstacles, point_stops
-from ..problem import Beam, BeamProblem, Load
+from .. import beam_system, scenes, solve
 from ..render import animate, render_beam
 
 
 def point_stops_run():
-    return solve(beam_system(point_stops.problem()), dt=5e-5, T=0.6, beta=0.5, frames=120)
+    return solve(beam_system(scenes.point_stops()), dt=5e-5, T=0.6, beta=0.5, frames=120)
 
 
 def flat_obstacles_run():
-    L = 10.0
-    pb = BeamProblem(Beam(L, 282.84, point_stops.PIPE_RHO_S), flat_obstacles.obstacles(L),
-                     load=Load.uniform(lambda t: np.sin(10 * t)), J=40)
-    return solve(beam_system(pb), dt=1e-3, T=1.0, beta=0.5, frames=100)
+    return solve(beam_system(scenes.flat_obstacles()), dt=1e-3, T=1.0, beta=0.5, frames=100)
 
 
 SCENES = {

@@ -35,18 +35,13 @@ SLOW = {"osqp", "daqp"}   # Python-level engines: only on the short configuratio
 
 
 def build(scene: str, p: dict):
-    from ..bar import Bar, bar_system
-    from ..cases import convex_obstacles, flat_obstacles, point_stops
+    from .. import scenes
+    from ..bar import bar_system
     if scene == "bar":
-        return bar_system(Bar(N=p["N"]))
-    from ..problem import Beam, BeamProblem, Load
-    import numpy as np
-    if scene == "point_stops":
-        return point_stops.problem(J=p.get("J", 19), element=p.get("element", "hermite"))
-    L = 10.0
-    obst = convex_obstacles.obstacles(L) if scene == "convex" else flat_obstacles.obstacles(L)
-    return BeamProblem(Beam(L, 282.84), obst, load=Load.uniform(lambda t: np.sin(10 * t)),
-                       J=p.get("J", 40), element=p.get("element", "hermite"))
+        return bar_system(scenes.impacting_bar(N=p["N"]))
+    make = {"point_stops": scenes.point_stops, "convex": scenes.convex_obstacles,
+            "flat": scenes.flat_obstacles}[scene]
+    return make(**{k: p[k] for k in ("J", "element") if k in p})
 
 
 def child(scene: str, p: dict, solver: str, repeat: int) -> dict:

@@ -21,11 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..bar import Bar, errors, run_bar
-from ..cases import convex_obstacles, point_stops
-from ..cases.point_stops import PIPE_RHO_S
+from .. import scenes
+from ..bar import errors, run_bar
 from ..integrators import solve
-from ..problem import Beam, BeamProblem, Load
 from ..reference import BarExact
 from ..semidiscrete import beam_system
 
@@ -50,10 +48,10 @@ def bar_ladder(quick: bool):
     for label, kw in methods:
         for N in Ns:
             dt = 0.1 / N            # Courant number c·Δt/h = 0.1, as the paper's Δt = 1e-3 at N = 100
-            bar = Bar(N=N, k=kw.get("k", 100.0))
+            bar = scenes.impacting_bar(N=N, k=kw.get("k", 100.0))
             run = run_bar(bar, dt, T, beta=kw["beta"], method=kw.get("method", "contact"),
                           solver=kw.get("solver", "auto"))
-            exact = BarExact.of(Bar(N=N), T)       # the rigid obstacle's exact solution
+            exact = BarExact.of(scenes.impacting_bar(N=N), T)   # the rigid obstacle's exact solution
             e = errors(run, exact)
             yield {"scene": "bar", "method": label, "J": N, "dt": dt, "error": e["l2_uL"],
                    "error_u0": e["l2_u0"], "wall_time_s": run.result.wall_time_s,
@@ -67,7 +65,7 @@ def beam_rung(scene, label, kw, problem, dt, T, t_ref, y_ref) -> dict:
     compression)."""
     stiff = kw.get("stiffness")
     r = solve(beam_system(problem), dt, T, kw["beta"], solver=kw.get("solver", "auto"),
-              stiffness=stiff / PIPE_RHO_S if stiff else None, frames=2, progress=False)
+              stiffness=stiff / scenes.PIPE_RHO_S if stiff else None, frames=2, progress=False)
     tip = r.observed["tip_displacement"]
     return {"scene": scene, "method": label, "J": problem.J, "dt": dt,
             "error": l2(tip - on_grid(t_ref, y_ref, r.t), dt), "wall_time_s": r.wall_time_s,
@@ -75,17 +73,11 @@ def beam_rung(scene, label, kw, problem, dt, T, t_ref, y_ref) -> dict:
 
 
 # -------------------------------------------------------------------------- convex
-def convex_problem(J, element="hermite"):
-    L = 10.0
-    return BeamProblem(Beam(L, 282.84), convex_obstacles.obstacles(L),
-                       load=Load.uniform(lambda t: np.sin(10 * t)), J=J, element=element)
-
-
 def convex_ladder(quick: bool):
     T = 1.0
     rungs = [(10, 4e-3), (20, 2e-3), (40, 1e-3), (80, 5e-4)]
     Jref, dtref = (160, 1.25e-4) if quick else (320, 6.25e-5)
-    ref = solve(beam_system(convex_problem(Jref)), dtref, T, 0.5, frames=2, progress=False)
+    ref = solve(beam_system(scenes.convex_obstacles(J=Jref)), dtref, T, 0.5, frames=2, progress=False)
     t_ref, y_ref = ref.t, ref.observed["tip_displacement"]
     methods = [("contact β=1/2 hermite active-set", dict(beta=0.5)),
                ("contact β=1/2 bspline active-set", dict(beta=0.5, element="bspline")),
@@ -98,7 +90,7 @@ def convex_ladder(quick: bool):
                 for k in ((1e4, 1e6) if quick else (1e4, 1e5, 1e6))]
     for label, kw in methods:
         for J, dt in rungs:
-            pb = convex_problem(J, kw.get("element", "hermite"))
+            pb = scenes.convex_obstacles(J=J, element=kw.get("element", "hermite"))
             yield beam_rung("convex", label, kw, pb, dt, T, t_ref, y_ref)
 
 
@@ -113,7 +105,7 @@ def second_impact(t, force):
 def point_stops_ladder(quick: bool):
     rungs = [(5, 2e-4), (10, 1e-4), (20, 5e-5), (40, 2.5e-5)]
     T = 0.3
-    ref_pb = point_stops.problem(J=80)
+    ref_pb = scenes.point_stops(J=80)
     ref = solve(beam_system(ref_pb), 2.5e-6 if not quick else 5e-6, T, 0.5, frames=2,
                 progress=False)
     horizon = second_impact(ref.t, ref.contact_force[:, 0])
@@ -128,7 +120,7 @@ def point_stops_ladder(quick: bool):
                 for k in ((1e6, 1e8) if quick else (1e6, 1e7, 1e8))]
     for label, kw in methods:
         for J, dt in rungs:
-            pb = point_stops.problem(J=J, element=kw.get("element", "hermite"))
+            pb = scenes.point_stops(J=J, element=kw.get("element", "hermite"))
             yield {**beam_rung("point_stops", label, kw, pb, dt, horizon, t_ref, y_ref),
                    "horizon_s": float(horizon)}
 

@@ -10,28 +10,25 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import cli
+from .. import cli, scenes
 from ..integrators import solve
 from ..io import write_timeseries
 from ..plotting import trajectory_chart
-from ..problem import InitialState, Load, check_beta, check_positive
+from ..problem import check_beta
 from ..semidiscrete import beam_system
-from . import _longitudinal
+from . import pipe_parser
 from ._beam import run_beam_case
-from .convex_obstacles import obstacles as convex
 
 
 def main(argv=None) -> int:
-    p = _longitudinal.parser("skfem_beam.cases.energy_decay", __doc__, T=1.0)
+    p = pipe_parser("skfem_beam.cases.energy_decay", __doc__, J=40, dt=1e-3, T=1.0,
+                    L=scenes.PIPE10_L)
     p.add_argument("--compare-beta", type=float, default=0.25,
                    help="a second β whose energy is charted beside --beta (negative: none)")
     args = cli.parse(p, argv)
-    check_positive("L", args.L)
+    pb = scenes.energy_decay(J=args.J, element=args.element, L=args.L, k2=args.k2,
+                             nodes=cli.mesh_nodes(args))
     other = None if args.compare_beta < 0 else check_beta(args.compare_beta)
-    pb = _longitudinal.problem(args, convex(args.L, 0.2, 0.3), load=Load(),
-                               initial=InitialState(u0=lambda x: 0.005 * x**2,
-                                                    du0=lambda x: 0.01 * x,
-                                                    v0=lambda x: -x))
 
     def energy_files(folder, data, run):
         columns = {"t": data["t"], f"energy_beta_{run.beta:g}": data["energy"]}

@@ -7,26 +7,18 @@ The second paper's Table 3 scene: g1 = −0.01, g2 = 0.01 on [L/2, L], no obstac
 """
 from __future__ import annotations
 
-import numpy as np
-
-from .. import cli
-from ..problem import Obstacles, check_positive
-from . import _longitudinal
+from .. import cli, scenes
+from . import pipe_parser
 from ._beam import run_beam_case
 
 
-def obstacles(L: float, gap: float = 0.01) -> Obstacles:
-    gap = check_positive("gap", gap)
-    return Obstacles(g1=lambda x: np.where(x >= L / 2, -gap, -np.inf),
-                     g2=lambda x: np.where(x >= L / 2, gap, np.inf), breakpoints=(L / 2,))
-
-
 def main(argv=None) -> int:
-    p = _longitudinal.parser("skfem_beam.cases.flat_obstacles", __doc__)
+    p = pipe_parser("skfem_beam.cases.flat_obstacles", __doc__, J=40, dt=1e-3, T=1.0,
+                    L=scenes.PIPE10_L)
     p.add_argument("--gap", type=float, default=0.01, help="obstacles at ±gap on [L/2, L] (m)")
     args = cli.parse(p, argv)
-    check_positive("L", args.L)
-    pb = _longitudinal.problem(args, obstacles(args.L, args.gap))
+    pb = scenes.flat_obstacles(J=args.J, element=args.element, L=args.L, k2=args.k2,
+                               gap=args.gap, nodes=cli.mesh_nodes(args))
     config = {"f": "sin(10 t)", "u0": "0", "v0": "0", "g": "±gap on [L/2, L]"}
     return run_beam_case("flat_obstacles", pb, args, config, stops=(-args.gap, args.gap))
 

@@ -17,15 +17,13 @@ import time
 
 import numpy as np
 
-from .. import cli
+from .. import cli, scenes
 from ..errors import InputError
 from ..integrators import solve
 from ..io import output_dir, write_summary
 from ..problem import check_beta, check_positive
 from ..semidiscrete import beam_system
 from ..stability import PAPER_KAPPA_BOUNDS, kappa_h, linear_limit, prop31_limit, stability_table
-from . import point_stops
-from .point_stops import PIPE_RHO_S
 
 PAPER_KAPPA = "first paper (5.2), 24·420·19²/37"
 
@@ -121,10 +119,10 @@ def main(argv=None) -> int:
             raise InputError(f"--methods: {m!r} is not one of: contact, penalty")
     T = check_positive("T", args.T)
     max_seconds = check_positive("max-seconds", args.max_seconds)
-    stiffness = check_positive("stiffness", args.stiffness) / PIPE_RHO_S
+    stiffness = check_positive("stiffness", args.stiffness) / scenes.PIPE_RHO_S
     from ..io import check_output_dir
     check_output_dir(args.out, args.overwrite)
-    pb = point_stops.problem(J=args.J)
+    pb = scenes.point_stops(J=args.J)
     system = beam_system(pb)
     kappa = kappa_h(system)
     dx = pb.beam.L / pb.J

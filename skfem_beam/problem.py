@@ -49,7 +49,7 @@ def _constant(c: float) -> Profile:
 
 @dataclass(frozen=True)
 class Beam:
-    """Euler–Bernoulli beam u_tt + k² u_xxxx = f on [0, L], clamped at x = 0.
+    """Euler–Bernoulli beam u_tt + k² u_xxxx = f on [0, L] (end conditions: BeamProblem.ends).
 
     ``rho_S`` (kg/m, mass per unit length) is only used to report forces in newtons.
     """

@@ -1,9 +1,11 @@
 """skfem_beam: beams and bars vibrating between obstacles, contact-implicit β-schemes."""
 from .errors import InputError, SolverError
-from .scheme import Result, Stepping, solve
+from .modes import Modes, modes
 from .problem import Beam, BeamProblem, InitialState, Load, Obstacles, Support
+from .scheme import Result, Stepping, solve
 from .semidiscrete import SemiDiscrete, beam_system
 
 __version__ = "0.1.0"
-__all__ = ["Beam", "BeamProblem", "InitialState", "InputError", "Load", "Obstacles",
-           "Result", "SemiDiscrete", "SolverError", "Support", "beam_system", "solve"]
+__all__ = ["Beam", "BeamProblem", "InitialState", "InputError", "Load", "Modes", "Obstacles",
+           "Result", "SemiDiscrete", "SolverError", "Stepping", "Support", "beam_system",
+           "modes", "solve"]

@@ -13,6 +13,7 @@ from typing import Callable
 import numpy as np
 
 from .errors import InputError
+from .spaces.ends import DEFAULT_ENDS, END_CONDITIONS, check_ends, fixed_dofs, support_nodes
 
 Profile = Callable[[np.ndarray], np.ndarray]   # g(x), u0(x), ...: vectorised in x
 TimeFunction = Callable[[np.ndarray], np.ndarray]  # a(t): vectorised in t
@@ -48,7 +49,7 @@ def _constant(c: float) -> Profile:
 
 @dataclass(frozen=True)
 class Beam:
-    """Euler–Bernoulli beam u_tt + k² u_xxxx = f on [0, L], clamped at x = 0.
+    """Euler–Bernoulli beam u_tt + k² u_xxxx = f on [0, L] (end conditions: BeamProblem.ends).
 
     ``rho_S`` (kg/m, mass per unit length) is only used to report forces in newtons.
     """
@@ -159,7 +160,13 @@ class InitialState:
 
 @dataclass(frozen=True)
 class BeamProblem:
-    """A beam scene: beam, support motion, obstacles, load and initial state, on a mesh."""
+    """A beam scene: beam, support motion, obstacles, load and initial state, on a mesh.
+
+    ``ends`` = (condition at x = 0, condition at x = L), each one of ``clamped``,
+    ``pinned``, ``sliding``, ``free`` (see :mod:`skfem_beam.spaces.ends`); ``supports``
+    are abscissae of rigid supports u(x_s) = 0, strictly inside (0, L) and at mesh nodes.
+    The defaults are the papers' beam, clamped at 0 and free at L.
+    """
     beam: Beam
     obstacles: Obstacles = field(default_factory=Obstacles)
     support: Support = field(default_factory=Support)
@@ -168,8 +175,12 @@ class BeamProblem:
     J: int = 19
     element: str = "hermite"
     nodes: np.ndarray | None = None   # x_0 = 0 < x_1 < ... < x_J = L; uniform when None
+    ends: tuple[str, str] = DEFAULT_ENDS
+    supports: tuple[float, ...] = ()
 
     def __post_init__(self):
+        object.__setattr__(self, "ends", check_ends(self.ends))
+        object.__setattr__(self, "supports", self._check_supports())
         if self.nodes is None:
             if isinstance(self.J, bool) or not isinstance(self.J, (int, np.integer)) or self.J < 1:
                 raise InputError(f"J={self.J!r} must be a whole number ≥ 1")
@@ -195,7 +206,55 @@ class BeamProblem:
             if d > 1e-9 * self.beam.L:
                 raise InputError(f"the mesh has no node at the obstacle break point x={b:g} "
                                  f"(nearest node {d:.3g} m away); choose J so that it is a node")
-        lo, hi = self.obstacles.bounds(self.nodes[1:])
-        if self.support.moves and (np.isfinite(lo) | np.isfinite(hi))[:-1].any():
-            raise InputError("a moving support is only supported with obstacles at the tip "
-                             "x = L (where the lifting h vanishes)")
+        J = self.nodes.size - 1
+        value_fixed, slope_fixed = fixed_dofs(J, self.ends,
+                                              support_nodes(self.nodes, self.supports))
+        n_fixed = int(value_fixed.sum() + slope_fixed.sum())
+        if self.element == "bspline" and J < 3 and "free" not in self.ends:
+            raise InputError(f"element='bspline' with ends={self.ends!r} needs J ≥ 3 (got "
+                             f"J={J}): the two end conditions would share a B-spline")
+        if (2 * J + 2 if self.element == "hermite" else J + 3) <= n_fixed:
+            raise InputError(f"ends={self.ends!r} and supports={self.supports!r} leave no "
+                             f"degree of freedom on J={J} elements; use a finer mesh")
+        free = np.flatnonzero(~value_fixed)   # nodes where u is free: obstacle rows live there
+        lo, hi = self.obstacles.bounds(self.nodes[free])
+        if self.supports:
+            s_lo, s_hi = self.obstacles.bounds(np.asarray(self.supports, dtype=float))
+            bad = (s_lo > 0) | (s_hi < 0)
+            if bad.any():
+                i = int(np.argmax(bad))
+                raise InputError(f"the obstacles exclude u=0 at the support "
+                                 f"x={self.supports[i]:g} (g1={s_lo[i]:g}, g2={s_hi[i]:g})")
+        if self.support.moves:
+            if self.ends[0] != "clamped" or self.ends[1] not in ("free", "pinned") \
+                    or self.supports:
+                raise InputError(f"a moving support needs ends=('clamped', 'free') or "
+                                 f"('clamped', 'pinned') and no intermediate supports (the "
+                                 f"lifting h is the clamped–free one); got ends={self.ends!r}, "
+                                 f"supports={self.supports!r}")
+            if (np.isfinite(lo) | np.isfinite(hi))[free < J].any():
+                raise InputError("a moving support is only supported with obstacles at the "
+                                 "tip x = L (where the lifting h vanishes)")
+
+    def _check_supports(self) -> tuple[float, ...]:
+        """``supports`` as sorted floats strictly inside (0, L), pairwise distinct."""
+        sup = self.supports
+        if isinstance(sup, (str, bytes)) or not hasattr(sup, "__iter__"):
+            raise InputError(f"supports={sup!r} must be a sequence of abscissae in (0, L)")
+        L = self.beam.L
+        out = []
+        for i, xs in enumerate(sup):
+            xs = check_finite(f"supports[{i}]", xs)
+            if not 0.0 <= xs <= L:
+                raise InputError(f"support x={xs:g} lies outside [0, L={L:g}]")
+            for end, at in ((0, 0.0), (1, L)):
+                if abs(xs - at) <= 1e-9 * L:
+                    e = self.ends[end]
+                    hint = "already fixed there" if END_CONDITIONS[e][0] else \
+                        f"use ends[{end}]={'clamped' if e == 'sliding' else 'pinned'!r} instead"
+                    raise InputError(f"support x={xs:g} is at the {e} end x={at:g} ({hint}); "
+                                     f"supports must lie strictly inside (0, L={L:g})")
+            if any(abs(xs - o) <= 1e-9 * L for o in out):
+                raise InputError(f"two supports at x={xs:g}; each support needs its own node")
+            out.append(xs)
+        return tuple(sorted(out))

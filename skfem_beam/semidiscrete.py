@@ -47,11 +47,11 @@ class SemiDiscrete:
 def beam_system(problem: BeamProblem, samples_per_element: int = 20) -> SemiDiscrete:
     """Discretise a beam scene (the papers' V_h, K_h of (8), loads with the lifting)."""
     beam, sup = problem.beam, problem.support
-    space = make_space(problem.element, problem.nodes)
-    x_nodes = problem.nodes[1:]
+    space = make_space(problem.element, problem.nodes, problem.ends, problem.supports)
+    x_nodes = problem.nodes[space.value_nodes]     # where u is free (x_1..x_J when clamped)
     lo_all, hi_all = problem.obstacles.bounds(x_nodes)
     finite = np.isfinite(lo_all) | np.isfinite(hi_all)
-    C = space.C[np.flatnonzero(finite)]
+    C = space.nodal[space.value_nodes[finite]]
 
     # f = f̃ − h φ'' − k² h'''' φ, with h'''' = −8/L⁴
     L, k2 = beam.L, beam.k2

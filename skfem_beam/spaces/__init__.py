@@ -1,10 +1,14 @@
-"""Finite element spaces V_h ⊂ V = {w ∈ H²(0,L): w(0) = w'(0) = 0} (and P1 for the bar).
+"""Finite element spaces V_h ⊂ V = {w ∈ H²(0,L): the end conditions and supports} (and P1
+for the bar).  The beam spaces take ``ends`` (default clamped at 0, free at L: the papers'
+V = {w(0) = w'(0) = 0}) and ``supports`` (abscissae of rigid supports), see :mod:`.ends`.
 
 Every space offers the same small interface, used by :mod:`skfem_beam.semidiscrete`:
 
 - ``nodes`` (J+1,), ``n`` (number of free dofs), ``mesh`` (the real ``skfem.MeshLine``);
 - ``M`` mass (u, v) and ``S`` bending (u'', v'') as CSR matrices on the free dofs;
-- ``C`` (J × n): the nodal values u(x_1..x_J) = C·coefficients (constraint (8));
+- ``nodal`` ((J+1) × n): the nodal values u(x_0..x_J) = nodal·coefficients (zero rows
+  where u is fixed), ``value_nodes``: the nodes where u is free;
+- ``C`` (J × n): the rows x_1..x_J of ``nodal`` (constraint (8));
 - ``sampler(xi)``: values and second derivatives at local abscissae ξ ∈ [0, 1] of
   every element, as sparse matrices (penetration between nodes, output sub-points);
 - ``load_vector(b)``: (b, φ_i) for a profile b(x);
@@ -13,15 +17,17 @@ Every space offers the same small interface, used by :mod:`skfem_beam.semidiscre
 """
 from __future__ import annotations
 
+from .ends import DEFAULT_ENDS, END_CONDITIONS  # noqa: F401
 from .hermite import HermiteSpace
 
 
-def make_space(element: str, nodes):
+def make_space(element: str, nodes, ends=DEFAULT_ENDS, supports=()):
+    """The space of ``element`` on ``nodes``; ``ends``/``supports`` for the beam spaces."""
     if element == "hermite":
-        return HermiteSpace(nodes)
+        return HermiteSpace(nodes, ends, supports)
     if element == "bspline":
         from .bspline import BSplineSpace
-        return BSplineSpace(nodes)
+        return BSplineSpace(nodes, ends, supports)
     if element == "p1":
         from .lagrange import LagrangeSpace
         return LagrangeSpace(nodes)

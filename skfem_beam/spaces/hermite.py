@@ -6,6 +6,11 @@ round-off grows with the distance from the origin over the element size (measure
 therefore assemble on a *broken* copy of the mesh in which every element starts at
 x = 0 — the element matrices are translation invariant — and gather the element
 blocks into the global numbering.  The result equals the closed forms to round-off.
+
+End conditions and supports (:mod:`.ends`) drop degrees of freedom: a clamped end its
+value and slope, a pinned end its value, a sliding end its slope, a free end nothing,
+a rigid support the value at its node.  The remaining dofs keep the node order, so M
+and S stay banded (half bandwidth 3).
 """
 from __future__ import annotations
 
@@ -15,6 +20,9 @@ import numpy as np
 import scipy.sparse as sp
 from skfem import Basis, BilinearForm, ElementLineHermite, LinearForm, MeshLine
 from skfem.helpers import dd
+
+from ..errors import InputError
+from .ends import DEFAULT_ENDS, check_ends, fixed_dofs, support_nodes
 
 
 @BilinearForm
@@ -50,27 +58,41 @@ class HermiteSpace:
     name = "hermite"
     kd = 3  # half bandwidth of M and S
 
-    def __init__(self, nodes):
+    def __init__(self, nodes, ends=DEFAULT_ENDS, supports=()):
         x = np.asarray(nodes, dtype=float)
         self.nodes = x
         self.J = J = x.size - 1
         self.h = np.diff(x)
+        self.ends = check_ends(ends)
+        self.support_nodes = support_nodes(x, supports)
         self.mesh = MeshLine(x)
         p = np.zeros(2 * J)
         p[1::2] = self.h
         # a fresh element per mesh (DESIGN: the element caches mesh data)
         self._broken = MeshLine(p, np.arange(2 * J).reshape(J, 2).T)
         self._basis = Basis(self._broken, ElementLineHermite(), intorder=8)
-        # P: global dofs (2 per node, node 0 first) -> broken dofs; then drop node 0 (clamp)
+        # P: global dofs (2 per node: value, slope; node 0 first) -> broken dofs; then keep
+        # the dofs that the end conditions and supports leave free
         ed = self._basis.element_dofs
         glob = 2 * np.arange(J)[None, :] + np.arange(4)[:, None]
         P = sp.csr_matrix((np.ones(ed.size), (ed.ravel(), glob.ravel())),
                           shape=(self._basis.N, 2 * J + 2))
-        self._P = P[:, 2:].tocsr()
-        self.n = 2 * J
+        value_fixed, slope_fixed = fixed_dofs(J, self.ends, self.support_nodes)
+        free = np.flatnonzero(~np.column_stack([value_fixed, slope_fixed]).ravel())
+        if free.size == 0:
+            raise InputError(f"ends={self.ends!r} with J={J} leave no degree of freedom")
+        self._free = free
+        self._P = P[:, free].tocsr()
+        self.n = free.size
+        #: nodes whose displacement is free (obstacle rows may only sit there)
+        self.value_nodes = np.flatnonzero(~value_fixed)
         self.M = self._gather(mass.assemble(self._basis))
         self.S = self._gather(bending.assemble(self._basis))
-        self.C = sp.csr_matrix((np.ones(J), (np.arange(J), 2 * np.arange(J))), shape=(J, self.n))
+        # nodal values u(x_0..x_J) = nodal @ c (zero rows where u is fixed); C: x_1..x_J
+        col = np.searchsorted(free, 2 * self.value_nodes)
+        self.nodal = sp.csr_matrix((np.ones(col.size), (self.value_nodes, col)),
+                                   shape=(J + 1, self.n))
+        self.C = self.nodal[1:]
 
     def _gather(self, A):
         return (self._P.T @ A @ self._P).tocsr()
@@ -100,12 +122,14 @@ class HermiteSpace:
         return self._P.T @ load.assemble(self._basis, b=bq)
 
     def interpolate(self, u, du=None) -> np.ndarray:
-        x = self.nodes[1:]
         if du is None:
             du = five_point_slope(u, 1e-3 * (self.nodes[-1] - self.nodes[0]))
         c = np.empty(self.n)
-        c[0::2] = np.broadcast_to(u(x), x.shape)
-        c[1::2] = np.broadcast_to(du(x), x.shape)
+        is_value = self._free % 2 == 0
+        x = self.nodes[self._free[is_value] // 2]
+        c[is_value] = np.broadcast_to(u(x), x.shape)
+        x = self.nodes[self._free[~is_value] // 2]
+        c[~is_value] = np.broadcast_to(du(x), x.shape)
         return c
 
     def project(self, v) -> np.ndarray:

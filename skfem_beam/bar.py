@@ -46,7 +46,7 @@ import scipy.sparse as sp
 
 from .errors import InputError
 from .problem import check_finite, check_positive
-from .semidiscrete import SemiDiscrete
+from .semidiscrete import SceneView, SemiDiscrete
 from .spaces.lagrange import MASSES, LagrangeSpace
 
 OBSTACLES = ("rigid", "elastic")
@@ -135,7 +135,8 @@ def bar_system(bar: Bar) -> SemiDiscrete:
         observe={"u0": e0.toarray().ravel(), "uL": eL,
                  "mean_u": space.load_vector(np.ones_like) / bar.L}, space=space,
         meta={"kind": "bar", "L": bar.L, "a": bar.a, "b": bar.b, "rho": bar.rho,
-              "obstacle": bar.obstacle, "k": bar.k, "N": bar.N, "mass": bar.mass})
+              "obstacle": bar.obstacle, "k": bar.k, "N": bar.N, "mass": bar.mass},
+        view=SceneView("bar", bar.L))
 
 
 METHODS = ("contact", "penalty")
@@ -151,7 +152,7 @@ def spring_step_ratio(bar: Bar, dt: float) -> float:
 
 @dataclass
 class BarRun:
-    """A bar run, as series at the step times tₙ (n = 0..N).
+    """A bar run, as series at the step times tₙ (n = 0, 1, … to T).
 
     ``force`` is the obstacle reaction R at tₙ: the force of the step centred on tₙ
     (for the spring, its β-weighted value β R^{n+1} + (1−2β) Rⁿ + β R^{n−1}).  The
@@ -177,6 +178,7 @@ class BarRun:
     energy: np.ndarray
     load_potential: np.ndarray
     result: object   # the integrator's Result (run to T + Δt, see run_bar)
+    every: int = 1   # the series keep every ``every``-th step
 
     @property
     def penetration(self) -> float:
@@ -188,66 +190,138 @@ class BarRun:
         return self.result.wall_time_s
 
 
-def run_bar(bar: Bar, dt: float, T: float, beta: float = 0.25, method: str = "contact",
-            solver: str = "auto", all_states_limit: int = 4_000_000) -> BarRun:
-    """Integrate the bar with the shared scheme (:func:`skfem_beam.integrators.solve`).
+def steps_to(T: float, dt: float) -> int:
+    """N = ⌈T/Δt⌉: the steps of a bar run to T (checked)."""
+    return int(np.ceil(check_positive("T", T) / check_positive("dt", dt) - 1e-9))
+
+
+def bar_run(bar: Bar, dt: float, T: float, beta: float = 0.25, method: str = "contact",
+            solver: str = "auto", frames: int = 200, all_states_limit: int = 4_000_000):
+    """The bar's :class:`~skfem_beam.integrators.Run` (not yet driven), to T + Δt.
 
     rigid + contact: the Signorini condition u(0) ≥ 0 (one constrained value, so the
     step is the projection of Lemma 4.1); rigid + penalty: a one-sided spring of
     stiffness ``bar.k`` stands in for the rigid obstacle (normal compliance); elastic:
     the obstacle *is* the spring R = kU⁻ (either method).  The run goes one step past
-    T so that the force centred on t_N is known.
+    T so that the force centred on t_N is known.  It saves every step (the reaction at
+    tₙ comes from step n + 1) and keeps every state as a frame when there are at most
+    ``all_states_limit`` values (the energy split needs them); else ``frames`` frames.
     """
     if method not in METHODS:
         raise InputError(f"method={method!r} is not one of: {', '.join(METHODS)}")
-    from .integrators import solve
+    from .contact import resolve
+    from .scheme import Run, Stepping
     system = bar_system(bar)
-    spring = bar.obstacle == "elastic" or method == "penalty"
-    if spring and bar.k == 0:
+    if _spring(bar, method) and bar.k == 0:
         raise InputError("k=0 must be > 0 for a penalty spring")
-    N = int(np.ceil(check_positive("T", T) / check_positive("dt", dt) - 1e-9))
-    every_state = (N + 2) * system.n <= all_states_limit
-    r = solve(system, dt, N * dt + dt, beta=beta, solver=solver,
-              stiffness=bar.k if spring else None, frames=N + 1 if every_state else 200)
-    n = min(N + 1, r.t.size)     # an unstable run stops early
-    t = r.t[:n]
-    u0, uL = r.observed["u0"][:n], r.observed["uL"][:n]
+    n_steps = steps_to(T, dt)
+    every_state = (n_steps + 2) * system.n <= all_states_limit
+    stepping = Stepping(dt, n_steps * dt + dt, beta,
+                        frames=n_steps + 1 if every_state else frames)
+    return Run(system, stepping, resolve(solver, bar.k if _spring(bar, method) else None))
 
-    # force at tₙ = the force of step n → n+1 (recorded with state n+1)
-    force = np.full(n, np.nan)
-    lam = r.contact_force[:, 0]
-    m = min(n, lam.size - 1)
-    force[1:m] = lam[2:m + 1]
-    if spring:
-        force[0] = bar.k * max(-u0[0], 0.0)
 
-    if spring:
+def _spring(bar: Bar, method: str) -> bool:
+    return bar.obstacle == "elastic" or method == "penalty"
+
+
+class BarSeries:
+    """The bar's series at tₙ (n = 0, every, 2·every, … ≤ N), computed from its run's
+    saved buffers as the run goes (``columns``, the timeseries.csv contract), or all at
+    once (:meth:`bar_run`).  ``exact``: a :class:`skfem_beam.reference.BarExact` whose
+    values are written beside the computed ones, or None."""
+
+    def __init__(self, bar: Bar, run, T: float, method: str = "contact", every: int = 1,
+                 exact=None):
+        from .scheme.stepping import check_count
+        self.bar, self.method, self.exact = bar, method, exact
+        self.every = check_count("save_every", every)
+        self.n_steps = steps_to(T, run.dt)
+        self.spring = _spring(bar, method)
+        s = run.system
+        self.names = list(s.observe)
+        Um0 = max(-s.u0[0], 0.0)
+        self.obstacle0 = 0.5 * bar.k * (run.beta * 0.0 + Um0 * Um0) if self.spring else 0.0
+        self.energy0 = 0.5 * s.v0 @ (s.M @ s.v0) + 0.5 * s.u0 @ (s.K @ s.u0) + self.obstacle0
+
+    def ready(self, run) -> int:
+        """Rows whose values are final: the reaction at tₙ needs state n + 1."""
+        return min(run.n + 1 if run.done else run.n, self.n_steps + 1)
+
+    def rows(self, run, k0: int, k1: int) -> dict:
+        """Every series (BarRun's names) at the states n in [k0, k1) kept by ``every``."""
+        n = np.arange(k0, k1)
+        n = n[n % self.every == 0]
+        bar, dt, beta, s = self.bar, run.dt, run.beta, run.system
+        obs = {k: run.obs[n, i] for i, k in enumerate(self.names)}
+        u0, first = obs["u0"], n == 0
+        force = np.full(n.size, np.nan)
+        known = (n >= 1) & (n + 1 <= run.n)      # force at tₙ = the force of step n → n+1
+        force[known] = run.lam[n[known] + 1, 0]
         Um = np.maximum(-u0, 0.0)
-        Um_prev = np.concatenate([Um[:1], Um[:-1]])   # at t = 0: ½k(U⁻)² of the data
-        obstacle = 0.5 * bar.k * (r.beta * (Um - Um_prev) ** 2 + Um * Um_prev)
-    else:
-        obstacle = np.zeros(n)
-    kinetic = np.full(n, np.nan)
-    strain = np.full(n, np.nan)
-    if every_state and r.frames_u.shape[0] >= n:
-        U = r.frames_u[:n]
-        d = np.diff(U, axis=0)
-        Md, Kd = (system.M @ d.T).T, (system.K @ d.T).T
-        kinetic[1:] = 0.5 * np.einsum("ij,ij->i", d, Md) / dt**2
-        strain[1:] = 0.5 * (r.beta * np.einsum("ij,ij->i", d, Kd)
-                            + np.einsum("ij,ij->i", U[1:], (system.K @ U[:-1].T).T))
-        # t = 0: the data themselves
-        v, u = system.v0, system.u0
-        kinetic[0] = 0.5 * v @ (system.M @ v)
-        strain[0] = 0.5 * u @ (system.K @ u)
-        energy = kinetic + strain + obstacle
-    else:
-        energy = r.energy[:n] + obstacle
-        energy[0] = 0.5 * system.v0 @ (system.M @ system.v0) \
-            + 0.5 * system.u0 @ (system.K @ system.u0) + obstacle[0]
-    potential = -bar.f * bar.L * r.observed["mean_u"][:n]
-    return BarRun(bar, method, t, u0, uL, force, kinetic, strain, obstacle, energy,
-                  potential, r)
+        if self.spring:
+            force[first] = bar.k * Um[first]
+            Um_prev = np.maximum(-run.obs[np.maximum(n - 1, 0), self.names.index("u0")], 0.0)
+            Um_prev[first] = Um[first]         # at t = 0: ½k(U⁻)² of the data
+            obstacle = 0.5 * bar.k * (beta * (Um - Um_prev) ** 2 + Um * Um_prev)
+        else:
+            obstacle = np.zeros(n.size)
+        kinetic = np.full(n.size, np.nan)
+        strain = np.full(n.size, np.nan)
+        if run.frame_every == 1:                 # every state kept: the energy split
+            U, P = run.fr[n], run.fr[np.maximum(n - 1, 0)]
+            d = U - P
+            Md, Kd = (s.M @ d.T).T, (s.K @ d.T).T
+            kinetic = 0.5 * np.einsum("ij,ij->i", d, Md) / dt**2
+            strain = 0.5 * (beta * np.einsum("ij,ij->i", d, Kd)
+                            + np.einsum("ij,ij->i", U, (s.K @ P.T).T))
+            kinetic[first] = 0.5 * s.v0 @ (s.M @ s.v0)     # t = 0: the data themselves
+            strain[first] = 0.5 * s.u0 @ (s.K @ s.u0)
+            energy = kinetic + strain + obstacle
+        else:
+            energy = run.energy[n] + obstacle
+            energy[first] = self.energy0
+        return {"t": n * dt, "u0": u0, "uL": obs["uL"], "force": force, "kinetic": kinetic,
+                "strain": strain, "obstacle": obstacle, "energy": energy,
+                "load_potential": -bar.f * bar.L * obs["mean_u"]}
+
+    def columns(self, run, k0: int, k1: int) -> dict:
+        """The timeseries.csv columns of the rows in [k0, k1)."""
+        r = self.rows(run, k0, k1)
+        cols = {"t": r["t"], "u_0": r["u0"], "u_L": r["uL"], "contact_force": r["force"],
+                "energy": r["energy"], "energy_kinetic": r["kinetic"],
+                "energy_strain": r["strain"], "energy_obstacle": r["obstacle"]}
+        if self.bar.f != 0:
+            cols["load_potential"] = r["load_potential"]
+        ex = self.exact
+        if ex is not None:
+            t = r["t"]
+            cols.update(u_0_exact=ex.u(0.0, t), u_L_exact=ex.u(self.bar.L, t),
+                        contact_force_exact=ex.contact_force(t))
+            if self.bar.f == 0:   # an elastic bar with f = 0 conserves its energy
+                cols["energy_exact"] = np.full(t.size, self.energy0)
+        return cols
+
+    def bar_run(self, rows: dict, result) -> BarRun:
+        """A :class:`BarRun` of ``rows`` (from :meth:`rows`, or the columns of
+        :meth:`columns`)."""
+        get = {"u0": "u_0", "uL": "u_L", "force": "contact_force", "kinetic": "energy_kinetic",
+               "strain": "energy_strain", "obstacle": "energy_obstacle"}
+        col = {k: rows[k] if k in rows else rows[get[k]] for k in get}
+        potential = rows.get("load_potential", np.zeros(rows["t"].size))
+        return BarRun(self.bar, self.method, rows["t"], col["u0"], col["uL"], col["force"],
+                      col["kinetic"], col["strain"], col["obstacle"], rows["energy"], potential,
+                      result, self.every)
+
+
+def run_bar(bar: Bar, dt: float, T: float, beta: float = 0.25, method: str = "contact",
+            solver: str = "auto", all_states_limit: int = 4_000_000) -> BarRun:
+    """Integrate the bar with the shared scheme (:func:`bar_run`, driven to its end)."""
+    from .integrators import drive
+    run = bar_run(bar, dt, T, beta, method, solver, all_states_limit=all_states_limit)
+    drive(run)
+    series = BarSeries(bar, run, T, method)
+    return series.bar_run(series.rows(run, 0, series.ready(run)), run.result())
 
 
 def l2_time(e: np.ndarray, dt: float) -> float:
@@ -259,7 +333,7 @@ def l2_time(e: np.ndarray, dt: float) -> float:
 def errors(run: BarRun, exact) -> dict:
     """L²-in-time errors of u(0,·), u(L,·) and the reaction R against ``exact``
     (a :class:`skfem_beam.reference.BarExact`), and the largest pointwise ones."""
-    t, dt = run.t, run.result.dt
+    t, dt = run.t, run.result.dt * run.every
     e = {"u0": run.u0 - exact.u(0.0, t), "uL": run.uL - exact.u(run.bar.L, t),
          "force": run.force - exact.contact_force(t)}
     out = {f"l2_{k}": l2_time(v, dt) for k, v in e.items()}

@@ -7,13 +7,12 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 
 from . import __version__
 from .contact import SOLVERS
 from .errors import InputError, SolverError
-
-EXIT_INPUT, EXIT_SOLVER, EXIT_UNSTABLE = 2, 3, 4
+from .output.folder import EXIT_INPUT, EXIT_SOLVER, EXIT_UNSTABLE, report, stamp  # noqa: F401
+from .output.series import stored_args
 
 
 class Parser(argparse.ArgumentParser):
@@ -65,7 +64,6 @@ def parser(prog: str, description: str, *, J=None, dt=None, T=None, beta=None,
 
 def parse(p: Parser, argv=None):
     """Parse the flags; with --resume, the flags stored by the run being resumed."""
-    from .runner import stored_args
     args = stored_args(p.parse_args(argv), p)
     if getattr(args, "beta", 0.5) is None:   # the papers: β = 1/2 for contact, 1/4 for penalty
         args.beta = 0.25 if getattr(args, "method", "contact") == "penalty" else 0.5
@@ -106,20 +104,3 @@ def main_guard(main) -> None:
 
 def warn(message: str) -> None:
     print(f"warning: {message}", file=sys.stderr)
-
-
-def report(result, out) -> int:
-    """One line on stdout for a finished run; the exit code."""
-    if result.status != "success":
-        print(f"error: {result.message}; results up to t={result.t[-1]:.6g} s written to {out}",
-              file=sys.stderr)
-        return EXIT_UNSTABLE
-    print(f"{result.steps} steps in {result.wall_time_s:.3g} s "
-          f"({1e6 * result.wall_time_s / max(1, result.steps):.3g} µs/step), "
-          f"{result.impacts} impacts, max nodal violation {result.max_nodal_violation:.2e} m"
-          f" -> {out}")
-    return 0
-
-
-def stamp() -> dict:
-    return {"package_version": __version__, "written": time.strftime("%Y-%m-%dT%H:%M:%S%z")}

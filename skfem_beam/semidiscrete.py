@@ -18,6 +18,23 @@ from .problem import BeamProblem, lifting
 from .spaces import make_space
 
 
+@dataclass(frozen=True)
+class SceneView:
+    """What the output (fields, renders, charts) needs from the scene beyond the matrices.
+
+    ``kind``: "beam" or "bar"; ``L``: length; ``k2``: bending stiffness per unit mass
+    (beams, for the bending moment; None otherwise); ``support``: the moving support
+    (with ``phi(t)``, optionally ``phi_d(t)``), None when it does not move; ``obstacles``:
+    an object with ``bounds(x) -> (g1, g2)``, None when the obstacles are the bounds of
+    the constrained values alone.
+    """
+    kind: str = "beam"
+    L: float | None = None
+    k2: float | None = None
+    support: Any = None
+    obstacles: Any = None
+
+
 @dataclass
 class SemiDiscrete:
     M: sp.csr_matrix
@@ -38,6 +55,7 @@ class SemiDiscrete:
     sample_lo: np.ndarray | None = None
     sample_hi: np.ndarray | None = None
     meta: dict = field(default_factory=dict)
+    view: SceneView | None = None            # what the output needs (see SceneView)
 
     @property
     def n(self) -> int:
@@ -99,4 +117,5 @@ def beam_system(problem: BeamProblem, samples_per_element: int = 20) -> SemiDisc
         sample_x=sampler.x[keep], sample_E=sampler.E0[np.flatnonzero(keep)].tocsr(),
         sample_lo=s_lo[keep], sample_hi=s_hi[keep],
         meta={"kind": "beam", "L": L, "k2": k2, "rho_S": beam.rho_S,
-              "element": problem.element, "J": problem.J, "problem": problem})
+              "element": problem.element, "J": problem.J, "problem": problem},
+        view=SceneView("beam", L, k2, sup if sup.moves else None, problem.obstacles))

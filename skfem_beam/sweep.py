@@ -14,7 +14,8 @@ DIR receives, as runs finish, ``runs/<param>=<value>.json`` (written atomically)
 sweep started again with the same settings skips the values whose file exists.  At
 the end the files are assembled into ``poincare.csv`` (one row per section point),
 ``runs.csv`` (one row per value: impacts, contact-time fraction, detected period),
-``bifurcation.png`` and ``sweep.json``.  The CSV files hold only deterministic data
+``bifurcation.png`` and ``sweep.json``; the command's ``summary.json`` carries its status
+("running" until the end).  The CSV files hold only deterministic data
 (floats written exactly, as Python's repr): they are identical for any number of
 workers.
 
@@ -33,7 +34,6 @@ import inspect
 import json
 import math
 import os
-import shutil
 import sys
 import time
 from pathlib import Path
@@ -42,7 +42,7 @@ import numpy as np
 
 from . import cli, scenes
 from .errors import InputError, SolverError
-from .io import check_output_dir
+from .output.folder import Folder, atomic_write, check_output_dir, stamp
 from .problem import check_beta, check_positive
 
 # scene name -> (problem factory, parameters that may be swept or set)
@@ -216,20 +216,9 @@ def run_path(out: Path, param: str, value: float) -> Path:
     return Path(out) / "runs" / f"{param}={float(value)!r}.json"
 
 
-def _atomic_write(path: Path, write) -> None:
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
-        with open(tmp, "w", newline="") as fh:
-            write(fh)
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-
-
 def save_run(out: Path, result: dict) -> None:
     path = run_path(out, result["param"], result["value"])
-    _atomic_write(path, lambda fh: json.dump(result, fh))
+    atomic_write(path, lambda fh: json.dump(result, fh))
 
 
 def load_run(out: Path, settings: dict, value: float) -> dict | None:
@@ -276,11 +265,11 @@ def assemble(out: Path, settings: dict, results: list[dict], extra: dict | None 
             if r["status"] == "success" else None
     points = [(r["value"], k, t, u, v) for r in results
               for k, t, u, v in zip(r["k"], r["t"], r["tip_displacement"], r["tip_velocity"])]
-    _atomic_write(out / "poincare.csv", lambda fh: _csv(
+    atomic_write(out / "poincare.csv", lambda fh: _csv(
         fh, [param, "k", "t", "tip_displacement", "tip_velocity"], points))
     cols = ["omega", "dt", "steps_per_period", "transient_periods", "impacts",
             "impacts_per_period", "contact_fraction", "impacts_total", "period", "status"]
-    _atomic_write(out / "runs.csv", lambda fh: _csv(
+    atomic_write(out / "runs.csv", lambda fh: _csv(
         fh, [param] + [c for c in cols if c != param],
         [[r["value"]] + [r[c] for c in cols if c != param] for r in results]))
     bifurcation_chart(out / "bifurcation.png", settings, results)
@@ -292,56 +281,51 @@ def assemble(out: Path, settings: dict, results: list[dict], extra: dict | None 
                          "impacts": "contacts that start in the sampled window",
                          "period": "smallest p such that the section repeats every p forcing "
                                    "periods (to 1e-6·gap); 0: none up to periods/2"},
-               **(extra or {}), **cli.stamp()}
-    _atomic_write(out / "sweep.json", lambda fh: json.dump(summary, fh, indent=2,
+               **(extra or {}), **stamp()}
+    atomic_write(out / "sweep.json", lambda fh: json.dump(summary, fh, indent=2,
                                                            ensure_ascii=False))
     return summary
 
 
 def bifurcation_chart(path: Path, settings: dict, results: list[dict]) -> None:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from .output.charts import figure   # matplotlib only where a chart is drawn, not in workers
     param = settings["param"]
     label = {"omega": "support frequency ω (rad/s)", "amplitude": "support amplitude A (m)",
              "gap": "gap (m)", "k2": "k² (m⁴/s²)", "L": "L (m)"}.get(param, param)
-    fig, (ax, ax2) = plt.subplots(2, 1, figsize=(9, 6.5), dpi=120, sharex=True,
-                                  gridspec_kw={"height_ratios": [3, 1]})
-    x = np.concatenate([[r["value"]] * len(r["tip_displacement"]) for r in results] or [[]])
-    y = np.concatenate([r["tip_displacement"] for r in results] or [[]])
-    ax.plot(x, y, ",", color="k", alpha=0.8)
-    ax.plot(x, y, ".", ms=1.2, color="k", alpha=0.5)
-    gap = settings["fixed"].get("gap")
-    if gap is not None:
-        for g in (-gap, gap):
-            ax.axhline(g, color="tab:red", lw=0.8, ls="--")
-    elif param == "gap" and results:   # the stops move with the swept value
-        xs = np.array([r["value"] for r in results])
-        ax.plot(xs, xs, "--", xs, -xs, "--", color="tab:red", lw=0.8)
-    bad = [r["value"] for r in results if r["status"] != "success"]
-    if bad:
-        ax.plot(bad, [0.0] * len(bad), "x", color="tab:red", label="run failed / unstable")
-        ax.legend(loc="upper right", fontsize=8)
-    fixed = ", ".join(f"{k}={v:g}" for k, v in settings["fixed"].items())
-    ax.set_title(f"{settings['scene']}: Poincaré section of the tip, once per forcing period\n"
-                 f"({fixed}; {settings['periods']} periods after {settings['transient']:g} s, "
-                 f"J={settings['J']}, β={settings['beta']:g}, Δt≈{settings['dt_target']:g} s)",
-                 fontsize=9)
-    ax.set_ylabel("tip displacement ũ(L, kP) (m)")
-    ax.grid(alpha=0.3)
-    ok = [r for r in results if r["status"] == "success"]
-    ax2.plot([r["value"] for r in ok], [r["impacts_per_period"] for r in ok], ".-", ms=3,
-             lw=0.6, color="tab:blue")
-    ax2.set_ylabel("impacts / period", color="tab:blue")
-    ax3 = ax2.twinx()
-    ax3.plot([r["value"] for r in ok], [r["contact_fraction"] for r in ok], ".-", ms=3,
-             lw=0.6, color="tab:orange")
-    ax3.set_ylabel("contact-time fraction", color="tab:orange")
-    ax2.set_xlabel(label)
-    ax2.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
+    with figure(path, figsize=(9, 6.5), dpi=120, nrows=2, sharex=True,
+                gridspec_kw={"height_ratios": [3, 1]}) as (fig, (ax, ax2)):
+        x = np.concatenate([[r["value"]] * len(r["tip_displacement"]) for r in results] or [[]])
+        y = np.concatenate([r["tip_displacement"] for r in results] or [[]])
+        ax.plot(x, y, ",", color="k", alpha=0.8)
+        ax.plot(x, y, ".", ms=1.2, color="k", alpha=0.5)
+        gap = settings["fixed"].get("gap")
+        if gap is not None:
+            for g in (-gap, gap):
+                ax.axhline(g, color="tab:red", lw=0.8, ls="--")
+        elif param == "gap" and results:   # the stops move with the swept value
+            xs = np.array([r["value"] for r in results])
+            ax.plot(xs, xs, "--", xs, -xs, "--", color="tab:red", lw=0.8)
+        bad = [r["value"] for r in results if r["status"] != "success"]
+        if bad:
+            ax.plot(bad, [0.0] * len(bad), "x", color="tab:red", label="run failed / unstable")
+            ax.legend(loc="upper right", fontsize=8)
+        fixed = ", ".join(f"{k}={v:g}" for k, v in settings["fixed"].items())
+        ax.set_title(f"{settings['scene']}: Poincaré section of the tip, once per forcing period\n"
+                     f"({fixed}; {settings['periods']} periods after {settings['transient']:g} s, "
+                     f"J={settings['J']}, β={settings['beta']:g}, Δt≈{settings['dt_target']:g} s)",
+                     fontsize=9)
+        ax.set_ylabel("tip displacement ũ(L, kP) (m)")
+        ax.grid(alpha=0.3)
+        ok = [r for r in results if r["status"] == "success"]
+        ax2.plot([r["value"] for r in ok], [r["impacts_per_period"] for r in ok], ".-", ms=3,
+                 lw=0.6, color="tab:blue")
+        ax2.set_ylabel("impacts / period", color="tab:blue")
+        ax3 = ax2.twinx()
+        ax3.plot([r["value"] for r in ok], [r["contact_fraction"] for r in ok], ".-", ms=3,
+                 lw=0.6, color="tab:orange")
+        ax3.set_ylabel("contact-time fraction", color="tab:orange")
+        ax2.set_xlabel(label)
+        ax2.grid(alpha=0.3)
 
 
 # ---------------------------------------------------------------- the sweep
@@ -476,11 +460,14 @@ def main(argv=None) -> int:
     progress = not args.no_progress
     serial = (scheduler is None and workers == 0) or not args.overwrite and all(
         run_path(out, settings["param"], v).exists() for v in values)   # nothing left to run
+    resume = not args.overwrite and (out / "runs").is_dir()
     try:
         with contextlib.nullcontext() if serial else dask_client(workers, scheduler) as client:
-            if args.overwrite and out.exists():
-                shutil.rmtree(out)
-            summary = sweep(settings, values, out, client, progress)
+            with Folder.open(out, {"case": "sweep", "settings": settings,
+                                   "config": {k: v for k, v in vars(args).items()}},
+                             args.overwrite, resume) as folder:
+                (out / "runs").mkdir(exist_ok=True)
+                summary = folder.close(**sweep(settings, values, out, client, progress))
     except KeyboardInterrupt:
         n = sum(run_path(out, settings["param"], v).exists() for v in values)
         print(f"interrupted: {n} of {len(values)} values done in {out / 'runs'}; "

@@ -333,3 +333,48 @@ def test_case_bad_input_subprocess(tmp_path):
                        timeout=120)
     assert p.returncode == 2 and p.stderr.strip() == "error: N=0 must be a whole number ≥ 1"
     assert p.stdout == "" and not out.exists()
+
+
+def test_case_honours_save_every_and_frames(tmp_path):
+    """The bar streams through the same pipeline as the beams: --save-every keeps every
+    n-th row, --frames about that many field frames (not one per step)."""
+    from conftest import exit_code
+    from skfem_beam.cases import impacting_bar
+    out = tmp_path / "run"
+    assert exit_code(impacting_bar.main, ["--T", "1", "--save-every", "10", "--frames", "20",
+                                          "--format", "vtu", "--out", str(out)]) == 0
+    rows = list(csv.DictReader(open(out / "timeseries.csv")))
+    assert len(rows) == 101 and float(rows[1]["t"]) == pytest.approx(0.01)
+    assert len(list((out / "fields_vtu").iterdir())) == 21
+    full = run_bar(Bar(), DT, 1.0)
+    assert np.array([float(r["u_L"]) for r in rows]) == pytest.approx(full.uL[::10], abs=1e-15)
+    s = json.loads((out / "summary.json").read_text())
+    assert s["status"] == "success" and s["steps"] == 1000
+
+
+def test_case_disk_full_then_resume_is_bit_identical(tmp_path, monkeypatch, capsys):
+    """Checkpoints and --resume work for the bar as for the beams."""
+    from conftest import exit_code
+    from skfem_beam.cases import impacting_bar
+    from skfem_beam.output import series
+    out, ref = tmp_path / "run", tmp_path / "ref"
+    base = ["--T", "3", "--flush-every", "250", "--format", "xdmf", "--obstacle", "elastic"]
+    real = series.SeriesFile.append
+    calls = {"n": 0}
+
+    def full(self, columns):
+        calls["n"] += 1
+        if calls["n"] > 5:
+            raise OSError(28, "No space left on device")
+        real(self, columns)
+
+    monkeypatch.setattr(series.SeriesFile, "append", full)
+    assert exit_code(impacting_bar.main, base + ["--checkpoint-every", "0", "--out", str(out)]) == 3
+    assert json.loads((out / "summary.json").read_text())["status"] == "failed"
+    monkeypatch.setattr(series.SeriesFile, "append", real)
+    assert exit_code(impacting_bar.main, ["--resume", str(out)]) == 0
+    assert exit_code(impacting_bar.main, base + ["--out", str(ref)]) == 0
+    assert (out / "timeseries.csv").read_text() == (ref / "timeseries.csv").read_text()
+    a, b = (json.loads((d / "summary.json").read_text()) for d in (out, ref))
+    for key in ("steps", "impacts", "errors", "energy", "max_penetration", "status"):
+        assert a[key] == b[key], key

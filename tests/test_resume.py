@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from conftest import exit_code
-from skfem_beam import runner
+from skfem_beam.output import series as runner
 from skfem_beam.cases import point_stops
 
 ARGS = ["--dt", "1e-5", "--T", "1.0", "--flush-every", "2000", "--frames", "10"]

@@ -7,10 +7,10 @@ import numpy as np
 
 from .. import cli
 from ..contact import resolve
+from ..output.charts import energy_chart, shape_chart, trajectory_chart
+from ..output.series import execute, prepare
 from ..scheme import Run, Stepping
-from ..plotting import energy_chart, shape_chart, trajectory_chart
 from ..problem import check_beta, check_positive
-from ..runner import execute, prepare
 from ..semidiscrete import beam_system
 from ..stability import kappa_h, linear_limit
 
@@ -18,7 +18,8 @@ from ..stability import kappa_h, linear_limit
 def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) -> int:
     """Discretise ``problem``, run it with the flags in ``args``, write DIR, return exit code.
 
-    ``extra(folder, data, run)`` may write more files into the output folder.
+    ``extra(folder, data, run)`` may write more files into the output folder (``data``:
+    the timeseries columns, from memory).
     """
     cli.check_method(args)
     check_beta(args.beta)
@@ -71,7 +72,5 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
                   "contact_force_N": "N (contact_force × rho_S)"},
         "penalty_stiffness_N_per_m": args.stiffness if args.method == "penalty" else None,
         "config": {**config, **{k: v for k, v in vars(args).items() if k != "resume"}},
-        **cli.stamp(),
     }
-    return execute(run, out, args, summary, columns, finish,
-                   resume=bool(getattr(args, "resume", None)))
+    return execute(run, out, args, summary, columns, finish)

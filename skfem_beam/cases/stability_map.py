@@ -20,7 +20,8 @@ import numpy as np
 from .. import cli, scenes
 from ..errors import InputError
 from ..integrators import solve
-from ..io import output_dir, write_summary
+from ..output.charts import figure
+from ..output.folder import Folder, check_output_dir
 from ..problem import check_beta, check_positive
 from ..semidiscrete import beam_system
 from ..stability import PAPER_KAPPA_BOUNDS, kappa_h, linear_limit, prop31_limit, stability_table
@@ -67,35 +68,31 @@ def run_map(system, betas, ratios, methods, T, stiffness, kappa, kappa_paper, ma
 
 
 def chart(path, rows, kappa, kappa_paper, title):
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(8, 5), dpi=110)
-    b = np.linspace(0, 0.5, 400)
-    lin = [linear_limit(kappa, x) for x in b]
-    ax.plot(b, lin, "k-", lw=1.5, label="linear limit 2/√(κ_h(1−4β))")
-    ax.plot(b, [prop31_limit(kappa, x) for x in b], "b--", lw=1,
-            label="Prop. 3.1 bound, exact κ_h")
-    ax.plot(b, [prop31_limit(kappa_paper, x) for x in b], "b:", lw=1,
-            label="Prop. 3.1 bound, the paper's κ̄ (5.2)")
-    marker = {"contact": "o", "penalty": "s"}
-    shift = {"contact": -0.006, "penalty": 0.006}
-    for method in sorted({r["method"] for r in rows}):
-        for ok in (True, False):
-            sel = [r for r in rows if r["method"] == method and (r["status"] == "success") == ok]
-            if sel:
-                ax.scatter([r["beta"] + shift[method] for r in sel], [r["dt"] for r in sel],
-                           marker=marker[method], facecolors="none" if not ok else None,
-                           color="tab:green" if ok else "tab:red", s=40,
-                           label=f"{method}: {'stable' if ok else 'unstable'}")
-    ax.set_yscale("log")
-    ax.set_xlabel("β")
-    ax.set_ylabel("Δt (s)")
-    ax.set_title(title)
-    ax.axvline(0.25, color="gray", lw=0.5)
-    ax.legend(fontsize=7, loc="upper left")
-    ax.grid(alpha=0.3, which="both")
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
+    with figure(path, figsize=(8, 5)) as (fig, ax):
+        b = np.linspace(0, 0.5, 400)
+        lin = [linear_limit(kappa, x) for x in b]
+        ax.plot(b, lin, "k-", lw=1.5, label="linear limit 2/√(κ_h(1−4β))")
+        ax.plot(b, [prop31_limit(kappa, x) for x in b], "b--", lw=1,
+                label="Prop. 3.1 bound, exact κ_h")
+        ax.plot(b, [prop31_limit(kappa_paper, x) for x in b], "b:", lw=1,
+                label="Prop. 3.1 bound, the paper's κ̄ (5.2)")
+        marker = {"contact": "o", "penalty": "s"}
+        shift = {"contact": -0.006, "penalty": 0.006}
+        for method in sorted({r["method"] for r in rows}):
+            for ok in (True, False):
+                sel = [r for r in rows if r["method"] == method and (r["status"] == "success") == ok]
+                if sel:
+                    ax.scatter([r["beta"] + shift[method] for r in sel], [r["dt"] for r in sel],
+                               marker=marker[method], facecolors="none" if not ok else None,
+                               color="tab:green" if ok else "tab:red", s=40,
+                               label=f"{method}: {'stable' if ok else 'unstable'}")
+        ax.set_yscale("log")
+        ax.set_xlabel("β")
+        ax.set_ylabel("Δt (s)")
+        ax.set_title(title)
+        ax.axvline(0.25, color="gray", lw=0.5)
+        ax.legend(fontsize=7, loc="upper left")
+        ax.grid(alpha=0.3, which="both")
 
 
 def main(argv=None) -> int:
@@ -120,8 +117,7 @@ def main(argv=None) -> int:
     T = check_positive("T", args.T)
     max_seconds = check_positive("max-seconds", args.max_seconds)
     stiffness = check_positive("stiffness", args.stiffness) / scenes.PIPE_RHO_S
-    from ..io import check_output_dir
-    check_output_dir(args.out, args.overwrite)
+    out = check_output_dir(args.out, args.overwrite)
     pb = scenes.point_stops(J=args.J)
     system = beam_system(pb)
     kappa = kappa_h(system)
@@ -129,21 +125,21 @@ def main(argv=None) -> int:
     kappa_paper = PAPER_KAPPA_BOUNDS["hermite"][PAPER_KAPPA] * pb.beam.k2 / dx**4
     t0 = time.perf_counter()
     rows = run_map(system, betas, ratios, methods, T, stiffness, kappa, kappa_paper, max_seconds)
-    with output_dir(args.out, args.overwrite) as tmp:
+    summary = {"case": "stability_map", "J": pb.J, "T": T, "kappa_h": kappa,
+               "kappa_paper_5_2": kappa_paper, "config": vars(args)}
+    with Folder.open(out, summary, args.overwrite) as folder:
         import csv
-        with open(tmp / "stability_map.csv", "w", newline="") as fh:
+        with open(folder / "stability_map.csv", "w", newline="") as fh:
             w = csv.DictWriter(fh, fieldnames=list(rows[0]))
             w.writeheader()
             w.writerows(rows)
-        chart(tmp / "stability_map.png", rows, kappa, kappa_paper,
+        chart(folder / "stability_map.png", rows, kappa, kappa_paper,
               f"pipe scene J={pb.J}, T={T:g} s: κ_h={kappa:.4g}, paper's κ̄={kappa_paper:.4g} s⁻²")
-        write_summary(tmp, {"case": "stability_map", "J": pb.J, "T": T, "kappa_h": kappa,
-                            "kappa_paper_5_2": kappa_paper, "runs": len(rows),
-                            "bounds": {f"beta={b:g}": stability_table(kappa, "hermite", pb.beam.k2,
-                                                                      dx, b) for b in betas},
-                            "unstable": sum(r["status"] != "success" for r in rows),
-                            "wall_time_s": time.perf_counter() - t0, "config": vars(args),
-                            **cli.stamp()})
+        folder.close(runs=len(rows),
+                     bounds={f"beta={b:g}": stability_table(kappa, "hermite", pb.beam.k2, dx, b)
+                             for b in betas},
+                     unstable=sum(r["status"] != "success" for r in rows),
+                     wall_time_s=time.perf_counter() - t0)
     print(f"{len(rows)} runs, {sum(r['status'] != 'success' for r in rows)} unstable -> {args.out}")
     return 0
 

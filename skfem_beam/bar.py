@@ -66,7 +66,7 @@ class Bar:
     ``u0`` is a uniform initial displacement: a gap to the obstacle when > 0 (the bar
     then flies freely for u0/|v0| before it hits).  ``mass`` is the mass matrix; the
     default ``average`` is the one that meets the accuracy targets (see
-    :mod:`skfem_beam.spaces.lagrange` and DESIGN "Bar accuracy").
+    :mod:`skfem_beam.spaces.lagrange` and docs/design.md §6, "Bar accuracy").
     """
     a: float = 1.0           # Young's modulus (Pa)
     b: float = 0.0           # Kelvin–Voigt viscosity (Pa·s)
@@ -197,7 +197,7 @@ def steps_to(T: float, dt: float) -> int:
 
 def bar_run(bar: Bar, dt: float, T: float, beta: float = 0.25, method: str = "contact",
             solver: str = "auto", frames: int = 200, all_states_limit: int = 4_000_000):
-    """The bar's :class:`~skfem_beam.integrators.Run` (not yet driven), to T + Δt.
+    """The bar's :class:`~skfem_beam.scheme.Run` (not yet driven), to T + Δt.
 
     rigid + contact: the Signorini condition u(0) ≥ 0 (one constrained value, so the
     step is the projection of Lemma 4.1); rigid + penalty: a one-sided spring of
@@ -317,7 +317,7 @@ class BarSeries:
 def run_bar(bar: Bar, dt: float, T: float, beta: float = 0.25, method: str = "contact",
             solver: str = "auto", all_states_limit: int = 4_000_000) -> BarRun:
     """Integrate the bar with the shared scheme (:func:`bar_run`, driven to its end)."""
-    from .integrators import drive
+    from .scheme import drive
     run = bar_run(bar, dt, T, beta, method, solver, all_states_limit=all_states_limit)
     drive(run)
     series = BarSeries(bar, run, T, method)

@@ -147,7 +147,7 @@ def run_value(settings: dict, value: float) -> dict:
     The statistics cover the sampled window (after the transient) only; the transient
     alone is run a second time to subtract its counts (it is a prefix of the full run).
     """
-    from .integrators import solve
+    from .scheme import solve
     from .semidiscrete import beam_system
     t_start, cpu_start = time.perf_counter(), time.process_time()
     dt, spp, ntr, omega = section_plan(settings, value)

@@ -10,7 +10,7 @@ def pipe():
     """The first paper's scene as a problem object (J=19 Hermite)."""
     return scenes.point_stops()
 
-# summary.json keys every case writes (the output contract of DESIGN.md)
+# summary.json keys every case writes (the output contract, docs/design.md §5)
 SUMMARY_KEYS = {"case", "J", "dt", "T", "beta", "element", "solver", "steps", "wall_time_s",
                 "max_penetration", "max_nodal_violation", "energy_final", "impacts"}
 

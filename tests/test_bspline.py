@@ -134,7 +134,7 @@ def test_interpolation_error_is_fourth_order():
 # --- 3. cantilever eigenfrequencies ---------------------------------------------------
 
 def omegas(space, count):
-    """ω_n of (k²S, M).  eigh(M, S) → 1/μ keeps the lowest modes (DESIGN); then a
+    """ω_n of (k²S, M).  eigh(M, S) → 1/μ keeps the lowest modes (docs/design.md §6); then a
     Rayleigh quotient with (v'', v'') summed as squares at Gauss points removes the
     round-off of the assembled S·v (~eps·J⁴: a fourth difference of smooth data)."""
     mu, V = sla.eigh(space.M.toarray(), space.S.toarray())

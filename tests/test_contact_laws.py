@@ -10,13 +10,13 @@ from skfem_beam import InputError, beam_system, scenes, solve
 from skfem_beam.contact import LAWS, ContactLaw, resolve
 from skfem_beam.contact.penalty import Penalty
 
-DESIGN = Path(__file__).parents[1] / "docs" / "design.md"
+DESIGN_DOC = Path(__file__).parents[1] / "docs" / "design.md"
 
 
 def test_the_documented_law_runs_and_agrees_with_projection(tmp_path):
     """The example of docs/design.md, run as written: the pipe hits its upper stop first
     (t ≈ 0.088 s); the lower-only law is the projection, to the last bit, until then."""
-    code = re.search(r"## Adding a contact law.*?```python\n(.*?)```", DESIGN.read_text(),
+    code = re.search(r"## Adding a contact law.*?```python\n(.*?)```", DESIGN_DOC.read_text(),
                      re.S).group(1)
     script = tmp_path / "law_example.py"
     script.write_text(code)

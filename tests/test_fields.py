@@ -13,7 +13,7 @@ import pytest
 from skfem_beam import beam_system, scenes, solve
 from skfem_beam.bar import Bar, bar_system
 from skfem_beam.errors import InputError
-from skfem_beam.fields import FieldWriter, lifting_dd, sample_line, write_fields
+from skfem_beam.output.fields import FieldWriter, lifting_dd, sample_line, write_fields
 from skfem_beam.meshes import PAPER_MESHES, load_mesh, write_mesh
 from skfem_beam.problem import Beam, BeamProblem, Load, Obstacles, lifting
 
@@ -279,7 +279,7 @@ def _colour_masks(img):
 
 def test_render_png_shows_beam_between_stops(run, tmp_path):
     pytest.importorskip("pyvista")
-    from skfem_beam.render import render_beam
+    from skfem_beam.output.render import render_beam
     k = _contact_frame(run)
     path = tmp_path / "beam.png"
     img = render_beam(path, run, times=[run.frames_t[k]], case="point_stops")
@@ -305,7 +305,7 @@ def test_render_png_shows_beam_between_stops(run, tmp_path):
 
 def test_animation_gif(run, tmp_path):
     pytest.importorskip("pyvista")
-    from skfem_beam.render import animate
+    from skfem_beam.output.render import animate
     path = animate(tmp_path / "run.gif", run, every=10, window_size=(480, 200))
     import imageio.v3 as iio
     frames = iio.imread(path)

@@ -56,7 +56,7 @@ def test_cantilever_frequencies_converge_at_rate_4():
     errors = []
     for J in Js:
         sp = HermiteSpace(np.linspace(0, L, J + 1))
-        # eigh(M, S) gives 1/ω² accurately for the lowest modes (DESIGN: not eigh(S, M))
+        # eigh(M, S) gives 1/ω² accurately for the lowest modes (docs/design.md §6: not eigh(S, M))
         mu = scipy.linalg.eigh(sp.M.toarray(), k2 * sp.S.toarray(), eigvals_only=True)
         omega = np.sort(1 / np.sqrt(mu[::-1][:4]))
         errors.append(np.abs(omega - exact) / exact)

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..integrators import solve
+from ..scheme import solve
 from ..semidiscrete import beam_system
 from ..scenes import PIPE_RHO_S, point_stops
 from ..stability import kappa_h

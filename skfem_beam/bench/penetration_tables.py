@@ -19,8 +19,8 @@ from pathlib import Path
 import numpy as np
 
 from .. import scenes
-from ..integrators import solve
-from ..plotting import penetration_chart
+from ..scheme import solve
+from ..output.charts import penetration_chart
 from ..problem import Obstacles
 from ..semidiscrete import beam_system
 

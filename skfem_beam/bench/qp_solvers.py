@@ -37,7 +37,7 @@ def scene(J: int, element: str, obstacles: bool = True):
 
 
 def best_run(system, solver: str, dt: float, T: float, repeat: int):
-    from ..integrators import solve
+    from ..scheme import solve
     frames = int(round(T / dt))              # every step: for the comparison and replay
     runs = [solve(system, dt=dt, T=T, beta=0.5, solver=solver, frames=frames,
                   progress=False) for _ in range(repeat)]

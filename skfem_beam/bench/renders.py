@@ -8,7 +8,7 @@
   forced by sin 10t, with the flat obstacles ±0.01 m on [L/2, L], displacement ×50.
 
 ``--gif`` also writes an animation of each run.  Rendering is off-screen (EGL, no
-display needed; see :mod:`skfem_beam.render`).
+display needed; see :mod:`skfem_beam.output.render`).
 """
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ import argparse
 from pathlib import Path
 
 from .. import beam_system, scenes, solve
-from ..render import animate, render_beam
+from ..output.render import animate, render_beam
 
 
 def point_stops_run():

@@ -46,7 +46,7 @@ def build(scene: str, p: dict):
 
 def child(scene: str, p: dict, solver: str, repeat: int) -> dict:
     """Runs in the child process: the timings of one configuration."""
-    from ..integrators import solve
+    from ..scheme import solve
     from ..semidiscrete import beam_system
     from ._floor import banded_solve_floor
     system = build(scene, p)

@@ -23,7 +23,7 @@ import numpy as np
 
 from .. import scenes
 from ..bar import errors, run_bar
-from ..integrators import solve
+from ..scheme import solve
 from ..reference import BarExact
 from ..semidiscrete import beam_system
 

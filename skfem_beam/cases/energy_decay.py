@@ -11,9 +11,9 @@ from __future__ import annotations
 import numpy as np
 
 from .. import cli, scenes
-from ..integrators import solve
-from ..io import write_timeseries
-from ..plotting import trajectory_chart
+from ..scheme import solve
+from ..output.folder import write_timeseries
+from ..output.charts import trajectory_chart
 from ..problem import check_beta
 from ..semidiscrete import beam_system
 from . import pipe_parser

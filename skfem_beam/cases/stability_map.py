@@ -19,7 +19,7 @@ import numpy as np
 
 from .. import cli, scenes
 from ..errors import InputError
-from ..integrators import solve
+from ..scheme import solve
 from ..output.charts import figure
 from ..output.folder import Folder, check_output_dir
 from ..problem import check_beta, check_positive

@@ -2,7 +2,7 @@
 
 The step QP  min ½xᵀAx − Fᵀx,  lo ≤ Cx ≤ hi  is set up ONCE per run (A, C, lo, hi are
 constant); each step only updates q = −F = −A x_free and warm-starts from the last
-solution.  What makes OSQP's answer trustworthy here (see DESIGN.md, "Known traps"):
+solution.  What makes OSQP's answer trustworthy here (see docs/design.md, "Known traps"):
 
 - Scaling.  OSQP's tolerances are absolute.  Unknowns are measured in units of
   s = the largest finite |bound| (x = s·x̂) and the objective is divided by s²·ā

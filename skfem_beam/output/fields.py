@@ -2,7 +2,7 @@
 
 One frame is written per :meth:`FieldWriter.write` call (coefficient vectors u, v and
 the nodal contact forces λ), so a run can stream its output; :func:`write_fields`
-writes all frames of a :class:`~skfem_beam.integrators.Result`.
+writes all frames of a :class:`~skfem_beam.scheme.Result`.
 
 The fields live as point data on a line mesh along the x axis (points padded to 3-D,
 as VTK needs).  Its points are ``samples_per_element`` sub-points of every element
@@ -143,7 +143,7 @@ def sample_line(system, samples_per_element: int = 8) -> LineSamples:
 
 
 class _XdmfSeries(meshio.xdmf.TimeSeriesWriter):
-    """meshio's XDMF time series writer with the traps of DESIGN.md worked around.
+    """meshio's XDMF time series writer with the traps of docs/design.md §6 worked around.
 
     - meshio opens the ``.h5`` in the *working directory* (``filename.stem + ".h5"``);
       here it is opened beside the ``.xdmf`` (the XML refers to it by base name, so the

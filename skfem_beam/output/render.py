@@ -4,7 +4,7 @@
 - :func:`animate`: a GIF (or MP4 with ``imageio-ffmpeg``) of the saved frames.
 
 The beam is drawn through the same sub-points as the field files
-(:func:`skfem_beam.fields.sample_line`), so a Hermite or B-spline beam is the cubic,
+(:func:`skfem_beam.output.fields.sample_line`), so a Hermite or B-spline beam is the cubic,
 not its chords; the displacement is the physical ũ (support motion included).
 Obstacles are drawn as walls whose face sits one tube radius beyond g (so the tube
 touches the wall when the centre line touches g); point stops as blocks.

@@ -1,4 +1,4 @@
-"""Running a command's :class:`~skfem_beam.integrators.Run` so that a long run loses nothing.
+"""Running a command's :class:`~skfem_beam.scheme.Run` so that a long run loses nothing.
 
 One pipeline for the beam scenes and the bar.  After every input has been checked the
 output :class:`~.folder.Folder` is made (summary "running"); ``timeseries.csv`` grows by
@@ -26,7 +26,7 @@ from typing import Callable
 import numpy as np
 
 from ..errors import InputError, SolverError
-from ..integrators import Run, drive
+from ..scheme import Run, drive
 from .fields import FieldWriter, check_format
 from .folder import Folder, check_output_dir, csv_rows, report
 

@@ -13,7 +13,7 @@ Every space offers the same small interface, used by :mod:`skfem_beam.semidiscre
   every element, as sparse matrices (penetration between nodes, output sub-points);
 - ``load_vector(b)``: (b, φ_i) for a profile b(x);
 - ``interpolate(u, du)``: coefficients of a function given by u(x) (and u'(x));
-- ``project(v)``: the L² projection (used for the initial velocity, see DESIGN).
+- ``project(v)``: the L² projection (used for the initial velocity, see docs/design.md §2).
 """
 from __future__ import annotations
 

@@ -5,7 +5,7 @@ constraint, not a boundary condition), so the coefficients *are* the nodal value
 ``C`` is the identity.  The interface follows :class:`~skfem_beam.spaces.hermite.HermiteSpace`
 where it applies; ``S`` here is the stiffness (u', v') instead of the bending form.
 
-Mass matrices (the choice sets the dispersion error of a wave, DESIGN "Bar accuracy"):
+Mass matrices (the choice sets the dispersion error of a wave, docs/design.md §6, "Bar accuracy"):
 
 - ``consistent``: (u, v) exactly; waves travel too slowly on the mesh;
 - ``lumped``: row sums on the diagonal; waves travel too fast;

@@ -14,9 +14,9 @@ from ..contact.registry import Auto
 from ..errors import InputError, SolverError
 from ..linalg import band_solve, rows_matvec
 from ..stability import kappa_h, linear_limit
-from .kernels import (FAILED, UNSTABLE, Ops, Series, State, call_explicit, call_law,
-                      csr_product,
-                      energy_beta, free_step, record, run_steps)
+from .kernels import (FAILED, UNSTABLE, Ops, PythonLaw, Series, State, call_explicit,
+                      call_law, csr_product,
+                      energy_beta, record, run_steps, run_steps_python)
 from .operators import csr_arrays, step_operators
 from .stepping import Result, Stepping
 
@@ -90,8 +90,11 @@ class Run:
         self.wall = 0.0
         self.status, self.message = "running", ""
         # load the compiled loop now, outside the timed loop
-        run_steps(*self._kernels, self.ops, self.st, self.out, 1, 1,
-                  np.zeros((0, self.loads.shape[1])), 0.0, True)
+        no_loads = np.zeros((0, self.loads.shape[1]))
+        if self.pysolver is None:
+            run_steps(*self._kernels, self.ops, self.st, self.out, 1, 1, no_loads, 0.0)
+        else:
+            run_steps_python(self.ops, self.st, self.out, 1, 1, no_loads, 0.0)
 
     @property
     def _kernels(self):
@@ -193,14 +196,21 @@ class Run:
             raise InputError(f"the load is too large for floating point: its work by step {n1} "
                              f"is {self.work:g}")
         if self.pysolver is None:
-            code = run_steps(*self._kernels, self.ops, self.st, self.out, n0, n1, G, Ebound, True)
+            code = run_steps(*self._kernels, self.ops, self.st, self.out, n0, n1, G, Ebound)
         else:
-            code = self._python_steps(n0, n1, G, Ebound)
+            PythonLaw.solver, PythonLaw.error = self.pysolver, None
+            try:
+                code = run_steps_python(self.ops, self.st, self.out, n0, n1, G, Ebound)
+            finally:
+                PythonLaw.solver = None
         self.wall += time.perf_counter() - t0
         k = int(self.st.counters[3])
         if code == FAILED:
+            why = f": {PythonLaw.error}" if PythonLaw.error is not None else ""
+            if PythonLaw.error is not None and not isinstance(PythonLaw.error, SolverError):
+                raise PythonLaw.error     # a bug in a user's law: its own traceback
             raise SolverError(f"the {self.solver} contact solver failed at step {k} "
-                              f"(t={k * self.dt:.6g} s)")
+                              f"(t={k * self.dt:.6g} s){why}")
         if code == UNSTABLE:
             limit = linear_limit(kappa_h(self.system), self.beta)
             self.status = "unstable"
@@ -213,27 +223,6 @@ class Run:
         self.n = n1
         if n1 == self.n_steps:
             self.status, self.message = "success", "the run reached T"
-
-    def _python_steps(self, n0, n1, G, Ebound) -> int:
-        """Steps whose law is solved in Python: the compiled free step, the law's μ, then
-        the compiled loop for the rest of the step (``free`` False)."""
-        st = self.st
-        for step in range(n0, n1):
-            Gn = G[step - n0:step - n0 + 1]
-            free_step(self.ops, st, Gn[0])
-            try:
-                mu, its = self.pysolver.solve(st.x, st.yf)
-            except SolverError as e:
-                raise SolverError(f"step {step + 1} (t={(step + 1) * self.dt:.6g} s): {e}") \
-                    from None
-            st.counters[2] += its
-            st.mu[:] = mu
-            np.not_equal(mu, 0.0, out=st.active)
-            code = run_steps(*self._kernels, self.ops, st, self.out, step, step + 1, Gn,
-                             Ebound, False)
-            if code:
-                return code
-        return 0
 
     # the saved series, by the names the output pipeline reads
     obs = property(lambda self: self.out.obs)

@@ -39,24 +39,17 @@ scheme conserves a weighted one.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sp
 
 from .errors import InputError
-from .problem import check_finite, check_positive
+from .checks import check_choice, check_count, check_finite, check_nonnegative, check_positive
 from .semidiscrete import SceneView, SemiDiscrete
 from .spaces.lagrange import MASSES, LagrangeSpace
 
 OBSTACLES = ("rigid", "elastic")
-
-
-def _check_nonnegative(name: str, value: float) -> float:
-    value = check_finite(name, value)
-    if value < 0:
-        raise InputError(f"{name}={value:g} must be ≥ 0")
-    return value
 
 
 @dataclass(frozen=True)
@@ -83,17 +76,13 @@ class Bar:
     def __post_init__(self):
         for name in ("a", "rho", "L"):
             object.__setattr__(self, name, check_positive(name, getattr(self, name)))
-        object.__setattr__(self, "b", _check_nonnegative("b", self.b))
+        object.__setattr__(self, "b", check_nonnegative("b", self.b))
         for name in ("f", "v0", "u0"):
             object.__setattr__(self, name, check_finite(name, getattr(self, name)))
-        if isinstance(self.N, bool) or not isinstance(self.N, (int, np.integer)) or self.N < 1:
-            raise InputError(f"N={self.N!r} must be a whole number ≥ 1")
-        object.__setattr__(self, "N", int(self.N))
-        if self.obstacle not in OBSTACLES:
-            raise InputError(f"obstacle={self.obstacle!r} is not one of: {', '.join(OBSTACLES)}")
-        if self.mass not in MASSES:
-            raise InputError(f"mass={self.mass!r} is not one of: {', '.join(MASSES)}")
-        k = _check_nonnegative("k", self.k)
+        object.__setattr__(self, "N", check_count("N", self.N))
+        check_choice("obstacle", self.obstacle, OBSTACLES)
+        check_choice("mass", self.mass, MASSES)
+        k = check_nonnegative("k", self.k)
         if k == 0 and self.obstacle == "elastic":
             raise InputError("k=0 must be > 0 for an elastic obstacle")
         object.__setattr__(self, "k", k)
@@ -191,8 +180,8 @@ class BarRun:
 
 
 def steps_to(T: float, dt: float) -> int:
-    """N = ⌈T/Δt⌉: the steps of a bar run to T (checked)."""
-    return int(np.ceil(check_positive("T", T) / check_positive("dt", dt) - 1e-9))
+    """⌈T/Δt⌉: the steps of a bar run to T (T and Δt checked by the run's Stepping)."""
+    return int(np.ceil(T / dt - 1e-9))
 
 
 def bar_run(bar: Bar, dt: float, T: float, beta: float = 0.25, method: str = "contact",
@@ -207,17 +196,16 @@ def bar_run(bar: Bar, dt: float, T: float, beta: float = 0.25, method: str = "co
     tₙ comes from step n + 1) and keeps every state as a frame when there are at most
     ``all_states_limit`` values (the energy split needs them); else ``frames`` frames.
     """
-    if method not in METHODS:
-        raise InputError(f"method={method!r} is not one of: {', '.join(METHODS)}")
+    check_choice("method", method, METHODS)
     from .contact import resolve
     from .scheme import Run, Stepping
     system = bar_system(bar)
     if _spring(bar, method) and bar.k == 0:
         raise InputError("k=0 must be > 0 for a penalty spring")
-    n_steps = steps_to(T, dt)
+    to_T = Stepping(dt, T, beta)                  # the checks of Δt, T and β
+    n_steps = to_T.steps
     every_state = (n_steps + 2) * system.n <= all_states_limit
-    stepping = Stepping(dt, n_steps * dt + dt, beta,
-                        frames=n_steps + 1 if every_state else frames)
+    stepping = replace(to_T, T=n_steps * dt + dt, frames=n_steps + 1 if every_state else frames)
     return Run(system, stepping, resolve(solver, bar.k if _spring(bar, method) else None))
 
 
@@ -233,7 +221,6 @@ class BarSeries:
 
     def __init__(self, bar: Bar, run, T: float, method: str = "contact", every: int = 1,
                  exact=None):
-        from .scheme.stepping import check_count
         self.bar, self.method, self.exact = bar, method, exact
         self.every = check_count("save_every", every)
         self.n_steps = steps_to(T, run.dt)

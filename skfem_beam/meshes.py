@@ -17,7 +17,7 @@ import meshio
 import numpy as np
 
 from .errors import InputError
-from .problem import check_positive
+from .checks import check_positive
 
 # name -> (L, J): uniform meshes of the papers (J even on [0, 10]: x = 5 is a node)
 PAPER_MESHES = {

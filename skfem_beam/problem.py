@@ -1,46 +1,22 @@
 """Plain, validated data objects describing a scene.
 
-Every check of user input lives here, so the Python API and the command line refuse
-bad values the same way: an :class:`~skfem_beam.errors.InputError` whose message names
-the value and what is allowed.
+Each object checks its inputs where it is built (with :mod:`skfem_beam.checks`), so the
+Python API and the command line refuse bad values the same way: an
+:class:`~skfem_beam.errors.InputError` whose message names the value and what is allowed.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
 
+from .checks import check_beta, check_choice, check_finite, check_positive  # noqa: F401
 from .errors import InputError
 from .spaces.ends import DEFAULT_ENDS, END_CONDITIONS, check_ends, fixed_dofs, support_nodes
 
 Profile = Callable[[np.ndarray], np.ndarray]   # g(x), u0(x), ...: vectorised in x
 TimeFunction = Callable[[np.ndarray], np.ndarray]  # a(t): vectorised in t
-
-
-def check_finite(name: str, value: float) -> float:
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        raise InputError(f"{name}={value!r} is not a number") from None
-    if not math.isfinite(value):
-        raise InputError(f"{name}={value} must be a finite number")
-    return value
-
-
-def check_positive(name: str, value: float) -> float:
-    value = check_finite(name, value)
-    if value <= 0:
-        raise InputError(f"{name}={value:g} must be > 0")
-    return value
-
-
-def check_beta(beta: float) -> float:
-    beta = check_finite("beta", beta)
-    if not 0.0 <= beta <= 0.5:
-        raise InputError(f"beta={beta:g} must lie in [0, 1/2]")
-    return beta
 
 
 def _constant(c: float) -> Profile:
@@ -197,8 +173,7 @@ class BeamProblem:
             x[0], x[-1] = 0.0, self.beam.L
             object.__setattr__(self, "nodes", x)
             object.__setattr__(self, "J", x.size - 1)
-        if self.element not in ("hermite", "bspline"):
-            raise InputError(f"element={self.element!r} is not one of: hermite, bspline")
+        check_choice("element", self.element, ("hermite", "bspline"))
         for b in self.obstacles.breakpoints:
             if not 0.0 <= b <= self.beam.L:
                 raise InputError(f"obstacle break point x={b:g} lies outside [0, L={self.beam.L:g}]")

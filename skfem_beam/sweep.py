@@ -43,7 +43,7 @@ import numpy as np
 from . import cli, scenes
 from .errors import InputError, SolverError
 from .output.folder import Folder, atomic_write, check_output_dir, stamp
-from .problem import check_beta, check_positive
+from .checks import check_beta, check_positive
 
 # scene name -> (problem factory, parameters that may be swept or set)
 SCENES = {

@@ -37,10 +37,10 @@ def main(argv=None) -> int:
     rows = []
     print(f"{'dt':>8s} {'reading':28s} {'max|u(L)|-g (m)':>16s} {'impacts':>8s} {'loop s':>7s}")
     for dt in dts:
-        for reading, kappa in (("1e8 in the normalised eq.", 1e8),
+        for reading, stiffness in (("1e8 in the normalised eq.", 1e8),
                                ("1e8 N/m / rhoS (physical)", 1e8 / PIPE_RHO_S),
                                ("contact-implicit", None)):
-            r = solve(system, dt, T, 0.25, stiffness=kappa, save_every=max(1, int(5e-6 / dt)),
+            r = solve(system, dt, T, 0.25, stiffness=stiffness, save_every=max(1, int(5e-6 / dt)),
                       frames=2, progress=False)
             pen = float(np.abs(r.observed["tip_displacement"]).max() - 0.1)
             rows.append({"dt": dt, "reading": reading, "penetration_m": pen,

@@ -10,7 +10,7 @@ from ..contact import resolve
 from ..output.charts import energy_chart, shape_chart, trajectory_chart
 from ..output.series import execute, prepare
 from ..scheme import Run, Stepping
-from ..problem import check_beta, check_positive
+from ..checks import check_positive
 from ..semidiscrete import beam_system
 from ..stability import kappa_h, linear_limit
 
@@ -22,24 +22,21 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
     the timeseries columns, from memory).
     """
     cli.check_method(args)
-    check_beta(args.beta)
-    check_positive("dt", args.dt)
-    check_positive("T", args.T)
+    stepping = Stepping(args.dt, args.T, args.beta, args.save_every, args.frames)
     out = prepare(args)                            # fail before the run, not after it
     system = beam_system(problem)
-    kappa = kappa_h(system)
-    limit = linear_limit(kappa, args.beta)
+    kh = kappa_h(system)
+    limit = linear_limit(kh, args.beta)
     if args.dt > limit:
         cli.warn(f"dt={args.dt:g} s is above the linear stability limit "
-                 f"2/√(κ_h(1−4β)) = {limit:.4g} s for beta={args.beta:g} (κ_h={kappa:.4g} s⁻²); "
+                 f"2/√(κ_h(1−4β)) = {limit:.4g} s for beta={args.beta:g} (κ_h={kh:.4g} s⁻²); "
                  "the run will likely go unstable")
     stiffness = None
     rho_S = problem.beam.rho_S
     if args.method == "penalty":
         # physical N/m → the mass-normalised equation u_tt + k²u'''' = f needs N/m per kg/m
         stiffness = check_positive("stiffness", args.stiffness) / (rho_S or 1.0)
-    run = Run(system, Stepping(args.dt, args.T, args.beta, args.save_every, args.frames),
-              resolve(args.solver, stiffness))
+    run = Run(system, stepping, resolve(args.solver, stiffness))
 
     def columns(run, k0, k1):
         force = run.lam[k0:k1].sum(axis=1)   # net force on the beam, m²/s² = N/(kg/m)
@@ -66,7 +63,7 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
     summary = {
         "case": case, "J": problem.J, "dt": run.dt, "T": run.n_steps * run.dt, "beta": run.beta,
         "element": problem.element, "method": args.method,
-        "kappa_h": kappa, "linear_stability_limit_dt": limit,
+        "kappa_h": kh, "linear_stability_limit_dt": limit,
         "units": {"displacement": "m", "energy": "½E_β, m³/s² (per unit mass per length)",
                   "contact_force": "m²/s² (N per kg/m)",
                   "contact_force_N": "N (contact_force × rho_S)"},

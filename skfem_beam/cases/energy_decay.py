@@ -14,7 +14,7 @@ from .. import cli, scenes
 from ..scheme import solve
 from ..output.folder import write_timeseries
 from ..output.charts import trajectory_chart
-from ..problem import check_beta
+from ..checks import check_beta
 from ..semidiscrete import beam_system
 from . import pipe_parser
 from ._beam import run_beam_case

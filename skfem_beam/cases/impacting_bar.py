@@ -27,7 +27,7 @@ from .. import cli
 from ..bar import Bar, BarSeries, bar_run, contact_periods, energy_report, errors, spring_step_ratio
 from ..output.charts import compare_chart
 from ..output.series import Series, execute, prepare
-from ..problem import check_beta, check_positive
+from ..checks import check_positive
 from ..reference import BarExact
 
 CASE = "impacting_bar"
@@ -51,8 +51,7 @@ def main(argv=None) -> int:
     args = cli.parse(p, argv)
 
     cli.check_method(args)
-    check_beta(args.beta)
-    dt, T = check_positive("dt", args.dt), check_positive("T", args.T)
+    dt, T = args.dt, args.T          # checked by the run's Stepping (bar_run)
     bar = Bar(a=args.a, b=args.b, rho=args.rho, L=args.L, f=args.f, v0=args.v0, u0=args.u0,
               obstacle=args.obstacle, k=args.k, N=args.N, mass=args.mass)
     penalty = args.method == "penalty" and bar.obstacle == "rigid"

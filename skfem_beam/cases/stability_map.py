@@ -22,7 +22,7 @@ from ..errors import InputError
 from ..scheme import solve
 from ..output.charts import figure
 from ..output.folder import Folder, check_output_dir
-from ..problem import check_beta, check_positive
+from ..checks import check_beta, check_positive
 from ..semidiscrete import beam_system
 from ..stability import PAPER_KAPPA_BOUNDS, kappa_h, linear_limit, prop31_limit, stability_table
 

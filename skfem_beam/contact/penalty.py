@@ -13,13 +13,14 @@ The start step weights the spring at u⁰ by ½(1−2β) instead (see scheme.run
 import numpy as np
 from numba import njit
 
+from ..checks import check_positive
 from .base import ContactLaw, compiled_explicit, compiled_law
 
 
 @njit(cache=True)
-def spring(y, lo, hi, kappa):
+def spring(y, lo, hi, stiffness):
     """The one-sided springs' force r(y) = −κ[(y − hi)⁺ − (lo − y)⁺] on one value."""
-    return -kappa * (max(y - hi, 0.0) - max(lo - y, 0.0))
+    return -stiffness * (max(y - hi, 0.0) - max(lo - y, 0.0))
 
 
 @njit(cache=True)
@@ -61,10 +62,10 @@ def compliance_solve(D, yf, lo, hi, c, state, mu):
 @compiled_explicit
 def penalty_explicit(y_cur, y_prev, lo, hi, params, r):
     """r = w_cur r(yⁿ) + w_prev r(yⁿ⁻¹): (1−2β) and β in a step, ½(1−2β) and 0 at the start."""
-    kappa, w_cur, w_prev = params[0], params[2], params[3]
+    stiffness, w_cur, w_prev = params[0], params[2], params[3]
     for j in range(r.size):
-        r[j] = w_cur * spring(y_cur[j], lo[j], hi[j], kappa) \
-            + w_prev * spring(y_prev[j], lo[j], hi[j], kappa)
+        r[j] = w_cur * spring(y_cur[j], lo[j], hi[j], stiffness) \
+            + w_prev * spring(y_prev[j], lo[j], hi[j], stiffness)
     return 0
 
 
@@ -89,7 +90,6 @@ class Penalty(ContactLaw):
     explicit = penalty_explicit
 
     def __init__(self, stiffness: float):
-        from ..problem import check_positive
         self.stiffness = check_positive("stiffness", stiffness)
 
     def setup(self, step, first=False):

@@ -7,17 +7,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
-from ..problem import check_beta, check_positive
+from ..checks import check_beta, check_choice, check_count, check_positive
 
 MAX_STEPS = 10**10        # beyond this a run is a hang, not a computation
 LOAD_WINDOWS = ("forward", "centered")
-
-
-def check_count(name: str, value, least: int = 1) -> int:
-    """A whole number ≥ ``least`` (bools refused)."""
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < least:
-        raise InputError(f"{name}={value!r} must be a whole number ≥ {least}")
-    return int(value)
 
 
 @dataclass(frozen=True)
@@ -47,9 +40,7 @@ class Stepping:
         object.__setattr__(self, "frames", check_count("frames", self.frames))
         object.__setattr__(self, "growth_limit", check_positive("growth_limit",
                                                                  self.growth_limit))
-        if self.load_window not in LOAD_WINDOWS:
-            raise InputError(f"load_window={self.load_window!r} is not one of: "
-                             f"{', '.join(LOAD_WINDOWS)}")
+        check_choice("load_window", self.load_window, LOAD_WINDOWS)
         if self.steps < 2:
             raise InputError(f"dt={dt:g} must be at most T/2={T / 2:g}")
         if self.steps > MAX_STEPS:

@@ -1,0 +1,53 @@
+"""The input checks every object uses where it is built: one clear InputError naming
+the value and what is allowed.  The Python API and the command line share them."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .errors import InputError
+
+
+def check_finite(name: str, value) -> float:
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{name}={value!r} is not a number") from None
+    if not math.isfinite(value):
+        raise InputError(f"{name}={value} must be a finite number")
+    return value
+
+
+def check_positive(name: str, value) -> float:
+    value = check_finite(name, value)
+    if value <= 0:
+        raise InputError(f"{name}={value:g} must be > 0")
+    return value
+
+
+def check_nonnegative(name: str, value) -> float:
+    value = check_finite(name, value)
+    if value < 0:
+        raise InputError(f"{name}={value:g} must be ≥ 0")
+    return value
+
+
+def check_beta(beta) -> float:
+    beta = check_finite("beta", beta)
+    if not 0.0 <= beta <= 0.5:
+        raise InputError(f"beta={beta:g} must lie in [0, 1/2]")
+    return beta
+
+
+def check_count(name: str, value, least: int = 1) -> int:
+    """A whole number ≥ ``least`` (bools refused)."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < least:
+        raise InputError(f"{name}={value!r} must be a whole number ≥ {least}")
+    return int(value)
+
+
+def check_choice(name: str, value, allowed) -> str:
+    if value not in allowed:
+        raise InputError(f"{name}={value!r} is not one of: {', '.join(allowed)}")
+    return value

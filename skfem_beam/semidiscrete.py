@@ -56,6 +56,12 @@ class SemiDiscrete:
     sample_hi: np.ndarray | None = None
     meta: dict = field(default_factory=dict)
     view: SceneView | None = None            # what the output needs (see SceneView)
+    # moving bounds (obstacles fixed to the ground or carried by a moving support, in the
+    # lifted variable): at time t the bounds are lo + bound_shift·φ(t), hi + bound_shift·φ(t)
+    # (and sample_lo/hi + sample_shift·φ(t)); φ = bound_motion, vectorised in t
+    bound_motion: Callable | None = None
+    bound_shift: np.ndarray | None = None    # (m,)
+    sample_shift: np.ndarray | None = None   # (samples,)
 
     @property
     def n(self) -> int:

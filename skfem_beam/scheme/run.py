@@ -2,7 +2,10 @@
 from __future__ import annotations
 
 import math
+import sys
+import threading
 import time
+from contextlib import contextmanager
 
 import numpy as np
 import scipy.sparse
@@ -24,6 +27,28 @@ _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(4)
 MAX_SAVED = 2 * 10**7     # saved rows × constrained values kept in memory (~1 GB)
 
 
+_NOTICE = "compiling numerical kernels (first run only) …"
+_noticed = []
+
+
+@contextmanager
+def compile_notice(after: float = 1.0):
+    """One line on stderr, once per process, when building a run takes longer than
+    ``after`` seconds: the first run of a fresh install compiles the numba kernels (tens of
+    seconds); later runs load them from numba's cache in a fraction of a second."""
+    def notice():
+        if not _noticed:
+            _noticed.append(True)
+            print(_NOTICE, file=sys.stderr, flush=True)
+    timer = threading.Timer(after, notice)
+    timer.daemon = True
+    timer.start()
+    try:
+        yield
+    finally:
+        timer.cancel()
+
+
 class Run:
     """The scheme's state and saved series for ``system`` on the grid ``stepping``,
     with the contact law ``law`` (a name of ``contact.LAWS``, "auto", or a law object).
@@ -35,6 +60,10 @@ class Run:
     """
 
     def __init__(self, system, stepping: Stepping, law: str | ContactLaw = "auto"):
+        with compile_notice():
+            self._build(system, stepping, law)
+
+    def _build(self, system, stepping, law) -> None:
         s, m = stepping, system.C.shape[0]
         n_steps = s.steps
         if n_steps // s.save_every * max(1, m) > MAX_SAVED:
@@ -105,7 +134,8 @@ class Run:
     @property
     def _kernels(self):
         """The compiled law and its explicit part (no-ops for a law solved in Python)."""
-        return (self.law.kernel or NoContact.kernel, self.law.explicit or no_explicit)
+        return ((self.law.kernel or NoContact.kernel).cfunc,
+                (self.law.explicit or no_explicit).cfunc)
 
     def _start(self, Orows, first_params) -> None:
         """u¹: one step of the scheme itself, from u⁰ and the fictitious u⁻¹ = u¹ − 2Δt v⁰
@@ -132,7 +162,7 @@ class Run:
         move_bounds(self.ops, st, self.motion(np.array([dt]))[0])   # the bounds at t₁
         kernel, explicit = self._kernels
         first = self.ops._replace(params=first_params)
-        if explicit is not no_explicit:   # its force at u⁰ as load, implicit at u¹ (as K)
+        if self.law.explicit is not None:   # its force at u⁰ as load, implicit at u¹ (as K)
             call_explicit(explicit, first, st, st.y_prev, st.y_prev, st.r_e)
             F0 += dt**2 * (op.C.T @ st.r_e)
             st.r_e[:] = 0.0

@@ -9,6 +9,7 @@ import pytest
 from skfem_beam import InputError, beam_system, scenes, solve
 from skfem_beam.contact import LAWS, ContactLaw, resolve
 from skfem_beam.contact.penalty import Penalty
+from skfem_beam.contact.restitution import Restitution
 
 DESIGN_DOC = Path(__file__).parents[1] / "docs" / "design.md"
 
@@ -30,7 +31,7 @@ def test_the_documented_law_runs_and_agrees_with_projection(tmp_path):
 
 
 def test_registry_names_and_auto():
-    assert set(LAWS) == {"projection", "active-set", "osqp", "daqp", "penalty"}
+    assert set(LAWS) == {"projection", "active-set", "osqp", "daqp", "penalty", "restitution"}
     for name in ("projection", "active-set", "osqp", "daqp"):
         assert resolve(name).name == name
     assert isinstance(resolve("auto", stiffness=1e3), Penalty)
@@ -87,3 +88,38 @@ def test_a_python_law_gives_the_compiled_run_and_solves_the_start_step():
     assert np.abs(a.frames_u - b.frames_u).max() <= 1e-10 * scale   # not chaotic: ~1e-10
     assert a.contact_force[1:].any()
     assert np.abs(a.contact_force - b.contact_force).max() <= 1e-9 * np.abs(a.contact_force).max()
+
+
+def test_restitution_zero_is_the_scheme_bit_for_bit():
+    system = beam_system(scenes.flat_obstacles())
+    a = solve(system, 1e-3, 0.5)
+    b = solve(system, 1e-3, 0.5, solver=Restitution(0.0))
+    assert np.array_equal(a.frames_u, b.frames_u) and a.impacts == b.impacts
+
+
+@pytest.mark.parametrize("e", [0.0, 0.3, 0.7, 1.0])
+def test_restitution_of_a_rigid_mass_is_e(e):
+    """One mass, no spring, released towards a wall at speed 1: after the impact it
+    leaves at speed e (Paoli–Schatzman on a rigid body), and the energy keeps e²."""
+    import scipy.sparse as sp
+    from skfem_beam import SemiDiscrete
+    one = sp.csr_matrix(np.ones((1, 1)))
+    system = SemiDiscrete(M=one, K=sp.csr_matrix((1, 1)), C=one, lo=np.zeros(1),
+                          hi=np.array([np.inf]), x_contact=np.zeros(1), loads=np.zeros((1, 0)),
+                          load_time=[], u0=np.array([0.0123]), v0=np.array([-1.0]),
+                          observe={"u": np.ones(1)})
+    r = solve(system, 1e-3, 0.1, solver=Restitution(e) if e else "auto")
+    v = r.velocity["u"]
+    assert r.impacts == 1
+    assert v[-1] == pytest.approx(e, abs=1e-12)
+    assert r.energy[-1] == pytest.approx(0.5 * e**2, abs=1e-12)
+
+
+@pytest.mark.parametrize("kw, word", [
+    ({"restitution": 1.5}, "restitution=1.5"), ({"restitution": -0.1}, "restitution=-0.1"),
+    ({"restitution": 0.5, "stiffness": 1e3}, "stiffness"),
+    ({"restitution": 0.5, "law": "osqp"}, "osqp"), ({"law": "restitution"}, "coefficient"),
+])
+def test_restitution_refusals(kw, word):
+    with pytest.raises(InputError, match=word):
+        resolve(**kw)

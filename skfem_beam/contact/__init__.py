@@ -14,6 +14,7 @@ and then x = x_free + W μ; μ/Δt² are the nodal contact forces.  Laws (regist
 - ``osqp``: the general QP engine, set up once per run.
 - ``daqp``: exact dual active-set QP (daqp's Model).
 - ``penalty``: normal compliance, one-sided springs (needs a stiffness).
+- ``restitution``: exact contact with a Newton coefficient of restitution e (Paoli–Schatzman).
 - ``auto``: the cheapest exact one for the scene.
 
 The protocol a law follows (and how to write one) is in :mod:`.base`.

@@ -8,6 +8,7 @@ from .daqp_solver import DAQP
 from .osqp_solver import OSQP
 from .penalty import Penalty
 from .projection import Projection
+from .restitution import Restitution
 
 LAWS = {
     "projection": Projection,
@@ -15,13 +16,23 @@ LAWS = {
     "osqp": OSQP,
     "daqp": DAQP,
     "penalty": Penalty,      # needs stiffness=
+    "restitution": Restitution,   # needs restitution= (e)
 }
 SOLVERS = ("auto", *LAWS)
 
 
-def resolve(law: str | ContactLaw = "auto", stiffness: float | None = None) -> ContactLaw:
+def resolve(law: str | ContactLaw = "auto", stiffness: float | None = None,
+            restitution: float = 0.0) -> ContactLaw:
     """A law object from a name in LAWS, ``"auto"`` (decided at setup: the cheapest exact
-    law for the scene) or a law object of the user's; ``stiffness`` means penalty."""
+    law for the scene) or a law object of the user's; ``stiffness`` means penalty,
+    ``restitution`` e > 0 the position-level scheme with Newton restitution."""
+    e = Restitution(restitution).e
+    if e > 0:
+        if law not in ("auto", "restitution") or stiffness is not None:
+            raise InputError(f"restitution={e:g} is a law of its own (exact contact with a "
+                             f"coefficient of restitution): it cannot be combined with "
+                             f"{'stiffness=' if stiffness is not None else f'solver={law!r}'}")
+        return Restitution(e)
     if stiffness is not None:
         if law not in ("auto", "penalty"):
             raise InputError(f"solver={law!r} cannot be combined with stiffness= (the penalty "
@@ -33,6 +44,8 @@ def resolve(law: str | ContactLaw = "auto", stiffness: float | None = None) -> C
         return Auto()
     if law == "penalty":
         raise InputError("solver='penalty' needs stiffness= (the spring stiffness 1/ε)")
+    if law == "restitution":
+        raise InputError("solver='restitution' needs restitution= (the coefficient e)")
     if law not in LAWS:
         raise InputError(f"solver={law!r} is not one of: {', '.join(SOLVERS)}")
     return LAWS[law]()

@@ -2,10 +2,11 @@
 from .errors import InputError, SolverError
 from .modes import Modes, modes
 from .problem import Beam, BeamProblem, InitialState, Load, Obstacles, Support
+from .results import SavedRun, read_run
 from .scheme import Result, Stepping, solve
 from .semidiscrete import SemiDiscrete, beam_system
 
 __version__ = "0.1.0"
 __all__ = ["Beam", "BeamProblem", "InitialState", "InputError", "Load", "Modes", "Obstacles",
-           "Result", "SemiDiscrete", "SolverError", "Stepping", "Support", "beam_system",
-           "modes", "solve"]
+           "Result", "SavedRun", "SemiDiscrete", "SolverError", "Stepping", "Support",
+           "beam_system", "modes", "read_run", "solve"]

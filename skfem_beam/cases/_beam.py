@@ -49,14 +49,21 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
 
     def finish(folder: Path, data: dict, run):
         t, beta, dt = data["t"], run.beta, run.dt
+        about = f"β={beta:g}, Δt={dt:g} s, J={problem.J}, {problem.element}"
         trajectory_chart(folder / "tip_displacement.png", t, {"ũ(L, t)": data["tip_displacement"]},
-                         stops=stops, title=f"{case}: tip displacement (β={beta:g}, Δt={dt:g} s, "
-                                            f"J={problem.J}, {problem.element})")
-        energy_chart(folder / "energy.png", t, data["energy"])
+                         stops=stops, title=f"{case}: tip displacement ({about})")
+        energy_chart(folder / "energy.png", t, data["energy"],
+                     title=f"{case}: discrete energy ½E_β ({about})")
         if np.any(data["contact_force"]):
-            trajectory_chart(folder / "contact_force.png", t, {"contact force": data["contact_force"]},
-                             title=f"{case}: net contact force", ylabel="force (m²/s²)")
-        shape_chart(folder / "beam_shapes.png", run.result(), title=f"{case}: u(x, t) at saved times")
+            # in newtons when the mass per length ρS is known (the column is λ·ρS)
+            newtons = "contact_force_N" in data
+            force = data["contact_force_N" if newtons else "contact_force"]
+            trajectory_chart(folder / "contact_force.png", t, {"net contact force λ": force},
+                             title=f"{case}: net contact force on the beam ({about})"
+                                   + (f", ρS={rho_S:g} kg/m" if newtons else ""),
+                             ylabel="force (N)" if newtons else "force per mass (m²/s² = N per kg/m)")
+        shape_chart(folder / "beam_shapes.png", run.result(),
+                    title=f"{case}: displacement ũ(x, t) at saved times ({about})")
         if extra is not None:
             extra(folder, data, run)
 

@@ -34,19 +34,63 @@ def _frame(ax, xlabel, ylabel, title="", legend=True, fontsize=None):
     ax.grid(alpha=0.3)
 
 
+def envelope(t, y, columns: int = 1000):
+    """(t, y) reduced to what ``columns`` pixel columns can show: in each of ``columns``
+    runs of consecutive samples (equally many: the rows are equally spaced in t) the
+    first minimum and the first maximum, in time order, and the first and last sample.
+
+    At most 2·columns + 4 points, drawing the same picture: every column's extremes are
+    kept, so impacts (the stop values, force peaks) are never lost.  No copy of y is made
+    unless it holds NaN (a gap, kept as a gap).
+    """
+    t, y = np.asarray(t), np.asarray(y)
+    n = y.size
+    if n <= 2 * columns + 4:
+        return t, y
+    chunk = -(-n // columns)
+    lo_src = hi_src = y
+    if np.isnan(y.min()):            # min propagates NaN: argmin/argmax would stop at it
+        lo_src, hi_src = np.where(np.isnan(y), np.inf, y), np.where(np.isnan(y), -np.inf, y)
+    full = n // chunk * chunk
+    starts = np.arange(0, full, chunk)
+    picks = [starts + lo_src[:full].reshape(-1, chunk).argmin(axis=1),
+             starts + hi_src[:full].reshape(-1, chunk).argmax(axis=1), [0, n - 1]]
+    if full < n:                     # the last, shorter run
+        picks.append([full + lo_src[full:].argmin(), full + hi_src[full:].argmax()])
+    idx = np.unique(np.concatenate(picks))
+    return t[idx], y[idx]
+
+
+def _columns(fig) -> int:
+    """The figure's width in pixels: no axes is wider, so no column is lost."""
+    return max(100, int(fig.get_figwidth() * fig.dpi))
+
+
+def plot_reduced(ax, t, y, **style):
+    """``ax.plot(t, y)`` of the :func:`envelope` of y at the figure's pixel width."""
+    return ax.plot(*envelope(t, y, _columns(ax.figure)), **style)
+
+
+def _stop_lines(ax, stops, names=("g1", "g2")):
+    """Horizontal lines at the finite ``stops``, one legend entry each."""
+    for name, g, ls in zip(names, stops, ("--", "-.")):
+        if g is not None and np.isfinite(g):
+            ax.axhline(g, color="k", lw=1.2, ls=ls, label=f"obstacle {name} = {g:g} m")
+
+
 def trajectory_chart(path, t, series: dict, stops=(), title="", ylabel="displacement (m)"):
-    """Lines ``series`` (label -> values) against t, with horizontal obstacle lines."""
+    """Lines ``series`` (label -> values) against t, with horizontal obstacle lines
+    (``stops``: g1, g2); long series are drawn reduced (:func:`envelope`)."""
     with figure(path) as (fig, ax):
         for label, y in series.items():
-            ax.plot(t, y, lw=0.9, label=label)
-        for g in stops:
-            if np.isfinite(g):
-                ax.axhline(g, color="k", lw=1.2, ls="--")
-        _frame(ax, "t (s)", ylabel, title, legend=len(series) > 1)
+            plot_reduced(ax, t, y, lw=0.9, label=label)
+        _stop_lines(ax, stops)
+        _frame(ax, "t (s)", ylabel, title, fontsize=9)
 
 
 def energy_chart(path, t, energy, title="discrete energy ½E_β"):
-    trajectory_chart(path, t, {"energy": energy}, title=title, ylabel="energy (m³/s²)")
+    trajectory_chart(path, t, {"½E_β (per unit mass per length)": energy}, title=title,
+                     ylabel="energy (m³/s²)")
 
 
 def compare_chart(path, t, computed: dict, exact: dict, title: str, ylabel: str):
@@ -54,29 +98,63 @@ def compare_chart(path, t, computed: dict, exact: dict, title: str, ylabel: str)
     with figure(path) as (fig, ax):
         pairs = zip(computed.items(), list(exact.items()) + [(None, None)] * len(computed))
         for (label, y), (elabel, ye) in pairs:
-            ax.plot(t, y, lw=1.0, label=label)
+            plot_reduced(ax, t, y, lw=1.0, label=label)
             if ye is not None:
-                ax.plot(t, ye, lw=1.1, ls=(0, (4, 3)), color="k", alpha=0.8, zorder=3,
-                        label=elabel)
+                plot_reduced(ax, t, ye, lw=1.1, ls=(0, (4, 3)), color="k", alpha=0.8,
+                             zorder=3, label=elabel)
         _frame(ax, "t (s)", ylabel, title, fontsize=9)
 
 
+def _obstacle(ax, x, g, name, marker):
+    """g(x) as a line where it spans an interval, as markers where it is a point stop;
+    one legend entry (NaN: no obstacle)."""
+    finite = np.isfinite(g)
+    if not finite.any():
+        return
+    # a run of one finite sample between NaNs is a point stop: a line would not show it
+    alone = finite & ~np.r_[False, finite[:-1]] & ~np.r_[finite[1:], False]
+    label = f"obstacle {name} ({'lower' if name == 'g1' else 'upper'})"
+    if alone.any():
+        ax.plot(x[alone], g[alone], ls="none", marker=marker, ms=11, color="k",
+                label=f"{label} (point stop)")
+        label = None
+    if (finite & ~alone).any():
+        ax.plot(x, np.where(alone, np.nan, g), color="k", lw=1.6,
+                ls="--" if name == "g1" else "-.", label=label)
+
+
 def shape_chart(path, result, count=14, title=""):
-    """The beam u(x, t_k) at ``count`` saved frames with the obstacles (papers' Figs 1–3)."""
-    system = result.system
-    sampler = system.space.sampler(np.linspace(0.0, 1.0, 9))
-    with figure(path) as (fig, ax):
-        idx = np.unique(np.linspace(0, len(result.frames_t) - 1, count).astype(int))
+    """The physical displacement ũ(x, t_k) = u + h(x)φ(t_k) at ``count`` saved frames, with
+    the obstacles g1, g2 (papers' Figs 1–3): what ParaView shows, support motion included."""
+    from .fields import sample_line
+    line = sample_line(result.system)
+    good = np.flatnonzero(np.isfinite(result.frames_u).all(axis=1))
+    idx = good[np.unique(np.linspace(0, good.size - 1, min(count, good.size)).astype(int))]
+    with figure(path, figsize=(9, 4.4)) as (fig, ax):
         cmap = plt.get_cmap("viridis")
-        for i, k in enumerate(idx):
-            ax.plot(sampler.x, sampler.E0 @ result.frames_u[k], lw=0.9,
-                    color=cmap(i / max(1, len(idx) - 1)),
-                    label=f"t={result.frames_t[k]:.3g} s" if i in (0, len(idx) - 1) else None)
-        if system.sample_x is not None and system.sample_x.size:
-            for g in (system.sample_lo, system.sample_hi):
-                gx = np.where(np.isfinite(g), g, np.nan)
-                ax.plot(system.sample_x, gx, "k", lw=1.5)
-        _frame(ax, "x (m)", "u (m)", title)
+        times = result.frames_t[idx]
+        norm = plt.Normalize(times.min(), max(times.max(), times.min() + 1e-300))
+        span = [np.inf, -np.inf]
+        for k in idx:
+            tk = result.frames_t[k]
+            ut = line.fields(tk, result.frames_u[k], result.frames_v[k],
+                             result.frames_force[k])["displacement"]
+            ax.plot(line.x, ut, lw=1.0, color=cmap(norm(tk)),
+                    label=f"ũ(x, t) at {idx.size} times" if k == idx[0] else None)
+            span = [min(span[0], ut.min()), max(span[1], ut.max())]
+        _obstacle(ax, line.x, line.g1, "g1", "^")
+        _obstacle(ax, line.x, line.g2, "g2", "v")
+        # the beam's range and the narrowest gap: obstacles far from the beam (the
+        # convex ones reach ±0.75 m at the ends) would squash the curves to a line
+        for g, pick in ((line.g1, max), (line.g2, min)):
+            if np.isfinite(g).any():
+                span = [min(span[0], pick(np.nanmin(g), np.nanmax(g))),
+                        max(span[1], pick(np.nanmin(g), np.nanmax(g)))]
+        pad = 0.08 * (span[1] - span[0]) or 1e-3
+        ax.set_ylim(span[0] - pad, span[1] + pad)
+        bar = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax, pad=0.01)
+        bar.set_label("t (s)")
+        _frame(ax, "x (m)", "ũ (m)", title, fontsize=9)
 
 
 def penetration_chart(path, rows: list[dict], title=""):

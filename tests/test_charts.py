@@ -1,0 +1,151 @@
+"""Charts from data in memory: long series reduced without losing an extreme, the beam
+drawn as ParaView shows it (ũ, with the obstacles), forces in newtons, legends."""
+import tracemalloc
+from contextlib import contextmanager
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
+
+from conftest import exit_code
+from skfem_beam import beam_system, scenes, solve
+from skfem_beam.cases import point_stops
+from skfem_beam.output import charts
+from skfem_beam.output.charts import envelope, plot_reduced, shape_chart, trajectory_chart
+
+N = 2_000_000
+
+
+@pytest.fixture(scope="module")
+def tip():
+    """2,000,000 rows like a tip between stops at ±0.1 m: long stays on a stop, single-row
+    spikes, and rows where it touches the stop once."""
+    t = np.arange(N) * 1e-6
+    y = np.clip(0.13 * np.sin(2 * np.pi * 3.1 * t) + 0.004 * np.sin(2 * np.pi * 410 * t),
+                -0.1, 0.1)
+    y[[777_777, 1_234_567]] = [0.0999999, -0.0999999]     # lone near-touches
+    y[1_500_001] = 0.1                                    # a lone touch inside a free flight
+    return t, y
+
+
+@contextmanager
+def kept_figure(store):
+    """charts.figure, but the figure is kept open for inspection instead of saved."""
+    fig, ax = plt.subplots(figsize=(9, 4), dpi=110)
+    store.update(fig=fig, ax=ax)
+    yield fig, ax
+
+
+def test_envelope_keeps_every_column_extreme(tip):
+    t, y = tip
+    columns = 990
+    tr, yr = envelope(t, y, columns)
+    assert tr.size <= 2 * columns + 4 and np.all(np.diff(tr) > 0)
+    # every sample kept is a sample of the series (no interpolation, no smoothing)
+    idx = np.searchsorted(t, tr)
+    assert np.array_equal(t[idx], tr) and np.array_equal(y[idx], yr)
+    chunk = -(-N // columns)
+    for k0 in range(0, N, chunk):                      # each pixel column's min and max
+        sel = (idx >= k0) & (idx < k0 + chunk)
+        assert yr[sel].max() == y[k0:k0 + chunk].max()
+        assert yr[sel].min() == y[k0:k0 + chunk].min()
+    assert yr.max() == 0.1 and yr.min() == -0.1       # the stop values themselves
+    assert 1_500_001 in idx and 777_777 in idx and 1_234_567 in idx
+    assert idx[0] == 0 and idx[-1] == N - 1
+
+
+def test_envelope_copies_nothing_and_keeps_nan_gaps(tip):
+    t, y = tip
+    tracemalloc.start()
+    envelope(t, y, 1000)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert peak < 0.1 * y.nbytes, peak                 # no copy of the 16 MB series
+    z = y.copy()
+    z[:1] = np.nan                                     # the bar's R(0) is NaN
+    tr, zr = envelope(t, z, 1000)
+    assert np.isnan(zr[0]) and np.nanmax(zr) == 0.1 and np.nanmin(zr) == -0.1
+    short = np.arange(50.0)
+    assert envelope(short, short, 1000)[1] is short   # short series drawn as they are
+
+
+def test_a_long_series_is_drawn_reduced_with_a_legend(tip, monkeypatch, tmp_path):
+    t, y = tip
+    store = {}
+    monkeypatch.setattr(charts, "figure", lambda *a, **k: kept_figure(store))
+    trajectory_chart(tmp_path / "tip.png", t, {"ũ(L, t)": y}, stops=(-0.1, 0.1))
+    ax = store["ax"]
+    line = ax.lines[0]
+    assert line.get_xdata().size <= 2 * 990 + 4 and max(line.get_ydata()) == 0.1
+    labels = ax.get_legend_handles_labels()[1]
+    assert labels == ["ũ(L, t)", "obstacle g1 = -0.1 m", "obstacle g2 = 0.1 m"]
+    plt.close(store["fig"])
+    fig, ax = plt.subplots(figsize=(4, 3), dpi=100)
+    assert plot_reduced(ax, t, y)[0].get_xdata().size <= 2 * 400 + 4
+    plt.close(fig)
+
+
+def test_beam_shapes_show_the_physical_displacement_and_the_stops(monkeypatch, tmp_path):
+    """ũ = u + h(x)φ(t): at x = 0 every curve sits on the support φ(t) = 0.2 sin 10t (the
+    relative u would start at 0), at x = L on u(L) (h(L) = 0); the stops are markers."""
+    r = solve(beam_system(scenes.point_stops()), dt=5e-5, T=0.6, beta=0.5, frames=12)
+    store = {}
+    monkeypatch.setattr(charts, "figure", lambda *a, **k: kept_figure(store))
+    shape_chart(tmp_path / "shapes.png", r, count=6)
+    ax = store["ax"]
+    curves = [ln for ln in ax.lines if ln.get_xdata().size > 2]
+    assert len(curves) == 6
+    L = 1.501
+    times = np.unique(np.linspace(0, r.frames_t.size - 1, 6).astype(int))
+    for ln, k in zip(curves, times):
+        x, u = np.asarray(ln.get_xdata()), np.asarray(ln.get_ydata())
+        assert x[0] == 0 and x[-1] == pytest.approx(L)
+        assert u[0] == pytest.approx(0.2 * np.sin(10 * r.frames_t[k]), abs=1e-12)
+        assert u[-1] == pytest.approx(r.observed["tip_displacement"][round(r.frames_t[k] / r.dt)],
+                                      abs=1e-12)
+    assert max(abs(ln.get_ydata()[0]) for ln in curves) > 0.15     # the support has moved
+    stops = {ln.get_label(): (ln.get_xdata()[0], ln.get_ydata()[0]) for ln in ax.lines
+             if ln.get_marker() in ("^", "v")}
+    assert stops == {"obstacle g1 (lower) (point stop)": (pytest.approx(L), -0.1),
+                     "obstacle g2 (upper) (point stop)": (pytest.approx(L), 0.1)}
+    assert ax.get_legend() is not None and ax.get_ylabel() == "ũ (m)"
+    plt.close(store["fig"])
+
+
+def test_flat_obstacles_are_lines(monkeypatch, tmp_path):
+    r = solve(beam_system(scenes.flat_obstacles(J=20)), dt=1e-3, T=0.05, beta=0.5, frames=5)
+    store = {}
+    monkeypatch.setattr(charts, "figure", lambda *a, **k: kept_figure(store))
+    shape_chart(tmp_path / "shapes.png", r)
+    g = {ln.get_label(): ln for ln in store["ax"].lines if ln.get_label().startswith("obstacle")}
+    assert set(g) == {"obstacle g1 (lower)", "obstacle g2 (upper)"}
+    x, g2 = np.asarray(g["obstacle g2 (upper)"].get_xdata()), \
+        np.asarray(g["obstacle g2 (upper)"].get_ydata())
+    L = x[-1]
+    assert np.all(g2[x >= L / 2] == 0.01) and np.all(np.isnan(g2[x < L / 2 - 1e-9]))
+    plt.close(store["fig"])
+
+
+def test_case_charts_force_in_newtons(monkeypatch, tmp_path):
+    """The pipe's ρS is known: its contact force chart is in N (the contact_force_N column)."""
+    figures = {}
+
+    @contextmanager
+    def keep(path, *a, **k):
+        with kept_figure(figures.setdefault(path.name, {})) as fa:
+            yield fa
+
+    monkeypatch.setattr(charts, "figure", keep)
+    out = tmp_path / "run"
+    assert exit_code(point_stops.main, ["--T", "0.3", "--out", str(out), "--format", "none"]) == 0
+    assert set(figures) == {"tip_displacement.png", "energy.png", "contact_force.png",
+                            "beam_shapes.png"}
+    ax = figures["contact_force.png"]["ax"]
+    assert ax.get_ylabel() == "force (N)"
+    rows = np.loadtxt(out / "timeseries.csv", delimiter=",", skiprows=1)
+    force_N = rows[:, 5]
+    y = ax.lines[0].get_ydata()
+    assert np.max(np.abs(y)) == np.max(np.abs(force_N)) > 10      # N, not m²/s² ÷ ρS
+    for name, fa in figures.items():
+        assert fa["ax"].get_legend() is not None, name
+        plt.close(fa["fig"])

@@ -1,0 +1,239 @@
+"""Results back in Python: read_run against the in-memory result of the same run, the
+.npz/.mat export read back, and ``python -m skfem_beam``."""
+import json
+import re
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from scipy.io import loadmat
+
+from conftest import exit_code
+from skfem_beam import InputError, read_run
+from skfem_beam.__main__ import COMMANDS, listing, main as skfem_main
+from skfem_beam.cases import _beam, convex_obstacles, flat_obstacles, impacting_bar, point_stops
+from skfem_beam.output.fields import sample_line
+from skfem_beam.results import export, export_main, matlab_name, variables
+
+MATLAB = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,62}$")
+
+
+BEAMS = {
+    "point_stops": (point_stops.main, ["--T", "0.3", "--frames", "40", "--flush-every", "1000"]),
+    "flat_obstacles": (flat_obstacles.main, ["--T", "0.2", "--frames", "20", "--format", "vtu"]),
+    "convex_obstacles": (convex_obstacles.main, ["--T", "0.2", "--save-every", "3"]),
+}
+
+
+def _run_case(module, main, monkeypatch, argv):
+    kept = {}
+    real = module.execute
+
+    def execute(run, out, args, summary, series, finish):
+        def keep(folder, data, run_):
+            kept.update(data=data, run=run_)
+            return finish(folder, data, run_)
+        return real(run, out, args, summary, series, keep)
+
+    monkeypatch.setattr(module, "execute", execute)
+    assert exit_code(main, argv) == 0
+    return kept
+
+
+def _assert_same_series(saved, data):
+    assert list(saved.series) == list(data)
+    for k, v in data.items():    # 17 significant digits written: bit for bit
+        assert saved.series[k].shape == v.shape
+        assert np.array_equal(saved.series[k], v, equal_nan=True), k
+
+
+def _assert_same_frames(saved, run):
+    """The field frames read back equal the ones computed from the run's own states."""
+    f = saved.fields
+    line = sample_line(run.system)
+    assert np.array_equal(f.x, line.x)
+    res = run.result()
+    assert f.t.size >= 2 and f.t[-1] <= res.T + 1e-12
+    for j, t in enumerate(f.t):
+        k = int(np.argmin(np.abs(res.frames_t - t)))
+        assert abs(res.frames_t[k] - t) <= 1e-12
+        want = line.fields(t, res.frames_u[k], res.frames_v[k], res.frames_force[k])
+        assert set(want) == set(f.arrays)
+        for name, v in want.items():
+            assert np.array_equal(f[name][j], v, equal_nan=True), (name, t)
+
+
+@pytest.mark.parametrize("case", list(BEAMS))
+def test_beam_run_reads_back_exactly(case, tmp_path, monkeypatch):
+    main, argv = BEAMS[case]
+    out = tmp_path / case
+    kept = _run_case(_beam, main, monkeypatch, argv + ["--out", str(out)])
+    saved = read_run(out)
+    _assert_same_series(saved, kept["data"])
+    res = kept["run"].result()
+    assert saved.summary["status"] == "success" and saved.status == "success"
+    assert saved.summary["steps"] == res.steps and saved.summary["impacts"] == res.impacts
+    assert saved.summary["max_nodal_violation"] == res.max_nodal_violation
+    assert saved.summary["case"] == case and saved.summary["config"]["T"] == float(argv[1])
+    assert saved.fields.source == ("vtu" if "vtu" in argv else "xdmf")
+    _assert_same_frames(saved, kept["run"])
+    assert saved.impacts is None and saved.tables == {}
+    if case == "point_stops":        # rows every step; ũ(L) touches the stops exactly
+        assert saved.t.size == 6001 and np.abs(saved["tip_displacement"]).max() == 0.1
+        # the stability limit (inf for β = 1/2) comes back a float, not the string JSON had
+        assert saved.summary["linear_stability_limit_dt"] == np.inf
+        assert "inf" in (out / "summary.json").read_text()
+
+
+def test_xdmf_and_vtu_give_the_same_frames(tmp_path):
+    out = tmp_path / "run"
+    assert exit_code(point_stops.main, ["--T", "0.05", "--frames", "10", "--out", str(out)]) == 0
+    a, b = read_run(out, fields="xdmf"), read_run(out, fields="vtu")
+    assert (a.fields.source, b.fields.source) == ("xdmf", "vtu")
+    assert np.array_equal(a.fields.t, b.fields.t) and a.fields.t.size == 11
+    assert np.array_equal(a.fields.points, b.fields.points)
+    for k in a.fields.arrays:
+        assert np.array_equal(a.fields[k], b.fields[k], equal_nan=True), k
+    assert a.fields["displacement_vector"].shape == (11, a.fields.x.size, 3)
+    assert read_run(out, fields="none").fields is None
+    with pytest.raises(InputError, match="fields='h5'"):
+        read_run(out, fields="h5")
+
+
+def test_bar_reads_back_exactly(tmp_path, monkeypatch):
+    out = tmp_path / "bar"
+    kept = _run_case(impacting_bar, impacting_bar.main, monkeypatch,
+                     ["--T", "1", "--N", "40", "--frames", "25", "--out", str(out)])
+    saved = read_run(out)
+    _assert_same_series(saved, kept["data"])
+    assert np.isnan(saved["contact_force"][0])      # R(0) is not defined: written "nan"
+    assert {"u_0_exact", "u_L_exact", "contact_force_exact", "energy_exact"} <= set(saved.series)
+    assert saved.summary["N"] == 40 and saved.summary["status"] == "success"
+    assert saved.fields.t.size >= 20 and "bending_moment" not in saved.fields.arrays
+
+
+@pytest.fixture(scope="module")
+def folder(tmp_path_factory):
+    out = tmp_path_factory.mktemp("runs") / "pipe"
+    assert exit_code(point_stops.main, ["--T", "0.1", "--frames", "8", "--out", str(out)]) == 0
+    return out
+
+
+def test_extra_columns_impacts_and_tables_are_read_generically(folder, tmp_path):
+    """Columns another command adds (probes) and an impacts.csv come back by name."""
+    run = tmp_path / "run"
+    shutil.copytree(folder, run)
+    lines = (run / "timeseries.csv").read_text().splitlines()
+    probe = np.arange(len(lines) - 1) / 3.0
+    (run / "timeseries.csv").write_text("\n".join(
+        [lines[0] + ",probe_u(0.75)"] + [f"{r},{p:.17g}" for r, p in zip(lines[1:], probe)]) + "\n")
+    (run / "impacts.csv").write_text("t,x,side,velocity\n0.0123,1.501,g2,0.5\n"
+                                     "0.0456,1.501,g1,-0.25\n")
+    (run / "energy.csv").write_text("t,energy_beta_0.5\n0,1.5\n0.001,1.25\n")
+    saved = read_run(run)
+    assert np.array_equal(saved["probe_u(0.75)"], probe)
+    assert list(saved.impacts) == ["t", "x", "side", "velocity"]
+    assert saved.impacts["side"].tolist() == ["g2", "g1"]
+    assert np.array_equal(saved.impacts["velocity"], [0.5, -0.25])
+    assert list(saved.tables) == ["energy"]
+    assert np.array_equal(saved.tables["energy"]["energy_beta_0.5"], [1.5, 1.25])
+    names = variables(saved)
+    assert {"probe_u_0_75_", "impacts_side", "impacts_t", "energy_energy_beta_0_5"} <= set(names)
+
+
+@pytest.mark.parametrize("files, missing", [
+    ((), "no summary.json and no timeseries.csv"),
+    (("summary.json",), "no timeseries.csv"),
+    (("timeseries.csv", "poincare.csv"), "no summary.json"),
+])
+def test_not_a_run_is_refused_in_one_line(tmp_path, files, missing):
+    for name in files:
+        (tmp_path / name).write_text("{}" if name.endswith("json") else "t\n0\n")
+    with pytest.raises(InputError) as e:
+        read_run(tmp_path)
+    assert str(e.value) == f"{tmp_path} is not a run folder: {missing}"
+    with pytest.raises(InputError, match="no such folder"):
+        read_run(tmp_path / "nothing")
+
+
+def test_npz_export_reads_back(folder, tmp_path):
+    saved = read_run(folder)
+    path = export(folder, "npz", tmp_path / "pipe.npz")
+    with np.load(path) as z:
+        assert json.loads(str(z["summary_json"])) == json.loads(json.dumps(saved.summary))
+        for k, v in saved.series.items():
+            assert np.array_equal(z[k], v)
+        assert np.array_equal(z["fields_t"], saved.fields.t)
+        assert np.array_equal(z["fields_x"], saved.fields.x)
+        assert np.array_equal(z["fields_g2"], saved.fields["g2"], equal_nan=True)
+        assert np.array_equal(z["fields_displacement"], saved.fields["displacement"])
+
+
+def test_mat_export_reads_back_with_names_matlab_accepts(folder, tmp_path):
+    saved = read_run(folder)
+    assert exit_code(export_main, [str(folder), "--to", "mat", "--out",
+                                   str(tmp_path / "pipe.mat")]) == 0
+    m = loadmat(tmp_path / "pipe.mat")
+    names = [k for k in m if not k.startswith("__")]
+    assert all(MATLAB.match(k) for k in names), names
+    for k, v in saved.series.items():        # column vectors, as MATLAB users expect
+        assert m[k].shape == (v.size, 1) and np.array_equal(m[k][:, 0], v)
+    assert np.array_equal(m["fields_displacement"], saved.fields["displacement"])
+    assert m["fields_displacement_vector"].shape == saved.fields["displacement_vector"].shape
+    s = m["summary"][0, 0]
+    assert all(MATLAB.match(k) for k in s.dtype.names)
+    assert s["impacts"][0, 0] == saved.summary["impacts"]
+    assert str(s["case"][0]) == "point_stops" and s["linear_stability_limit_dt"][0, 0] == np.inf
+    config = s["config"][0, 0]
+    assert config["J"][0, 0] == 19 and config["mesh"].size == 0      # None: empty matrix
+    # default file: inside the run folder, named after it
+    assert exit_code(export_main, [str(folder), "--to", "npz"]) == 0
+    assert (folder / "pipe.npz").is_file()
+    (folder / "pipe.npz").unlink()
+
+
+def test_matlab_names():
+    taken = {}
+    for raw, want in [("u(L, t)", "u_L__t_"), ("1st", "x1st"), ("_x", "x_x"),
+                      ("energy_beta_0.5", "energy_beta_0_5"), ("ũ", "x_")]:
+        assert matlab_name(raw) == want
+    long = "a" * 80
+    assert matlab_name(long) == "a" * 63
+    for _ in range(3):
+        taken[matlab_name("u(L)", taken)] = 1
+    assert list(taken) == ["u_L_", "u_L__2", "u_L__3"]
+
+
+@pytest.mark.parametrize("argv, word", [
+    (["--to", "xls"], "--to 'xls' is not one of: npz, mat"),
+    (["--to", "mat", "--out", "x.npz"], "must end in .mat"),
+    (["--to", "mat", "--out", "/no/such/folder/x.mat"], "does not exist"),
+])
+def test_export_bad_input_one_line(folder, capsys, argv, word):
+    assert exit_code(export_main, [str(folder)] + argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and word in err, err
+
+
+def test_python_m_skfem_beam(tmp_path):
+    text = listing()
+    for module in ("skfem_beam.cases.point_stops", "skfem_beam.cases.impacting_bar",
+                   "skfem_beam.cases.stability_map", "skfem_beam.sweep",
+                   "skfem_beam.bench.work_precision", "skfem_beam.bench.speed"):
+        line = next(x for x in text.splitlines() if f"python -m {module} " in x)
+        assert len(line.split(None, 3)[3]) > 20        # with its one-line description
+    assert "cases._beam" not in text and "bench._floor" not in text
+    assert all(f"python -m skfem_beam {name} " in text for name in COMMANDS)
+    p = subprocess.run([sys.executable, "-m", "skfem_beam"], capture_output=True, text=True)
+    assert p.returncode == 0 and p.stdout == text
+    p = subprocess.run([sys.executable, "-m", "skfem_beam", "plot"], capture_output=True,
+                       text=True)
+    assert p.returncode == 2 and p.stdout == "" and p.stderr.count("\n") == 1
+    assert "unknown command 'plot'" in p.stderr
+    p = subprocess.run([sys.executable, "-m", "skfem_beam", "export", str(tmp_path),
+                        "--to", "mat"], capture_output=True, text=True)
+    assert p.returncode == 2 and p.stderr.count("\n") == 1 and "not a run folder" in p.stderr
+    assert not list(tmp_path.iterdir())
+    assert skfem_main(["nope"]) == 2

@@ -13,9 +13,10 @@ spring k = 100); Example 2 is ``--f -1 --T 6``.  The periodic rod (exact solutio
 known, docs/design.md §1) is ``--far-end clamped --v0 0 --u0-csv rod.csv`` with the two
 rows ``0,0.5`` and ``1,0``.  ``--u0-csv``/``--v0-csv`` read x,value rows (linear in
 between; they replace --u0/--v0).  With ``--A`` forces are in N, energies in J and
-``--k`` is in N/m; without it everything is per unit cross-section (Pa, J/m², Pa/m).  Writes into DIR: summary.json,
-timeseries.csv (u(0,t), u(L,t), reaction, energies, and the exact solution beside
-them when it is known, i.e. b = 0), the field series (XDMF and/or VTU, --format), and charts,
+``--k`` is in N/m; without it everything is per unit cross-section (Pa, J/m², Pa/m).
+Writes into DIR: summary.json, timeseries.csv (u(0,t), u(L,t), reaction, energies, and
+the exact solution beside them when it is known: b = 0 and uniform data with a free far
+end, or the periodic rod), the field series (XDMF and/or VTU, --format), and charts,
 through the same streaming pipeline as the beam scenes (checkpoints, --resume).
 
 Defaults and why: ``--mass average`` (the mean of consistent and lumped mass cancels

@@ -4,8 +4,9 @@ The unknowns are the nodal values of the nodes that are not ``fixed``: a clamped
 (u = 0) drops its node; a free end and the end at an obstacle keep theirs (the obstacle
 is a constraint, not a boundary condition).  ``C`` maps the unknowns to the values at
 every node (the identity when nothing is fixed); ``sampler``, ``load_vector``,
-``interpolate`` and ``project`` work on the unknowns.  The interface follows :class:`~skfem_beam.spaces.hermite.HermiteSpace`
-where it applies; ``S`` here is the stiffness (u', v') instead of the bending form.
+``interpolate`` and ``project`` work on the unknowns.  The interface follows
+:class:`~skfem_beam.spaces.hermite.HermiteSpace` where it applies; ``S`` here is the
+stiffness (u', v') instead of the bending form.
 
 Mass matrices (the choice sets the dispersion error of a wave, docs/design.md §6, "Bar accuracy"):
 

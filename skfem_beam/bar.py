@@ -50,45 +50,154 @@ from .semidiscrete import SceneView, SemiDiscrete
 from .spaces.lagrange import MASSES, LagrangeSpace
 
 OBSTACLES = ("rigid", "elastic")
+FAR_ENDS = ("free", "clamped")
+SIDES = ("left", "right")
+
+
+@dataclass(frozen=True)
+class Table:
+    """A profile given as (x, value) pairs, x increasing: linear interpolation between
+    them.  It must cover the bar [0, L] (checked by :class:`Bar`)."""
+    x: tuple
+    value: tuple
+
+    def __call__(self, x):
+        return np.interp(np.asarray(x, dtype=float), self.x, self.value)
+
+    @classmethod
+    def of(cls, name: str, pairs) -> "Table":
+        try:
+            xy = np.asarray(pairs, dtype=float)
+        except (TypeError, ValueError):
+            raise InputError(f"{name}={pairs!r} is neither a number, a function of x nor "
+                             f"(x, value) pairs") from None
+        if xy.ndim != 2 or xy.shape[1] != 2 or xy.shape[0] < 2:
+            raise InputError(f"{name}: a table needs at least two (x, value) pairs, "
+                             f"got an array of shape {xy.shape}")
+        if not np.isfinite(xy).all():
+            raise InputError(f"{name}: the table has a value that is not a finite number")
+        step = np.diff(xy[:, 0])
+        if (step <= 0).any():
+            i = int(np.argmax(step <= 0))
+            raise InputError(f"{name}: the table's x must increase, but x={xy[i, 0]:g} is "
+                             f"followed by x={xy[i + 1, 0]:g}")
+        return cls(tuple(xy[:, 0].tolist()), tuple(xy[:, 1].tolist()))
+
+
+def _profile(name: str, value):
+    """A uniform value (float), a :class:`Table`, or a function of x, as given."""
+    if isinstance(value, Table) or (callable(value) and not isinstance(value, type)):
+        return value
+    if np.ndim(value) == 0:
+        return check_finite(name, value)
+    return Table.of(name, value)
+
+
+def profile_values(value, x: np.ndarray) -> np.ndarray:
+    """The profile ``value`` (a number, a Table or a function) at the abscissae ``x``."""
+    if isinstance(value, float):
+        return np.full(x.shape, value)
+    return np.broadcast_to(np.asarray(value(x), dtype=float), x.shape).copy()
+
+
+def read_profile(path: str, flag: str) -> Table:
+    """A profile from a CSV file of x,value rows (a header line and # comments allowed)."""
+    try:
+        lines = open(path, encoding="utf-8").read().splitlines()
+    except OSError as e:
+        raise InputError(f"{flag} {path}: cannot read it ({e.strerror or e})") from None
+    pairs = []
+    for i, line in enumerate(lines, 1):
+        cells = [c.strip() for c in line.split("#")[0].split(",")]
+        if cells == [""]:
+            continue
+        try:
+            if len(cells) != 2:
+                raise ValueError
+            pairs.append((float(cells[0]), float(cells[1])))
+        except ValueError:
+            if pairs or i > 1:       # only the first line may be a header
+                raise InputError(f"{flag} {path}: line {i} {line.strip()!r} is not two "
+                                 f"numbers x,value") from None
+    return Table.of(f"{flag} {path}", pairs)
+
+
+def describe(value):
+    """A profile for summary.json: the number, the table's pairs, or 'function'."""
+    if isinstance(value, float):
+        return value
+    if isinstance(value, Table):
+        return {"x": list(value.x), "value": list(value.value)}
+    return "function of x"
 
 
 @dataclass(frozen=True)
 class Bar:
     """The bar scene.  Defaults: the paper's Example 1 (k = 100, v0 = −1, N = 100).
 
-    ``u0`` is a uniform initial displacement: a gap to the obstacle when > 0 (the bar
-    then flies freely for u0/|v0| before it hits).  ``mass`` is the mass matrix; the
-    default ``average`` is the one that meets the accuracy targets (see
-    :mod:`skfem_beam.spaces.lagrange` and docs/design.md §6, "Bar accuracy").
+    ``u0``, ``v0``: the initial displacement and velocity, each a number (uniform), a
+    function of x, or a table of (x, value) pairs (linear interpolation); the scheme
+    starts from their nodal values.  A uniform u0 > 0 is a gap to the obstacle at x = 0
+    (the bar then flies freely for u0/|v0| before it hits).
+
+    ``obstacle_at``: the end the obstacle sits at, "left" (x = 0: u(0) ≥ 0) or "right"
+    (x = L: u(L) ≤ 0); the numbers 0 and L are accepted too.  The gap is U = u(0) or
+    U = −u(L), so the law reads the same at either end (U ≥ 0, R ≥ 0, RU = 0, or
+    R = kU⁻) and R ≥ 0 is the obstacle's push on the bar.  ``far_end``: the other end,
+    "free" (σ = 0) or "clamped" (u = 0; u0 must vanish there).
+
+    ``A``: the cross-section (m²).  None (default) is the paper's per-unit-section form:
+    forces in Pa, energies in J/m², the spring k in Pa/m.  With A the matrices carry it
+    (ρA, EA, bA, fA): forces are in N, energies in J, and k is a spring in N/m.
+    ``mass`` is the mass matrix; the default ``average`` is the one that meets the
+    accuracy targets (see :mod:`skfem_beam.spaces.lagrange` and docs/design.md §6).
     """
-    a: float = 1.0           # Young's modulus (Pa)
+    a: float = 1.0           # Young's modulus E (Pa)
     b: float = 0.0           # Kelvin–Voigt viscosity (Pa·s)
     rho: float = 1.0         # density (kg/m³)
     L: float = 1.0           # length (m)
     f: float = 0.0           # uniform body force (N/m³); Example 2: −1
-    v0: float = -1.0         # uniform initial velocity (m/s); < 0 moves towards the obstacle
-    u0: float = 0.0          # uniform initial displacement (m); the gap to the obstacle
+    v0: object = -1.0        # initial velocity (m/s): number, function or table; < 0 moves left
+    u0: object = 0.0         # initial displacement (m): number, function or table
     obstacle: str = "rigid"  # 'rigid' (Signorini) or 'elastic' (spring R = k U⁻)
-    k: float = 100.0         # spring stiffness (Pa/m) of the elastic obstacle
+    k: float = 100.0         # spring stiffness of the elastic obstacle (Pa/m; N/m with A)
     N: int = 100             # number of elements
     mass: str = "average"    # 'consistent' | 'lumped' | 'average'
+    far_end: str = "free"    # 'free' | 'clamped': the end without the obstacle
+    obstacle_at: object = "left"   # 'left' (x = 0) | 'right' (x = L), or 0 | L
+    A: float | None = None   # cross-section (m²); None: per unit cross-section
 
     def __post_init__(self):
         for name in ("a", "rho", "L"):
             object.__setattr__(self, name, check_positive(name, getattr(self, name)))
         object.__setattr__(self, "b", check_nonnegative("b", self.b))
-        for name in ("f", "v0", "u0"):
-            object.__setattr__(self, name, check_finite(name, getattr(self, name)))
+        object.__setattr__(self, "f", check_finite("f", self.f))
         object.__setattr__(self, "N", check_count("N", self.N))
         check_choice("obstacle", self.obstacle, OBSTACLES)
         check_choice("mass", self.mass, MASSES)
+        check_choice("far_end", self.far_end, FAR_ENDS)
+        object.__setattr__(self, "obstacle_at", _side(self.obstacle_at, self.L))
+        if self.A is not None:
+            object.__setattr__(self, "A", check_positive("A", self.A))
         k = check_nonnegative("k", self.k)
         if k == 0 and self.obstacle == "elastic":
             raise InputError("k=0 must be > 0 for an elastic obstacle")
         object.__setattr__(self, "k", k)
-        if self.obstacle == "rigid" and self.u0 < 0:
-            raise InputError(f"the initial state violates the rigid obstacle: "
-                             f"u(0,0)=u0={self.u0:g} < 0")
+        x = np.linspace(0.0, self.L, self.N + 1)
+        for name in ("v0", "u0"):
+            value = _profile(name, getattr(self, name))
+            object.__setattr__(self, name, value)
+            _check_values(name, value, x, self.L)
+        u = profile_values(self.u0, x)
+        end, far = (0, -1) if self.obstacle_at == "left" else (-1, 0)
+        where = ("(0,0)", "x=0") if end == 0 else ("(L,0)", "x=L")
+        if self.obstacle == "rigid" and self.gap_sign * u[end] < 0:
+            value = f"u{where[0]}=u0={self.u0:g}" if isinstance(self.u0, float) \
+                else f"u{where[0]}={u[end]:g}"
+            raise InputError(f"the initial state violates the rigid obstacle at {where[1]}: "
+                             f"{value} {'<' if end == 0 else '>'} 0")
+        if self.far_end == "clamped" and abs(u[far]) > 1e-12 * max(1.0, np.abs(u).max()):
+            raise InputError(f"u0={u[far]:g} at the clamped end x={x[far]:g} must be 0")
 
     @property
     def c(self) -> float:
@@ -96,35 +205,87 @@ class Bar:
         return math.sqrt(self.a / self.rho)
 
     @property
+    def E(self) -> float:
+        """Young's modulus (the paper's a)."""
+        return self.a
+
+    @property
     def h(self) -> float:
         return self.L / self.N
 
+    @property
+    def section(self) -> float:
+        """The factor of the matrices and loads: A, or 1 per unit cross-section."""
+        return 1.0 if self.A is None else self.A
+
+    @property
+    def gap_sign(self) -> float:
+        """U = gap_sign·u at the obstacle's end: +1 at x = 0, −1 at x = L."""
+        return 1.0 if self.obstacle_at == "left" else -1.0
+
+
+def _side(value, L: float) -> str:
+    if isinstance(value, str):
+        return check_choice("obstacle_at", value, SIDES)
+    x = check_finite("obstacle_at", value)
+    if x == 0.0:
+        return "left"
+    if abs(x - L) <= 1e-12 * L:
+        return "right"
+    raise InputError(f"obstacle_at={x:g} must be 'left', 'right', 0 or L={L:g} "
+                     f"(the obstacle sits at an end)")
+
+
+def _check_values(name: str, value, x: np.ndarray, L: float) -> None:
+    """A profile covers [0, L] (tables) and is finite at the nodes (functions)."""
+    if isinstance(value, Table) and (value.x[0] > 1e-12 * L or value.x[-1] < L * (1 - 1e-12)):
+        raise InputError(f"{name}: the table covers [{value.x[0]:g}, {value.x[-1]:g}], "
+                         f"not the whole bar [0, {L:g}]")
+    if isinstance(value, float):
+        return
+    try:
+        u = profile_values(value, x)
+    except Exception as e:   # a user function that fails on an array of abscissae
+        raise InputError(f"{name}: the function failed at the nodes ({type(e).__name__}: "
+                         f"{e}); it must take an array of x") from None
+    bad = ~np.isfinite(u)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise InputError(f"{name}(x={x[i]:g})={u[i]} must be a finite number")
+
 
 def bar_system(bar: Bar) -> SemiDiscrete:
-    """P1 semi-discretisation of the bar: M = ρM_mass, K = aS, B = bS, constraint u(0) ≥ 0.
+    """P1 semi-discretisation of the bar: M = ρA·M_mass, K = aA·S, B = bA·S (A = 1 per
+    unit cross-section), a clamped far end's node dropped, one constrained value at
+    the obstacle: u(0) ≥ 0 or u(L) ≤ 0.
 
     The constraint row is there for both obstacles: the rigid one enforces it, the
     elastic one is a spring on the same value (``solve(…, stiffness=bar.k)``).
     """
-    space = LagrangeSpace(np.linspace(0.0, bar.L, bar.N + 1), bar.mass)
-    n = space.n
-    e0 = sp.csr_matrix(([1.0], ([0], [0])), shape=(1, n))
-    eL = np.zeros(n)
-    eL[-1] = 1.0
-    loads = space.load_vector(lambda x: np.ones_like(x))[:, None] if bar.f != 0 \
+    left = bar.obstacle_at == "left"
+    fixed = () if bar.far_end == "free" else ((bar.N,) if left else (0,))
+    space = LagrangeSpace(np.linspace(0.0, bar.L, bar.N + 1), bar.mass, fixed)
+    n, A = space.n, bar.section
+    nodal = space.C.toarray()
+    e0, eL = nodal[0], nodal[-1]
+    loads = A * space.load_vector(lambda x: np.ones_like(x))[:, None] if bar.f != 0 \
         else np.zeros((n, 0))
     load_time = [lambda t, f=bar.f: np.full(np.shape(t), f)] if bar.f != 0 else []
+    u0, v0 = (np.full(n, p) if isinstance(p, float) else space.interpolate(p)
+              for p in (bar.u0, bar.v0))
     return SemiDiscrete(
-        M=(bar.rho * space.M).tocsr(), K=(bar.a * space.S).tocsr(),
-        B=(bar.b * space.S).tocsr() if bar.b > 0 else None,
-        C=e0, lo=np.array([0.0]), hi=np.array([np.inf]), x_contact=np.array([0.0]),
-        loads=loads, load_time=load_time,
-        u0=np.full(n, bar.u0), v0=np.full(n, bar.v0),
-        # mean_u = (1/L)∫u dx: the centre of mass, and the load's potential −fL·mean_u
-        observe={"u0": e0.toarray().ravel(), "uL": eL,
-                 "mean_u": space.load_vector(np.ones_like) / bar.L}, space=space,
+        M=(bar.rho * A * space.M).tocsr(), K=(bar.a * A * space.S).tocsr(),
+        B=(bar.b * A * space.S).tocsr() if bar.b > 0 else None,
+        C=sp.csr_matrix((e0 if left else eL)[None, :]),
+        lo=np.array([0.0 if left else -np.inf]), hi=np.array([np.inf if left else 0.0]),
+        x_contact=np.array([0.0 if left else bar.L]),
+        loads=loads, load_time=load_time, u0=u0, v0=v0,
+        # mean_u = (1/L)∫u dx: the centre of mass, and the load's potential −fAL·mean_u
+        observe={"u0": e0, "uL": eL, "mean_u": space.load_vector(np.ones_like) / bar.L},
+        space=space,
         meta={"kind": "bar", "L": bar.L, "a": bar.a, "b": bar.b, "rho": bar.rho,
-              "obstacle": bar.obstacle, "k": bar.k, "N": bar.N, "mass": bar.mass},
+              "obstacle": bar.obstacle, "k": bar.k, "N": bar.N, "mass": bar.mass,
+              "far_end": bar.far_end, "obstacle_at": bar.obstacle_at, "A": bar.A},
         view=SceneView("bar", bar.L))
 
 
@@ -135,7 +296,8 @@ def spring_step_ratio(bar: Bar, dt: float) -> float:
     """ω₀Δt, ω₀ = √(k/m₀): the contact node (mass m₀ = M₀₀) on the spring.  Well above 1
     the β-weighted one-sided spring mis-times each impact on the node and can gain
     energy there (measured: ×36 over Example 2 with k = 1e8, Δt = 1e-3)."""
-    m0 = bar.rho * bar.h * {"consistent": 1 / 3, "lumped": 1 / 2, "average": 5 / 12}[bar.mass]
+    share = {"consistent": 1 / 3, "lumped": 1 / 2, "average": 5 / 12}[bar.mass]
+    m0 = bar.rho * bar.section * bar.h * share
     return math.sqrt(bar.k / m0) * dt
 
 
@@ -150,7 +312,7 @@ class BarRun:
     obstacle.  Energies: ``kinetic`` ½|δu/Δt|²_M, ``strain`` ½(βδuᵀKδu + uⁿᵀKuⁿ⁻¹)
     (the two halves of the scheme's conserved E_β), ``obstacle`` the spring's
     ½k(β(δU⁻)² + Uⁿ⁻U^{n−1,−}) (the same quadratic form while it is compressed),
-    ``energy`` their sum; ``load_potential`` −fL·ū (ū the mean displacement), so that
+    ``energy`` their sum; ``load_potential`` −fAL·ū (ū the mean displacement), so that
     ``energy + load_potential`` is what an elastic bar conserves.  The split needs every
     state: for very long runs (more than ``all_states_limit`` stored values) only
     ``energy`` is given and the split is NaN.
@@ -170,9 +332,14 @@ class BarRun:
     every: int = 1   # the series keep every ``every``-th step
 
     @property
+    def gap(self) -> np.ndarray:
+        """U(tₙ): u(0, tₙ) for the obstacle at x = 0, −u(L, tₙ) for the one at x = L."""
+        return self.u0 if self.bar.obstacle_at == "left" else -self.uL
+
+    @property
     def penetration(self) -> float:
-        """max(−u(0, tₙ)) ≥ 0 over the run (the spring's compression for a spring)."""
-        return float(max(0.0, -np.min(self.u0)))
+        """max(−U(tₙ)) ≥ 0 over the run (the spring's compression for a spring)."""
+        return float(max(0.0, -np.min(self.gap)))
 
     @property
     def wall_time_s(self) -> float:
@@ -227,7 +394,9 @@ class BarSeries:
         self.spring = _spring(bar, method)
         s = run.system
         self.names = list(s.observe)
-        Um0 = max(-s.u0[0], 0.0)
+        self.sign = bar.gap_sign                 # U = sign·(C u), R = sign·λ
+        self.end = "u0" if bar.obstacle_at == "left" else "uL"
+        Um0 = max(-self.sign * float((s.C @ s.u0)[0]), 0.0)
         self.obstacle0 = 0.5 * bar.k * (run.beta * 0.0 + Um0 * Um0) if self.spring else 0.0
         self.energy0 = 0.5 * s.v0 @ (s.M @ s.v0) + 0.5 * s.u0 @ (s.K @ s.u0) + self.obstacle0
 
@@ -244,11 +413,12 @@ class BarSeries:
         u0, first = obs["u0"], n == 0
         force = np.full(n.size, np.nan)
         known = (n >= 1) & (n + 1 <= run.n)      # force at tₙ = the force of step n → n+1
-        force[known] = run.lam[n[known] + 1, 0]
-        Um = np.maximum(-u0, 0.0)
+        force[known] = self.sign * run.lam[n[known] + 1, 0]
+        Um = np.maximum(-self.sign * obs[self.end], 0.0)
         if self.spring:
             force[first] = bar.k * Um[first]
-            Um_prev = np.maximum(-run.obs[np.maximum(n - 1, 0), self.names.index("u0")], 0.0)
+            Um_prev = np.maximum(-self.sign * run.obs[np.maximum(n - 1, 0),
+                                                      self.names.index(self.end)], 0.0)
             Um_prev[first] = Um[first]         # at t = 0: ½k(U⁻)² of the data
             obstacle = 0.5 * bar.k * (beta * (Um - Um_prev) ** 2 + Um * Um_prev)
         else:
@@ -270,7 +440,7 @@ class BarSeries:
             energy[first] = self.energy0
         return {"t": n * dt, "u0": u0, "uL": obs["uL"], "force": force, "kinetic": kinetic,
                 "strain": strain, "obstacle": obstacle, "energy": energy,
-                "load_potential": -bar.f * bar.L * obs["mean_u"]}
+                "load_potential": -bar.f * bar.section * bar.L * obs["mean_u"]}
 
     def columns(self, run, k0: int, k1: int) -> dict:
         """The timeseries.csv columns of the rows in [k0, k1)."""

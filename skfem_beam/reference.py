@@ -330,10 +330,9 @@ class BarExact:
 
     @classmethod
     def of(cls, bar, T):
-        """The exact solution of a :class:`skfem_beam.bar.Bar`, or None if not known (b > 0)."""
-        if bar.b != 0:
-            return None
-        return cls(bar.a, bar.rho, bar.L, bar.v0, T, bar.obstacle, bar.k, bar.f, bar.u0)
+        """The exact solution of a :class:`skfem_beam.bar.Bar` up to T, or None where none
+        is known (see :func:`exact_of`: it may be a :class:`RodExact`)."""
+        return exact_of(bar, T)
 
     def _tau(self, t):
         return self.c * np.asarray(t, dtype=float) / self.L
@@ -402,3 +401,177 @@ def bar_elastic_paper(x, t, k):
     out = np.where((x <= t) & (x + t < 2), r2, out)
     out = np.where((x + t >= 2) & (t - x < 2) & (x <= t), r3, out)
     return out
+
+
+# ---------------------------------------------------------------------------------------
+# The periodic rod: u_tt = c² u_xx on (0, L), clamped at x = L, rigid obstacle at x = 0
+# (u(0, t) ≥ 0, R = −a u_x(0, t) ≥ 0, R·u(0, t) = 0), released at rest from u0 = d(1 − x/L).
+#
+# Non-dimensional (ξ = x/L, τ = ct/L, w = u/d): w0 = 1 − ξ, w_τ(ξ, 0) = 0.  d'Alembert
+# w = F(ξ − τ) + G(ξ + τ); at rest F = G = (1 − s)/2 on [0, 1].  Three rules carry F, G:
+#
+#   clamp at ξ = 1:        G(1 + τ) = −F(1 − τ)                 (w(1, τ) = 0)
+#   free at ξ = 0:         F(−τ) = G(τ) + const                   (w_ξ(0, τ) = 0)
+#   contact at ξ = 0:      F(−τ) = −G(τ)                          (w(0, τ) = 0)
+#   contact while R = −w_ξ(0) = −2G'(τ) ≥ 0; free while U = w(0) = F(−τ) + G(τ) ≥ 0.
+#
+# τ ∈ [0, 1]: free, U = 2G = 1 − τ: the released end runs to the obstacle at speed 1
+#   (u_t = −cd/L) and arrives at τ = 1.
+# τ ∈ [1, 2]: G(τ) = −F(2 − τ) = (1 − τ)/2 continues to fall: a free end would go below 0,
+#   so contact, F(−τ) = (τ − 1)/2, R = −2G' = 1 > 0 (R = a·d/L dimensional).
+# τ ∈ [2, 3]: G(τ) = −F(2 − τ) = (τ − 3)/2 now rises, R = −1 < 0: release at τ = 2, free,
+#   F(−τ) = G(τ) + 1 = (τ − 1)/2, U = τ − 2 ≥ 0.
+# At τ = 3: w(ξ, 3) = F(ξ − 3) + G(ξ + 3) = (2 − ξ)/2 − ξ/2 = 1 − ξ and w_τ = 0: the data
+# again.  So w is 3-periodic in τ (period 3L/c), F and G on one period are the tables
+#
+#   F: s = −3, −1, 0, 1 → 1, 0, ½, 0          G: s = 0, 2, 3, 4 → ½, −½, 0, −½
+#
+# (piecewise linear, slopes ±½).  Hence w_τ² + w_ξ² = 2(F'² + G'²) = 1 everywhere: the
+# energy ½∫(ρu_t² + a u_x²) = ½ a d²/L at all times (1/8 for a = L = 1, d = ½).
+# ---------------------------------------------------------------------------------------
+
+class RodExact:
+    """The exact periodic rod (comment above), per unit cross-section, in physical units:
+    modulus ``a``, density ``rho``, length ``L``, initial gap ``d`` = u0(0) ≥ 0; ``T`` the
+    horizon of :meth:`contact_intervals`.  On a characteristic the derivatives are the
+    values just after t (F' from the left, G' from the right): at t = 0 the end at the
+    obstacle is already released, σ(0) = 0 and u_t(0) = −cd/L."""
+
+    _F = (np.array([-3.0, -1.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.5, 0.0]))
+    _G = (np.array([0.0, 2.0, 3.0, 4.0]), np.array([0.5, -0.5, 0.0, -0.5]))
+
+    def __init__(self, a=1.0, rho=1.0, L=1.0, d=0.5, T=3.0):
+        self.a, self.rho, self.L, self.d = float(a), float(rho), float(L), float(d)
+        if not self.d >= 0:
+            raise ValueError("d = u0(0) < 0 violates the rigid obstacle")
+        self.c = np.sqrt(self.a / self.rho)
+        self.T = float(T)
+        self.period = 3.0 * self.L / self.c
+
+    def _args(self, x, t):
+        xi = np.asarray(x, dtype=float) / self.L
+        tau = np.mod(self.c * np.asarray(t, dtype=float) / self.L, 3.0)
+        xi, tau = np.broadcast_arrays(xi, tau)
+        return xi - tau, xi + tau
+
+    @staticmethod
+    def _slope(table, s, side):
+        """The slope of the piecewise-linear table at s, from the ``side`` at a break."""
+        nodes, values = table
+        i = np.clip(np.searchsorted(nodes, s, side=side) - 1, 0, nodes.size - 2)
+        return (np.diff(values) / np.diff(nodes))[i]
+
+    def _slopes(self, x, t):
+        """F'(ξ − τ), G'(ξ + τ) just after t (ξ − τ decreases, ξ + τ increases in time)."""
+        s1, s2 = self._args(x, t)
+        return self._slope(self._F, s1, "left"), self._slope(self._G, s2, "right")
+
+    def u(self, x, t):
+        s1, s2 = self._args(x, t)
+        return self.d * (np.interp(s1, *self._F) + np.interp(s2, *self._G))
+
+    def velocity(self, x, t):
+        dF, dG = self._slopes(x, t)
+        return self.d * self.c / self.L * (dG - dF)
+
+    def strain(self, x, t):
+        dF, dG = self._slopes(x, t)
+        return self.d / self.L * (dF + dG)
+
+    def contact_force(self, t):
+        """R = a·d/L while in contact (ct/L ∈ [1, 2) mod 3, the value just after t), else 0."""
+        tau = np.mod(self.c * np.asarray(t, dtype=float) / self.L, 3.0)
+        return np.where((tau >= 1.0) & (tau < 2.0), self.a * self.d / self.L, 0.0)
+
+    def contact_intervals(self) -> list[tuple[float, float]]:
+        """(L/c, 2L/c) + m·3L/c for every start ≤ T (none when d = 0: nothing moves)."""
+        s = self.L / self.c
+        count = int(np.floor((self.T / s - 1.0) / 3.0 + 1e-12)) + 1 if self.d > 0 else 0
+        return [((1 + 3 * m) * s, (2 + 3 * m) * s) for m in range(max(count, 0))]
+
+    def energy(self, t, points: int = 4001) -> dict:
+        """Kinetic ½∫ρu_t², strain ½∫a u_x² (midpoint rule on ``points`` cells; the
+        densities are piecewise constant) and their total, ½ a d²/L at every t."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        x = (np.arange(points) + 0.5) * self.L / points
+        X, Tm = np.meshgrid(x, t)
+        kin = 0.5 * self.rho * (self.velocity(X, Tm) ** 2).sum(axis=1) * self.L / points
+        strain = 0.5 * self.a * (self.strain(X, Tm) ** 2).sum(axis=1) * self.L / points
+        return {"kinetic": kin, "strain": strain, "obstacle": np.zeros(t.shape),
+                "total": kin + strain}
+
+
+class Oriented:
+    """An exact solution (per unit cross-section, obstacle at x = 0) seen in the bar's own
+    frame: mirrored (x → L − x, u → −u) when the obstacle is at x = L, and forces and
+    energies times the cross-section A when the bar has one."""
+
+    def __init__(self, exact, L: float, mirrored: bool, section: float = 1.0):
+        self.exact, self.L, self.mirrored, self.section = exact, float(L), mirrored, section
+
+    def _x(self, x):
+        x = np.asarray(x, dtype=float)
+        return self.L - x if self.mirrored else x
+
+    def u(self, x, t):
+        u = self.exact.u(self._x(x), t)
+        return -u if self.mirrored else u
+
+    def velocity(self, x, t):
+        v = self.exact.velocity(self._x(x), t)
+        return -v if self.mirrored else v
+
+    def strain(self, x, t):     # d/dx[−w(L − x)] = w'(L − x): the strain keeps its sign
+        return self.exact.strain(self._x(x), t)
+
+    def contact_force(self, t):
+        return self.section * self.exact.contact_force(t)
+
+    def contact_intervals(self):
+        return self.exact.contact_intervals()
+
+    def energy(self, t, points: int = 4001) -> dict:
+        return {k: self.section * v for k, v in self.exact.energy(t, points).items()}
+
+
+def exact_of(bar, T: float):
+    """The exact solution of a :class:`skfem_beam.bar.Bar` up to T, or None.
+
+    Known (elastic bar, b = 0): a free far end with uniform u0, v0 and f
+    (:class:`BarExact`), and the periodic rod (:class:`RodExact`: far end clamped, rigid
+    obstacle, f = 0, v0 = 0, u0 a table linear from the gap d at the obstacle to 0 at
+    the clamp).  Either end and a cross-section A are handled by :class:`Oriented`.
+    """
+    if bar.b != 0:
+        return None
+    left = bar.obstacle_at == "left"
+    sign, A = (1.0 if left else -1.0), bar.section
+    if bar.far_end == "free":
+        if not (isinstance(bar.u0, float) and isinstance(bar.v0, float)):
+            return None
+        ex = BarExact(bar.a, bar.rho, bar.L, sign * bar.v0, T, bar.obstacle, bar.k / A,
+                      sign * bar.f, sign * bar.u0)
+    else:
+        d = _rod_gap(bar, sign)
+        if d is None or bar.obstacle != "rigid" or bar.f != 0 or bar.v0 != 0.0:
+            return None
+        ex = RodExact(bar.a, bar.rho, bar.L, d, T)
+    return ex if left and bar.A is None else Oriented(ex, bar.L, not left, A)
+
+
+def _rod_gap(bar, sign: float):
+    """d if u0, seen from the obstacle's end (ξ = distance to it), is d(1 − ξ/L) exactly
+    (a number 0, or a table that is that line on [0, L]); else None."""
+    u0, L = bar.u0, bar.L
+    if isinstance(u0, float):
+        return 0.0 if u0 == 0.0 else None
+    if not hasattr(u0, "x"):          # a function: linearity cannot be checked exactly
+        return None
+    inside = [x for x in u0.x if 0.0 < x < L]
+    xi = np.array([0.0, *inside, L])          # abscissae measured in the bar's frame
+    dist = xi if sign > 0 else L - xi         # distance to the obstacle
+    w = sign * u0(xi)                         # the rod's displacement in its own frame
+    d = float(w[dist.argmin()])
+    if np.abs(w - d * (1.0 - dist / L)).max() > 1e-12 * max(abs(d), 1e-300):
+        return None
+    return d

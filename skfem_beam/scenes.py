@@ -5,6 +5,7 @@
     scenes.convex_obstacles()   second paper, Table 2: g = ±(0.005 + 0.03 (x − L/2)²)
     scenes.energy_decay()       second paper, Figs 4–7: f = 0, energy drops only at impacts
     scenes.impacting_bar()      third paper, Example 1 (and 2 with f=−1)
+    scenes.periodic_rod()       clamped rod released onto a rigid obstacle: 3-periodic, exact
 
 The case modules, the benchmarks, the notebooks and the tests all build their scenes
 here; the command line only maps its flags onto these keyword arguments.
@@ -84,3 +85,14 @@ def impacting_bar(**kw) -> Bar:
     """Example 1 of Do, Raupp & Feijoo (rigid obstacle; ``obstacle="elastic"`` for the
     spring k = 100; ``f=-1`` for Example 2); keywords as :class:`~skfem_beam.bar.Bar`."""
     return Bar(**kw)
+
+
+def periodic_rod(N=80, *, gap=0.5, L=1.0, a=1.0, rho=1.0, mass="average", obstacle_at="left",
+                 A=None) -> Bar:
+    """Clamped at the far end, rigid obstacle at the other, released at rest from the line
+    u0 = gap·(1 − distance to the obstacle/L) (½ − x/2 by default).  Its exact solution
+    (:class:`~skfem_beam.reference.RodExact`) has period 3L/c and energy ½·a·gap²/L·A
+    (1/8 for the defaults, A = 1)."""
+    u0 = [(0.0, gap), (L, 0.0)] if obstacle_at in ("left", 0) else [(0.0, 0.0), (L, -gap)]
+    return Bar(a=a, rho=rho, L=L, v0=0.0, u0=u0, obstacle="rigid", N=N, mass=mass,
+               far_end="clamped", obstacle_at=obstacle_at, A=A)

@@ -2,6 +2,7 @@
 convergence, energy, Example 2, speed, bad input and the command-line case."""
 import csv
 import json
+import re
 import subprocess
 import sys
 
@@ -378,3 +379,138 @@ def test_case_disk_full_then_resume_is_bit_identical(tmp_path, monkeypatch, caps
     a, b = (json.loads((d / "summary.json").read_text()) for d in (out, ref))
     for key in ("steps", "impacts", "errors", "energy", "max_penetration", "status"):
         assert a[key] == b[key], key
+
+
+# --- profiles, either end, clamped far end, cross-section (issue "own beam and bar") -------
+
+def test_profiles_equal_the_uniform_numbers():
+    """A table or a function that is the uniform value gives the same run, bit for bit."""
+    ref = run_bar(Bar(obstacle="elastic", u0=0.05, N=20), 5e-3, 1.5)
+    for u0, v0 in (([(0, 0.05), (1, 0.05)], [(0, -1.0), (1, -1.0)]),
+                   (lambda x: 0 * x + 0.05, lambda x: np.full_like(x, -1.0))):
+        got = run_bar(Bar(obstacle="elastic", u0=u0, v0=v0, N=20), 5e-3, 1.5)
+        assert np.array_equal(got.u0, ref.u0) and np.array_equal(got.uL, ref.uL)
+        assert np.array_equal(got.energy, ref.energy)
+
+
+def test_profile_is_interpolated_at_the_nodes():
+    bar = Bar(u0=[(0, 0.2), (0.5, 0.0), (1, 0.3)], v0=lambda x: x**2, N=4, obstacle="elastic")
+    s = bar_system(bar)
+    assert s.u0 == pytest.approx([0.2, 0.1, 0.0, 0.15, 0.3], abs=1e-16)
+    assert s.v0 == pytest.approx([0.0, 1 / 16, 1 / 4, 9 / 16, 1.0], abs=1e-16)
+
+
+def test_obstacle_at_the_right_end_is_the_mirror_image():
+    """Elastic Example 1 mirrored (obstacle at x = L, v0 = +1): u(L) = −u(0) of the original,
+    the same reaction R ≥ 0 and energy, and the same errors against the mirrored exact."""
+    left = run_bar(Bar(obstacle="elastic", N=50), 2e-3, 2.5)
+    right = run_bar(Bar(obstacle="elastic", obstacle_at="right", v0=1.0, N=50), 2e-3, 2.5)
+    # equal to round-off (the other end's sums run in the other order): 1.6e-13 measured
+    assert np.abs(right.uL + left.u0).max() < 1e-12 and np.abs(right.u0 + left.uL).max() < 1e-12
+    assert np.nanmax(np.abs(right.force - left.force)) < 1e-10 and np.nanmax(right.force) > 0.5
+    assert np.abs(right.energy - left.energy).max() < 1e-12
+    assert right.penetration == pytest.approx(left.penetration, rel=1e-9)
+    el, er = errors(left, BarExact.of(left.bar, 2.5)), errors(right, BarExact.of(right.bar, 2.5))
+    assert er["l2_uL"] == pytest.approx(el["l2_u0"], rel=1e-9)
+    assert er["l2_force"] == pytest.approx(el["l2_force"], rel=1e-9)
+    s = bar_system(right.bar)
+    assert s.lo[0] == -np.inf and s.hi[0] == 0.0 and s.x_contact[0] == 1.0
+    assert Bar(obstacle_at=1.0).obstacle_at == "right" and Bar(obstacle_at=0).obstacle_at == "left"
+
+
+def test_clamped_far_end_drops_its_node_and_reflects_with_a_sign_change():
+    """u0 = 0, v0 = −1 towards the obstacle at x = 0, the far end x = L clamped: the node
+    at L is gone, u(L, t) ≡ 0, and ½E_β is conserved until the first impact."""
+    bar = Bar(far_end="clamped", u0=0.0, v0=-1.0, obstacle="rigid", N=40)
+    s = bar_system(bar)
+    assert s.n == 40 and np.all(s.observe["uL"] == 0) and s.observe["u0"][0] == 1.0
+    # ρL less the clamped node's row and column: 2h/3 (consistent), h/2 (lumped), mean 7h/12
+    assert s.M.sum() == pytest.approx(1.0 - 7 / 12 / 40, abs=1e-15)
+    run = run_bar(bar, 0.01, 1.0)
+    assert np.all(run.uL == 0.0) and run.penetration <= 1e-15
+    assert BarExact.of(bar, 1.0) is None                         # no exact solution known
+
+
+def test_cross_section_gives_newtons_and_joules():
+    """A multiplies M, K and the load: u is unchanged, forces (N) and energies (J) scale by A;
+    the spring k is then in N/m, i.e. k/A per unit section."""
+    A = 2e-4
+    per = run_bar(Bar(obstacle="elastic", f=-1.0, N=30), 5e-3, 3.0)
+    phys = run_bar(Bar(obstacle="elastic", f=-1.0, N=30, A=A, k=100.0 * A), 5e-3, 3.0)
+    assert np.abs(phys.u0 - per.u0).max() < 1e-13
+    assert np.nanmax(np.abs(phys.force - A * per.force)) < 1e-12
+    assert np.abs(phys.energy + phys.load_potential - A * (per.energy + per.load_potential)
+                  ).max() < 1e-15
+    e_per, e_phys = errors(per, BarExact.of(per.bar, 3.0)), errors(phys, BarExact.of(phys.bar, 3.0))
+    assert e_phys["l2_u0"] == pytest.approx(e_per["l2_u0"], rel=1e-8)
+    assert e_phys["l2_force"] == pytest.approx(A * e_per["l2_force"], rel=1e-8)
+    assert Bar(a=3.0).E == 3.0
+
+
+@pytest.mark.parametrize("kw, word", [
+    (dict(u0=[(0, 0.1), (0.5, 0.2), (0.5, 0.3), (1, 0)]), "x must increase"),
+    (dict(u0=[(0, 0.1), (0.9, 0.1)]), "covers [0, 0.9]"),
+    (dict(u0=[(0, 0.1)]), "at least two"),
+    (dict(u0="abc"), "u0='abc'"),
+    (dict(v0=lambda x: np.where(x < 0.5, np.nan, x)), "v0(x=0)=nan"),
+    (dict(v0=lambda x: float(x)), "function failed"),
+    (dict(u0=[(0, -0.1), (1, 0.2)]), "u(0,0)=-0.1 < 0"),
+    (dict(obstacle_at="right", u0=0.1), "u(L,0)=u0=0.1 > 0"),
+    (dict(far_end="clamped", u0=0.1), "u0=0.1 at the clamped end x=1"),
+    (dict(far_end="pinned"), "far_end='pinned'"), (dict(obstacle_at="top"), "obstacle_at='top'"),
+    (dict(obstacle_at=0.5), "obstacle_at=0.5"), (dict(A=0), "A=0"), (dict(A=-1e-4), "A=-0.0001"),
+])
+def test_bar_refuses_bad_new_input(kw, word):
+    with pytest.raises(InputError, match=re.escape(word)) as e:
+        Bar(**kw)
+    assert "\n" not in str(e.value)
+
+
+def test_case_periodic_rod_from_a_csv(tmp_path):
+    """The rod through the command line: the exact solution is found and written beside."""
+    from conftest import exit_code
+    from skfem_beam.cases import impacting_bar
+    csv_path = tmp_path / "rod.csv"
+    csv_path.write_text("x,u\n0,0.5\n1,0\n")
+    out = tmp_path / "run"
+    assert exit_code(impacting_bar.main, [
+        "--far-end", "clamped", "--v0", "0", "--u0-csv", str(csv_path), "--N", "40",
+        "--dt", "0.01", "--T", "3", "--format", "none", "--out", str(out)]) == 0
+    s = json.loads((out / "summary.json").read_text())
+    assert SUMMARY_KEYS <= set(s) and s["exact_solution"] is True
+    assert s["exact_contact_periods"] == [[1.0, 2.0]] and s["impacts"] == 1
+    assert s["max_penetration"] <= 1e-15 and s["errors"]["l2_u0"] < 0.04
+    assert s["bar"]["u0"] == {"x": [0.0, 1.0], "value": [0.5, 0.0]}
+    rows = list(csv.DictReader(open(out / "timeseries.csv")))
+    assert float(rows[0]["energy"]) == pytest.approx(0.125, abs=1e-13)
+    assert float(rows[0]["energy_exact"]) == pytest.approx(0.125, abs=1e-13)
+
+
+def test_case_right_obstacle_and_cross_section(tmp_path):
+    from conftest import exit_code
+    from skfem_beam.cases import impacting_bar
+    out = tmp_path / "run"
+    assert exit_code(impacting_bar.main, [
+        "--obstacle-at", "right", "--v0", "1", "--A", "1e-4", "--E", "2", "--N", "40",
+        "--dt", "0.005", "--T", "2", "--format", "none", "--out", str(out)]) == 0
+    s = json.loads((out / "summary.json").read_text())
+    assert s["units"]["contact_force"] == "N" and s["bar"]["a"] == 2.0
+    assert s["max_penetration"] <= 1e-15 and s["impacts"] == 1
+    rows = list(csv.DictReader(open(out / "timeseries.csv")))
+    R = np.array([float(r["contact_force_exact"]) for r in rows])
+    assert R.max() == pytest.approx(1e-4 * np.sqrt(2.0))       # A·ρc|v0|
+
+
+@pytest.mark.parametrize("content, word", [("0,0.5\n0,0\n", "x must increase"),
+                                           ("0,0.5\n1,zero\n", "line 2"), (None, "cannot read")])
+def test_case_bad_csv_one_line_no_output(tmp_path, capsys, content, word):
+    from skfem_beam.cases import impacting_bar
+    path = tmp_path / "in" / "u0.csv"
+    if content is not None:
+        path.parent.mkdir()
+        path.write_text(content)
+    folder = tmp_path / "outs"
+    folder.mkdir()
+    assert_refused(impacting_bar.main, ["--far-end", "clamped", "--v0", "0", "--u0-csv",
+                                        str(path), "--out", str(folder / "run")], word, capsys,
+                   folder)

@@ -1,15 +1,22 @@
-"""The third paper's scene: a (visco)elastic bar hitting an obstacle at x = 0.
+"""The third paper's scene: a (visco)elastic bar hitting an obstacle at one end.
 
     python -m skfem_beam.cases.impacting_bar [--obstacle rigid|elastic] [--k 100]
-        [--a 1] [--b 0] [--rho 1] [--L 1] [--f 0] [--v0 -1] [--u0 0] [--N 100]
+        [--a|--E 1] [--b 0] [--rho 1] [--A m²] [--L 1] [--f 0] [--v0 -1] [--u0 0]
+        [--u0-csv FILE] [--v0-csv FILE] [--far-end free|clamped]
+        [--obstacle-at left|right] [--N 100]
         [--dt 1e-3] [--T 3] [--beta 0.25] [--method contact|penalty]
         [--mass average|consistent|lumped] [--save-every 1] [--frames 200] [--out DIR]
         [--checkpoint-every S] [--resume DIR]
 
 Example 1 of Do, Raupp & Feijoo is the default (add ``--obstacle elastic`` for the
-spring k = 100); Example 2 is ``--f -1 --T 6``.  Writes into DIR: summary.json,
-timeseries.csv (u(0,t), u(L,t), reaction, energies, and the exact solution beside
-them when it is known, i.e. b = 0), the field series (XDMF and/or VTU, --format), and charts,
+spring k = 100); Example 2 is ``--f -1 --T 6``.  The periodic rod (exact solution
+known, docs/design.md §1) is ``--far-end clamped --v0 0 --u0-csv rod.csv`` with the two
+rows ``0,0.5`` and ``1,0``.  ``--u0-csv``/``--v0-csv`` read x,value rows (linear in
+between; they replace --u0/--v0).  With ``--A`` forces are in N, energies in J and
+``--k`` is in N/m; without it everything is per unit cross-section (Pa, J/m², Pa/m).
+Writes into DIR: summary.json, timeseries.csv (u(0,t), u(L,t), reaction, energies, and
+the exact solution beside them when it is known: b = 0 and uniform data with a free far
+end, or the periodic rod), the field series (XDMF and/or VTU, --format), and charts,
 through the same streaming pipeline as the beam scenes (checkpoints, --resume).
 
 Defaults and why: ``--mass average`` (the mean of consistent and lumped mass cancels
@@ -24,7 +31,8 @@ from __future__ import annotations
 from dataclasses import replace
 
 from .. import cli
-from ..bar import Bar, BarSeries, bar_run, contact_periods, energy_report, errors, spring_step_ratio
+from ..bar import (Bar, BarSeries, bar_run, contact_periods, describe, energy_report, errors,
+                   read_profile, spring_step_ratio)
 from ..output.charts import compare_chart
 from ..output.series import Series, execute, prepare
 from ..checks import check_positive
@@ -38,22 +46,35 @@ def main(argv=None) -> int:
                    beta=0.25, element=False)
     p.add_argument("--obstacle", default="rigid", help="rigid | elastic")
     p.add_argument("--k", type=float, default=100.0, help="elastic obstacle: R = k·U⁻ (Pa/m)")
-    p.add_argument("--a", type=float, default=1.0, help="modulus (Pa)")
+    p.add_argument("--a", "--E", dest="a", type=float, default=1.0,
+                   help="Young's modulus E (Pa)")
     p.add_argument("--b", type=float, default=0.0, help="Kelvin–Voigt viscosity (Pa·s)")
     p.add_argument("--rho", type=float, default=1.0, help="density (kg/m³)")
+    p.add_argument("--A", type=float, default=None,
+                   help="cross-section (m²): forces in N, energies in J, --k in N/m "
+                        "(default: per unit cross-section)")
     p.add_argument("--L", type=float, default=1.0, help="length (m)")
     p.add_argument("--f", type=float, default=0.0, help="uniform body force (N/m³)")
     p.add_argument("--v0", type=float, default=-1.0, help="uniform initial velocity (m/s)")
     p.add_argument("--u0", type=float, default=0.0,
                    help="uniform initial displacement, the gap to the obstacle (m)")
+    p.add_argument("--u0-csv", default=None, metavar="FILE",
+                   help="initial displacement as x,u rows (replaces --u0)")
+    p.add_argument("--v0-csv", default=None, metavar="FILE",
+                   help="initial velocity as x,v rows (replaces --v0)")
+    p.add_argument("--far-end", default="free", help="free | clamped: the end without obstacle")
+    p.add_argument("--obstacle-at", default="left", help="left (x = 0) | right (x = L)")
     p.add_argument("--N", type=int, default=100, help="number of P1 elements")
     p.add_argument("--mass", default="average", help="average | consistent | lumped")
     args = cli.parse(p, argv)
 
     cli.check_method(args)
     dt, T = args.dt, args.T          # checked by the run's Stepping (bar_run)
-    bar = Bar(a=args.a, b=args.b, rho=args.rho, L=args.L, f=args.f, v0=args.v0, u0=args.u0,
-              obstacle=args.obstacle, k=args.k, N=args.N, mass=args.mass)
+    u0 = read_profile(args.u0_csv, "--u0-csv") if args.u0_csv else args.u0
+    v0 = read_profile(args.v0_csv, "--v0-csv") if args.v0_csv else args.v0
+    bar = Bar(a=args.a, b=args.b, rho=args.rho, L=args.L, f=args.f, v0=v0, u0=u0,
+              obstacle=args.obstacle, k=args.k, N=args.N, mass=args.mass,
+              far_end=args.far_end, obstacle_at=args.obstacle_at, A=args.A)
     penalty = args.method == "penalty" and bar.obstacle == "rigid"
     if penalty:   # the rigid obstacle approximated by a spring of stiffness 1/ε
         bar = replace(bar, k=check_positive("stiffness", args.stiffness))
@@ -83,13 +104,17 @@ def main(argv=None) -> int:
         "method": args.method, "obstacle": bar.obstacle,
         "spring_stiffness": bar.k if spring else None,
         "bar": {"a": bar.a, "b": bar.b, "rho": bar.rho, "L": bar.L, "f": bar.f,
-                "v0": bar.v0, "u0": bar.u0, "k": bar.k, "c": bar.c},
-        "units": {"displacement": "m", "contact_force": "Pa (force per unit cross-section)",
-                  "energy": "J/m² (per unit cross-section)",
+                "v0": describe(bar.v0), "u0": describe(bar.u0), "k": bar.k, "c": bar.c,
+                "far_end": bar.far_end, "obstacle_at": bar.obstacle_at, "A": bar.A},
+        "units": {"displacement": "m",
+                  "contact_force": "Pa (force per unit cross-section)" if bar.A is None
+                  else "N",
+                  "energy": "J/m² (per unit cross-section)" if bar.A is None else "J",
+                  "spring_stiffness": "Pa/m" if bar.A is None else "N/m",
                   "errors": "L² in time over the saved rows: √(Δt Σ eₙ²) (Δt the row "
                             "spacing); contact force from t₁ on",
-                  "max_penetration": "m: max(−u(0,tₙ)) over the saved rows (a spring's "
-                                     "compression)",
+                  "max_penetration": "m: max(−U(tₙ)) over the saved rows, U = u(0) or "
+                                     "−u(L) at the obstacle (a spring's compression)",
                   "wall_time_s": "the time loop alone (one step past T, for R at T)"},
         "notes": ("energy = kinetic + strain + obstacle, the scheme's E_β/2 split; "
                   "energy_final and the energy report add the load potential −fL·ū"),
@@ -99,17 +124,21 @@ def main(argv=None) -> int:
     def finish(folder, data, run):
         b = series.bar_run(data, run.result())
         periods = contact_periods(b.t, b.force, 0.1 * bar.L / bar.c)
-        title = (f"{bar.obstacle} obstacle{f' k={bar.k:g}' if spring else ''}, f={bar.f:g}, "
+        side = "" if (bar.obstacle_at, bar.far_end) == ("left", "free") else \
+            f" at x={'0' if bar.obstacle_at == 'left' else 'L'}, {bar.far_end} far end"
+        title = (f"{bar.obstacle} obstacle{f' k={bar.k:g}' if spring else ''}{side}, f={bar.f:g}, "
                  f"N={bar.N}, Δt={run.dt:g}, β={run.beta:g}, {bar.mass} mass")
         compare_chart(folder / "displacement.png", b.t, {"u(0, t)": b.u0, "u(L, t)": b.uL},
                       {"u(0, t) exact": data.get("u_0_exact"),
                        "u(L, t) exact": data.get("u_L_exact")}, title, "displacement (m)")
         compare_chart(folder / "contact_force.png", b.t, {"reaction R": b.force},
-                      {"R exact": data.get("contact_force_exact")}, title, "R (Pa)")
+                      {"R exact": data.get("contact_force_exact")}, title,
+                      "R (Pa)" if bar.A is None else "R (N)")
         compare_chart(folder / "energy.png", b.t,
                       {"kinetic": b.kinetic, "strain": b.strain, "obstacle": b.obstacle,
                        "total": b.energy + b.load_potential},
-                      {"exact total": data.get("energy_exact")}, title, "energy (J/m²)")
+                      {"exact total": data.get("energy_exact")}, title,
+                      "energy (J/m²)" if bar.A is None else "energy (J)")
         return {
             "T": float(b.t[-1]), "steps": min(run.n, series.n_steps),
             "max_penetration": b.penetration, "max_nodal_violation": b.penetration,

@@ -15,7 +15,9 @@ sweep started again with the same settings skips the values whose file exists.  
 the end the files are assembled into ``poincare.csv`` (one row per section point),
 ``runs.csv`` (one row per value: impacts, contact-time fraction, detected period),
 ``bifurcation.png`` and ``sweep.json``; the command's ``summary.json`` carries its status
-("running" until the end).  The CSV files hold only deterministic data
+("running" until the end).  On a cluster a value whose worker dies is tried again
+(``RETRIES`` times), then recorded "failed" in ``runs.csv`` (not in ``runs/``: the same
+command run again retries it) while the others finish.  The CSV files hold only deterministic data
 (floats written exactly, as Python's repr): they are identical for any number of
 workers.
 

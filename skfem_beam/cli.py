@@ -6,12 +6,15 @@ Exit codes: 0 success, 2 bad input, 3 a solver failed, 4 the run went unstable
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
+import threading
 
 from . import __version__
 from .contact import SOLVERS
 from .errors import InputError, SolverError
-from .output.folder import EXIT_INPUT, EXIT_SOLVER, EXIT_UNSTABLE, report, stamp  # noqa: F401
+from .output.folder import (EXIT_INPUT, EXIT_SOLVER, EXIT_UNSTABLE, OPENED,  # noqa: F401
+                            Interrupted, release, report, stamp)
 from .output.series import stored_args
 
 
@@ -64,7 +67,7 @@ def parser(prog: str, description: str, *, J=None, dt=None, T=None, beta=None,
 
 def parse(p: Parser, argv=None):
     """Parse the flags; with --resume, the flags stored by the run being resumed."""
-    args = stored_args(p.parse_args(argv), p)
+    args = stored_args(p.parse_args(argv), p, argv)
     if getattr(args, "beta", 0.5) is None:   # the papers: β = 1/2 for contact, 1/4 for penalty
         args.beta = 0.25 if getattr(args, "method", "contact") == "penalty" else 0.5
     return args
@@ -83,8 +86,19 @@ def check_method(args) -> None:
         raise InputError(f"--method {args.method!r} is not one of: contact, penalty")
 
 
+def _terminate(signum, frame):
+    raise Interrupted(signum)
+
+
 def main_guard(main) -> None:
-    """Run ``main()``; turn the project's errors into one stderr line and an exit code."""
+    """Run ``main()``; turn the project's errors into one stderr line and an exit code.
+
+    SIGTERM is turned into :class:`~skfem_beam.output.folder.Interrupted` like SIGINT
+    (a run in progress handles both itself: it stops at a chunk and keeps its files);
+    the exit code is 128 + the signal.  Folder locks are released on any exit."""
+    opened = len(OPENED)
+    old = signal.signal(signal.SIGTERM, _terminate) \
+        if threading.current_thread() is threading.main_thread() else None
     try:
         code = main()
     except InputError as e:
@@ -96,9 +110,16 @@ def main_guard(main) -> None:
     except OSError as e:   # disk full, folder removed under us, ...
         print(f"error: could not write the results: {e}", file=sys.stderr)
         sys.exit(EXIT_SOLVER)
-    except KeyboardInterrupt:
-        print("interrupted: no output written", file=sys.stderr)
-        sys.exit(130)
+    except KeyboardInterrupt as e:
+        name = signal.Signals(getattr(e, "signum", signal.SIGINT)).name
+        where = f"see {OPENED[-1] / 'summary.json'}" if len(OPENED) > opened \
+            else "no output written"
+        print(f"interrupted by {name}: {where}", file=sys.stderr)
+        sys.exit(getattr(e, "code", 130))
+    finally:
+        release()
+        if old is not None:
+            signal.signal(signal.SIGTERM, old)
     sys.exit(code or 0)
 
 

@@ -1,6 +1,6 @@
 """Parameter sweeps and bifurcation diagrams, on one core or a Dask cluster.
 
-    python -m skfem_beam.sweep --scene point_stops --param omega --values 5:40:200 \\
+    python -m skfem_beam.sweep --scene point_stops --param omega --values 'linspace(5, 40, 200)' \\
         [--transient 2 --periods 50] [--workers N | --scheduler tcp://HOST:PORT] --out DIR
 
 Each parameter value is one independent, deterministic run (one Dask task).  The run
@@ -15,7 +15,9 @@ sweep started again with the same settings skips the values whose file exists.  
 the end the files are assembled into ``poincare.csv`` (one row per section point),
 ``runs.csv`` (one row per value: impacts, contact-time fraction, detected period),
 ``bifurcation.png`` and ``sweep.json``; the command's ``summary.json`` carries its status
-("running" until the end).  The CSV files hold only deterministic data
+("running" until the end).  On a cluster a value whose worker dies is tried again
+(``RETRIES`` times), then recorded "failed" in ``runs.csv`` (not in ``runs/``: the same
+command run again retries it) while the others finish.  The CSV files hold only deterministic data
 (floats written exactly, as Python's repr): they are identical for any number of
 workers.
 
@@ -34,6 +36,7 @@ import inspect
 import json
 import math
 import os
+import re
 import sys
 import time
 from pathlib import Path
@@ -42,7 +45,7 @@ import numpy as np
 
 from . import cli, scenes
 from .errors import InputError, SolverError
-from .output.folder import Folder, atomic_write, check_output_dir, stamp
+from .output.folder import EXIT_SOLVER, Folder, atomic_write, check_output_dir, stamp
 from .checks import check_beta, check_positive
 
 # scene name -> (problem factory, parameters that may be swept or set)
@@ -63,21 +66,32 @@ def scene_defaults(scene: str) -> dict:
     return {n: sig.parameters[n].default for n in names}
 
 
+_LINSPACE = re.compile(r"^linspace\(([^,()]+),([^,()]+),([^,()]+)\)$")
+
+
 def parse_values(spec: str) -> list[float]:
-    """``a:b:n`` (n values from a to b, both included) or a comma list ``v1,v2,...``."""
+    """``linspace(a, b, n)`` (n values from a to b, both included, as numpy.linspace) or
+    an explicit comma list ``v1,v2,...``.  ``a:b:c`` is refused: MATLAB reads it as
+    start:step:stop, an older version of this command read it as start:stop:count."""
     spec = str(spec).strip()
-    parts = spec.split(":")
+    text = spec.replace(" ", "")
+    if ":" in text:
+        raise InputError(f"--values {spec!r}: a:b:c is ambiguous (start:step:stop in MATLAB); "
+                         "write linspace(5, 40, 200) for 200 values from 5 to 40, or a "
+                         "comma list 5,10,20")
+    m = _LINSPACE.match(text)
     try:
-        if len(parts) == 3 and parts[2].strip().lstrip("+-").isdigit():
-            a, b, n = float(parts[0]), float(parts[1]), int(parts[2])
-        elif len(parts) == 1:
-            values = [float(v) for v in spec.split(",")]
+        if m:
+            a, b, n = float(m[1]), float(m[2]), m[3]
+            if not n.lstrip("+-").isdigit():
+                raise ValueError
+            n = int(n)
         else:
-            raise ValueError
+            values = [float(v) for v in text.split(",")]
     except ValueError:
-        raise InputError(f"--values {spec!r} is not a:b:n (n values from a to b) "
-                         "or a comma list of numbers") from None
-    if len(parts) == 3:
+        raise InputError(f"--values {spec!r} is not linspace(a, b, n) (n values from a to "
+                         "b) or a comma list of numbers") from None
+    if m:
         if n < 1:
             raise InputError(f"--values {spec!r}: n={n} must be at least 1")
         values = [a] if n == 1 else np.linspace(a, b, n).tolist()
@@ -363,13 +377,57 @@ def dask_client(workers: int | None = None, scheduler: str | None = None):
         yield client
 
 
+RETRIES = 2     # a value whose worker dies is tried again this many times
+
+
+def lost(settings: dict, value: float, error: BaseException, attempts: int) -> dict:
+    """The result of a value whose task never finished (its worker died every time):
+    "failed", not saved in runs/, so that the same command run again retries it."""
+    return {"param": settings["param"], "value": float(value), "settings": settings,
+            "omega": section_plan(settings, value)[3], "dt": None, "steps_per_period": None,
+            "transient_periods": None, "k": [], "t": [], "tip_displacement": [],
+            "tip_velocity": [], "impacts": None, "impacts_per_period": None,
+            "contact_fraction": None, "impacts_total": None, "status": "failed",
+            "message": f"{type(error).__name__} after {attempts} attempts: {error}",
+            "timing": {"task_s": 0.0, "task_cpu_s": 0.0, "time_loop_s": 0.0, "steps": 0,
+                       "pid": None}}
+
+
+def _on_cluster(client, task, settings: dict, todo: list[float]):
+    """Results as they finish; a task that raises (a killed worker: KilledWorker) is
+    submitted again up to RETRIES times, then given up as :func:`lost`."""
+    from distributed import as_completed
+    attempts = {v: 1 for v in todo}
+    key = {}
+
+    def submit(v):
+        f = client.submit(task, settings, v, key=f"sweep-{v!r}-{attempts[v]}", pure=False)
+        key[f.key] = v
+        return f
+
+    queue = as_completed([submit(v) for v in todo])
+    for f in queue:
+        v = key[f.key]
+        try:
+            yield f.result()
+        except Exception as e:     # the worker died (KilledWorker) or the task broke
+            if attempts[v] > RETRIES:
+                yield lost(settings, v, e, attempts[v])
+            else:
+                attempts[v] += 1
+                queue.add(submit(v))
+
+
 def sweep(settings: dict, values: list[float], out, client=None, progress: bool = True,
-          warm: bool = True) -> dict:
+          warm: bool = True, task=None) -> dict:
     """Run every value not yet in ``out/runs`` (serially, or on ``client``), then assemble.
 
     Returns the summary (also written to ``out/sweep.json``); the per-value results are
-    the files in ``out/runs``.
+    the files in ``out/runs``.  On a cluster a value whose worker dies is retried
+    (RETRIES times), then marked failed in runs.csv while the others finish.
+    ``task``: what runs one value (default :func:`run_value`).
     """
+    task = task or run_value
     from tqdm import tqdm
     out = Path(out)
     (out / "runs").mkdir(parents=True, exist_ok=True)
@@ -388,21 +446,19 @@ def sweep(settings: dict, values: list[float], out, client=None, progress: bool 
                 client.run(warm_up, settings, todo[0])
             warm_s = time.perf_counter() - t
         t_runs = time.perf_counter()
-        if client is None:
-            finished = (run_value(settings, v) for v in todo)
-        else:
-            from distributed import as_completed
-            futures = [client.submit(run_value, settings, v, pure=True) for v in todo]
-            finished = (f.result() for f in as_completed(futures))
+        finished = (task(settings, v) for v in todo) if client is None else \
+            _on_cluster(client, task, settings, todo)
         for r in finished:
-            save_run(out, r)
+            if r["timing"]["pid"] is not None:    # a lost value is not saved: retried later
+                save_run(out, r)
             done[r["value"]] = r
             bar.update(1)
         runs_s = time.perf_counter() - t_runs
     finally:
         bar.close()
     results = [done[v] for v in values]
-    timing = {"values_run": len(todo), "values_resumed": len(values) - len(todo),
+    timing = {"values_run": len(todo), "values_lost": sum(
+        done[v]["timing"]["pid"] is None for v in todo), "values_resumed": len(values) - len(todo),
               "warm_up_s": warm_s, "runs_wall_s": runs_s, "total_wall_s": time.perf_counter() - t0,
               "runs_per_s": len(todo) / runs_s if todo and runs_s > 0 else None,
               "workers": 0 if client is None else len(client.nthreads()),
@@ -420,7 +476,7 @@ def parser():
     p.add_argument("--param", default="omega", help="the swept parameter: "
                    + " | ".join(SCENES["point_stops"][1]))
     p.add_argument("--values", required=True, default=argparse.SUPPRESS,
-                   help="a:b:n (n values from a to b inclusive) or v1,v2,...")
+                   help="'linspace(a, b, n)' (n values from a to b inclusive) or v1,v2,...")
     p.add_argument("--transient", type=float, default=2.0,
                    help="seconds skipped before sampling (rounded up to whole periods)")
     p.add_argument("--periods", type=int, default=50, help="forcing periods sampled")
@@ -468,19 +524,20 @@ def main(argv=None) -> int:
                              args.overwrite, resume) as folder:
                 (out / "runs").mkdir(exist_ok=True)
                 summary = folder.close(**sweep(settings, values, out, client, progress))
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as e:     # SIGINT, or SIGTERM (main_guard)
         n = sum(run_path(out, settings["param"], v).exists() for v in values)
         print(f"interrupted: {n} of {len(values)} values done in {out / 'runs'}; "
               "run the same command again to resume", file=sys.stderr)
-        return 130
+        return getattr(e, "code", 130)
     tm = summary["timing"]
-    if summary["failed"]:
-        cli.warn(f"{summary['failed']} of {len(values)} runs failed or went unstable "
-                 f"(status column of {out / 'runs.csv'})")
+    failed, lost_ = summary["failed"], tm["values_lost"]
     rate = f", {tm['runs_per_s']:.3g} runs/s" if tm["runs_per_s"] else ""
-    print(f"{len(values)} values ({tm['values_run']} run, {tm['values_resumed']} resumed) in "
-          f"{tm['total_wall_s']:.3g} s{rate} -> {out}")
-    return 0
+    why = (f" ({lost_} lost with their workers: run the same command again to retry them)"
+           if lost_ else " (failed or unstable: status column of runs.csv)" if failed else "")
+    print(f"{len(values)} values: {len(values) - failed} done, {failed} failed{why}; "
+          f"{tm['values_run']} run, {tm['values_resumed']} resumed in "
+          f"{tm['total_wall_s']:.3g} s{rate} -> {out}", file=sys.stderr if failed else sys.stdout)
+    return EXIT_SOLVER if lost_ else 0
 
 
 if __name__ == "__main__":

@@ -31,7 +31,7 @@ def results_without_timing(out):
 
 def test_two_workers_match_serial_exactly(tmp_path):
     settings = make_settings("point_stops", "omega", **SHORT)
-    values = parse_values("8:30:20")
+    values = parse_values("linspace(8, 30, 20)")
     serial = sweep(settings, values, tmp_path / "serial", client=None, progress=False)
     pytest.importorskip("distributed")
     with dask_client(workers=2) as client:
@@ -66,7 +66,7 @@ def test_section_is_sampled_exactly_once_per_period(pipe):
 
 def test_interrupted_sweep_resumes_without_redoing(tmp_path):
     out = tmp_path / "sweep"
-    args = ["--values", "8:30:10", "--transient", "0.2", "--periods", "3", "--workers", "0",
+    args = ["--values", "linspace(8, 30, 10)", "--transient", "0.2", "--periods", "3", "--workers", "0",
             "--no-progress", "--out", str(out)]
     p = subprocess.Popen(SWEEP + args, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                          text=True)
@@ -103,16 +103,18 @@ def test_interrupted_sweep_resumes_without_redoing(tmp_path):
 @pytest.mark.parametrize("args, word", [
     (["--scene", "moon"], "--scene 'moon'"),
     (["--param", "mass"], "--param 'mass'"),
-    (["--values", "5:40"], "a:b:n"),
-    (["--values", "5:40:2.5"], "a:b:n"),
-    (["--values", "a:b:3"], "a:b:n"),
-    (["--values", "5,x"], "a:b:n"),
-    (["--values", "5:40:0"], "n=0 must be at least 1"),
-    (["--values", "5:40:-3"], "n=-3 must be at least 1"),
+    (["--values", "5:0.5:40"], "write linspace(5, 40, 200)"),
+    (["--values", "5:40"], "a:b:c is ambiguous"),
+    (["--values", "linspace(5, 40, 2.5)"], "linspace(a, b, n)"),
+    (["--values", "linspace(a, b, 3)"], "linspace(a, b, n)"),
+    (["--values", "linspace(5, 40)"], "linspace(a, b, n)"),
+    (["--values", "5,x"], "linspace(a, b, n)"),
+    (["--values", "linspace(5, 40, 0)"], "n=0 must be at least 1"),
+    (["--values", "linspace(5,40,-3)"], "n=-3 must be at least 1"),
     (["--values", "5,nan"], "nan is not a finite number"),
     (["--values", "5,5"], "repeat"),
     (["--values=-2,5"], "omega=-2 must be > 0"),
-    (["--param", "gap", "--values", "0:0.1:3"], "gap=0 must be > 0"),
+    (["--param", "gap", "--values", "linspace(0, 0.1, 3)"], "gap=0 must be > 0"),
     (["--param", "amplitude", "--omega", "0"], "omega=0 must be > 0"),
     (["--periods", "0"], "periods=0"),
     (["--transient", "-1"], "transient=-1"),
@@ -129,10 +131,12 @@ def test_bad_input_one_line_no_output(tmp_path, capsys, args, word):
 
 
 def test_bad_input_through_python_m(tmp_path):
-    p = subprocess.run(SWEEP + ["--values", "5:40:0", "--out", str(tmp_path / "s")],
+    p = subprocess.run(SWEEP + ["--values", "5:0.5:40", "--out", str(tmp_path / "s")],
                        capture_output=True, text=True, timeout=120)
     assert p.returncode == 2
-    assert p.stderr.strip() == "error: --values '5:40:0': n=0 must be at least 1"
+    assert p.stderr.strip() == ("error: --values '5:0.5:40': a:b:c is ambiguous (start:step:stop "
+                                "in MATLAB); write linspace(5, 40, 200) for 200 values from 5 "
+                                "to 40, or a comma list 5,10,20")
     assert not list(tmp_path.iterdir())
 
 
@@ -156,3 +160,40 @@ def test_scheduler_address_sends_the_same_work(tmp_path):
     assert json.loads((out / "sweep.json").read_text())["timing"]["workers"] == 1
     for name in OUTPUTS:
         assert (out / name).read_bytes() == (tmp_path / "serial" / name).read_bytes()
+
+
+def test_values_syntax():
+    assert parse_values("linspace(5, 40, 8)") == np.linspace(5, 40, 8).tolist()
+    assert parse_values(" linspace( 5,40 , 1 ) ") == [5.0]
+    assert parse_values("5,40,200") == [5.0, 40.0, 200.0]     # a list: three values
+    assert parse_values("7.5") == [7.5]
+
+
+def test_killed_worker_is_retried_then_marked_failed(tmp_path):
+    """A value whose worker dies every time is tried 1 + RETRIES times, then "failed" in
+    runs.csv (not saved in runs/: the next run retries it); the others are saved."""
+    distributed = pytest.importorskip("distributed")
+    import dask
+    from skfem_beam import sweep as sweep_module
+
+    def dies_at_13(settings, value):     # pickled by value: runs in the worker
+        if value == 13.0:
+            import os
+            os._exit(1)
+        return sweep_module.run_value(settings, value)
+
+    settings = make_settings("point_stops", "omega", transient=0.2, periods=2)
+    values = [9.0, 13.0, 17.0]
+    out = tmp_path / "sweep"
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}), \
+            distributed.LocalCluster(n_workers=1, threads_per_worker=1, host="127.0.0.1",
+                                     dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        s = sweep(settings, values, out, client=client, progress=False, warm=False,
+                  task=dies_at_13)
+    assert s["failed"] == 1 and s["timing"]["values_lost"] == 1
+    runs = (out / "runs.csv").read_text().splitlines()
+    assert [r.split(",")[0] for r in runs[1:]] == ["9.0", "13.0", "17.0"]
+    assert runs[2].endswith(",failed") and runs[1].endswith(",success") \
+        and runs[3].endswith(",success")
+    assert sorted(f.name for f in (out / "runs").iterdir()) == ["omega=17.0.json", "omega=9.0.json"]

@@ -1,6 +1,6 @@
 """Sweep throughput (runs per second) serially and on local Dask clusters; overhead per task.
 
-    python -m skfem_beam.bench.sweep_throughput [--values 8:30:16] [--periods 10]
+    python -m skfem_beam.bench.sweep_throughput [--values "linspace(8, 30, 16)"] [--periods 10]
         [--transient 0.5] [--workers 1,2] [--out sweep_throughput.json]
 
 Every configuration runs the same sweep (``skfem_beam.sweep.sweep``, per-value files
@@ -73,7 +73,7 @@ def main(argv=None) -> int:
     from ..sweep import make_settings, parse_values
     ap = argparse.ArgumentParser(prog="skfem_beam.bench.sweep_throughput",
                                  description=__doc__.splitlines()[0])
-    ap.add_argument("--values", default="8:30:16", help="ω values, a:b:n")
+    ap.add_argument("--values", default="linspace(8, 30, 16)", help="ω values, linspace(a, b, n)")
     ap.add_argument("--transient", type=float, default=0.5)
     ap.add_argument("--periods", type=int, default=10)
     ap.add_argument("--workers", default="1,2", help="Dask worker counts to measure")

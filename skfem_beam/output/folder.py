@@ -3,14 +3,22 @@
 Every command writes through :class:`Folder`.  The folder is made only after every
 input has been checked (:func:`check_output_dir` is the last check), so bad input leaves
 nothing behind.  Its ``summary.json`` says ``"running"`` from the start, and at the end
-``"success"`` or ``"unstable"`` (the run's own status), or ``"failed"`` with the error's
-message when a solver fails or the disk is full.  A killed command leaves ``"running"``.
+``"success"`` or ``"unstable"`` (the run's own status), ``"interrupted"`` (SIGINT, SIGTERM),
+or ``"failed"`` with the error's message when a solver fails or the disk is full.  A
+killed command (SIGKILL, power cut) leaves ``"running"``.
+
+One writer per folder: a run holds an exclusive ``flock`` on ``DIR/.lock`` from before its
+first file until it ends (the kernel drops it with the process, so a killed run never
+blocks the next one); a second run or resume into the same folder is refused.
 """
 from __future__ import annotations
 
+import errno
+import fcntl
 import json
 import os
 import shutil
+import signal
 import sys
 import tempfile
 import time
@@ -23,6 +31,79 @@ from ..errors import InputError, SolverError
 
 EXIT_INPUT, EXIT_SOLVER, EXIT_UNSTABLE = 2, 3, 4
 SUMMARY = "summary.json"
+LOCK = ".lock"          # flock'ed by the one process writing the folder
+RESERVE = ".reserve"    # a little disk kept back, freed to write the final summary
+OURS = (LOCK, RESERVE)
+
+
+class Interrupted(KeyboardInterrupt):
+    """SIGINT or SIGTERM; ``signum`` says which (exit code 128 + signum)."""
+
+    def __init__(self, signum: int = signal.SIGINT):
+        super().__init__(signal.Signals(signum).name)
+        self.signum = int(signum)
+
+    @property
+    def code(self) -> int:
+        return 128 + self.signum
+
+
+_HELD: dict[Path, int] = {}     # folder → descriptor of its locked .lock, in this process
+OPENED: list[Path] = []         # the folders this process opened (for the interrupt line)
+
+
+def _busy(out: Path) -> InputError:
+    return InputError(f"{out} is being written by another run (its {LOCK} is locked); "
+                      "wait for it to end or choose another folder")
+
+
+def lock_folder(out: Path) -> None:
+    """Take the exclusive lock of folder ``out`` (which exists) for this process, or refuse
+    (InputError naming the folder) when another process holds it.  Held until
+    :func:`release`, or the process ends."""
+    key = Path(out).resolve()
+    if key in _HELD:
+        return
+    fd = os.open(key / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError as e:
+        os.close(fd)
+        if e.errno in (errno.EWOULDBLOCK, errno.EAGAIN):
+            raise _busy(out) from None
+        raise
+    _HELD[key] = fd
+
+
+def release(out=None) -> None:
+    """Drop the lock of ``out`` (every lock this process holds when None)."""
+    keys = list(_HELD) if out is None else [Path(out).resolve()]
+    for key in keys:
+        fd = _HELD.pop(key, None)
+        if fd is not None:
+            os.close(fd)     # closing the descriptor releases the flock
+
+
+def check_not_busy(out: Path) -> None:
+    """Refuse a folder another process is writing (probe its lock, hold nothing)."""
+    if Path(out).resolve() in _HELD or not (Path(out) / LOCK).exists():
+        return
+    lock_folder(out)
+    release(out)
+
+
+def _make_locked(out: Path) -> None:
+    """Create ``out`` (and parents) and lock it.  The parent folder is flock'ed meanwhile,
+    so two runs creating the same folder at once are ordered: the second finds it locked."""
+    parent = out.resolve().parent
+    parent.mkdir(parents=True, exist_ok=True)
+    pfd = os.open(parent, os.O_RDONLY)
+    try:
+        fcntl.flock(pfd, fcntl.LOCK_EX)      # held for a mkdir and a lock only
+        out.mkdir(exist_ok=True)
+        lock_folder(out)
+    finally:
+        os.close(pfd)
 
 
 def check_output_dir(out: str | os.PathLike, overwrite: bool = False) -> Path:
@@ -30,7 +111,9 @@ def check_output_dir(out: str | os.PathLike, overwrite: bool = False) -> Path:
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise InputError(f"--out {out} exists and is not a folder")
-    if out.is_dir() and any(out.iterdir()) and not overwrite:
+    if out.is_dir():
+        check_not_busy(out)
+    if out.is_dir() and _holds_files(out) and not overwrite:
         raise InputError(f"--out {out} already holds files; pass --overwrite to replace them")
     # missing parents are made when the run starts (after every check); probe the
     # nearest folder that exists: permission bits say little (root, read-only mounts, /proc)
@@ -44,6 +127,10 @@ def check_output_dir(out: str | os.PathLike, overwrite: bool = False) -> Path:
     except OSError as e:
         raise InputError(f"--out {out}: folder {parent} is not writable ({e.strerror})") from None
     return out
+
+
+def _holds_files(out: Path) -> bool:
+    return any(p.name not in OURS for p in out.iterdir())
 
 
 def stamp() -> dict:
@@ -104,11 +191,11 @@ def write_timeseries(folder: Path, columns: dict[str, np.ndarray],
 class Folder:
     """The output folder of one command and the status in its ``summary.json``.
 
-    ``Folder.open(out, summary, overwrite)`` after every check: makes the folder (replacing
-    it with ``overwrite``) and writes the summary with status "running"; ``resume=True``
-    reopens a folder a killed command left.  Used as a context manager, a solver error or
-    an OSError inside marks it "failed" (and propagates); :meth:`close` writes the final
-    summary.
+    ``Folder.open(out, summary, overwrite)`` after every check: makes and locks the folder
+    (emptying it with ``overwrite``) and writes the summary with status "running";
+    ``resume=True`` reopens a folder a stopped command left.  Used as a context manager, a
+    solver error or an OSError inside marks it "failed" (and propagates), and the lock is
+    released on any exit; :meth:`close` writes the final summary.
     """
 
     def __init__(self, path: Path, summary: dict):
@@ -117,13 +204,38 @@ class Folder:
     @classmethod
     def open(cls, out, summary: dict, overwrite: bool = False, resume: bool = False) -> "Folder":
         out = Path(out)
-        if not resume:
-            if out.exists() and overwrite:
-                shutil.rmtree(out)
-            out.mkdir(parents=True, exist_ok=True)
-        folder = cls(out, summary)
-        folder.write(status="running", **stamp())
+        _make_locked(out)
+        try:
+            if not resume and _holds_files(out):   # filled since the checks: a race lost
+                if not overwrite:
+                    raise InputError(f"--out {out} already holds files; pass --overwrite "
+                                     "to replace them")
+                for p in out.iterdir():     # keep the lock file: it is what others lock
+                    if p.name != LOCK:
+                        shutil.rmtree(p) if p.is_dir() and not p.is_symlink() else p.unlink()
+            folder = cls(out, summary)
+            OPENED.append(out)
+            folder.reserve()
+            folder.write(status="running", **stamp())
+        except BaseException:
+            release(out)
+            raise
         return folder
+
+    def reserve(self, size: int = 1 << 16) -> None:
+        """Keep ``size`` bytes of disk, so that the final summary fits when the disk fills."""
+        try:
+            with open(self.path / RESERVE, "wb") as fh:
+                fh.write(b"\0" * size)
+        except OSError:
+            (self.path / RESERVE).unlink(missing_ok=True)
+
+    def unreserve(self) -> None:
+        (self.path / RESERVE).unlink(missing_ok=True)
+
+    def release(self) -> None:
+        self.unreserve()
+        release(self.path)
 
     def __truediv__(self, name: str) -> Path:
         return self.path / name
@@ -133,14 +245,17 @@ class Folder:
         write_summary(self.path, self.summary)
 
     def fail(self, error: BaseException, **entries) -> None:
-        """Mark the folder "failed" (quietly, if even that cannot be written: a full disk)."""
+        """Mark the folder "failed" (the reserve freed first, so that it fits on a full disk;
+        quietly, if even that cannot be written)."""
+        self.unreserve()
         try:
-            self.write(status="failed", message=str(error), **entries)
+            self.write(**{"status": "failed", "message": str(error), **entries, **stamp()})
         except OSError:
             pass
 
     def close(self, status: str = "success", **entries) -> dict:
         """The final summary: ``entries`` and the status, with the version stamp."""
+        self.unreserve()
         self.write(**{"status": status, **entries, **stamp()})
         return self.summary
 
@@ -150,6 +265,9 @@ class Folder:
     def __exit__(self, kind, error, tb):
         if isinstance(error, (SolverError, OSError)):
             self.fail(error)
+        elif isinstance(error, KeyboardInterrupt):
+            self.fail(error, status="interrupted", message=f"interrupted ({error or 'SIGINT'})")
+        self.release()
         return False
 
 

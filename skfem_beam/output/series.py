@@ -16,55 +16,85 @@ buffers, and which field frames to write.
 """
 from __future__ import annotations
 
+import argparse
+import hashlib
 import json
 import os
+import signal
+import sys
+import threading
 import time
+import zlib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
 import numpy as np
 
+from ..checks import check_count, check_nonnegative, check_positive
 from ..errors import InputError, SolverError
 from ..scheme import Run, drive
 from .fields import FieldWriter, check_format
-from .folder import Folder, check_output_dir, csv_rows, report
+from .folder import (EXIT_SOLVER, SUMMARY, Folder, Interrupted, _plain, check_output_dir,
+                     csv_rows, lock_folder, report)
 
 CHECKPOINT = "checkpoint.npz"
+CHECKPOINT_FORMAT = 2
 BUFFERS = ("obs", "obsv", "energy", "lam")   # the run's saved series (not in its checkpoint)
 
 
 class SeriesFile:
-    """timeseries.csv written as the run goes (whole rows only, flushed per chunk), and the
-    same rows kept in memory (:meth:`data`), so nothing is read back from the file."""
+    """timeseries.csv written as the run goes, and the same rows kept in memory
+    (:meth:`data`), so nothing is read back from the file.
 
-    def __init__(self, path: Path, names: list[str], keep_rows: int | None = None):
+    Whole rows only: rows are written with ``os.write`` (no buffer to flush later), and a
+    write that fails (a full disk) cuts the file back to its last whole row before the
+    error goes on.  ``nbytes`` and ``crc`` (zlib.crc32 of the file so far) go into every
+    checkpoint, so that a resume can check the rows on disk are the ones it continues.
+    ``keep``: a checkpoint; the file is cut back to its rows (resume).
+    """
+
+    def __init__(self, path: Path, names: list[str], keep: dict | None = None):
         self.path, self.names = path, names
         self._chunks: list[dict] = []
-        if keep_rows is None:
-            self.fh = open(path, "w")
-            self.fh.write(",".join(names) + "\n")
-            self.rows = 0
-        else:   # resume: keep the header and the first keep_rows rows, drop the rest
+        if keep is None:
+            self.fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
+            self.rows, self.nbytes, self.crc = 0, 0, 0
+            self._write((",".join(names) + "\n").encode())
+        else:   # resume: keep the header and the checkpoint's rows (checked), drop the rest
+            self.rows, self.nbytes = int(keep["rows"]), int(keep["nbytes"])
+            self.crc = int(keep["crc"])
             with open(path, "rb") as fh:
-                lines = fh.read().split(b"\n")
-            if len(lines) < keep_rows + 1:
-                raise InputError(f"{path} has fewer rows than its checkpoint: cannot resume")
-            kept = lines[1:keep_rows + 1]
-            # the rows a killed process wrote come back exactly (17 digits round-trip)
+                head = fh.read(self.nbytes)
+            kept = head.split(b"\n")[1:-1]
+            # the rows a stopped process wrote come back exactly (17 digits round-trip)
             values = np.array([[float(v) for v in row.split(b",")] for row in kept]) \
                 .reshape(len(kept), len(names))
             self._chunks.append({k: values[:, i] for i, k in enumerate(names)})
-            self.fh = open(path, "wb")
-            self.fh.write(b"\n".join(lines[:keep_rows + 1]) + b"\n")
-            self.fh.close()
-            self.fh = open(path, "a")
-            self.rows = keep_rows
+            self.fd = os.open(path, os.O_WRONLY)
+            os.ftruncate(self.fd, self.nbytes)
+            os.lseek(self.fd, self.nbytes, os.SEEK_SET)
         self.sync()
+
+    def _write(self, data: bytes) -> None:
+        try:
+            view = memoryview(data)
+            while view:
+                view = view[os.write(self.fd, view):]
+        except OSError:
+            self.cut()
+            raise
+        self.nbytes += len(data)
+        self.crc = zlib.crc32(data, self.crc)
+
+    def cut(self) -> None:
+        """Back to the last whole row (shrinking a file needs no disk space)."""
+        os.ftruncate(self.fd, self.nbytes)
+        os.lseek(self.fd, self.nbytes, os.SEEK_SET)
 
     def append(self, columns: dict) -> None:
         text = csv_rows(columns, self.names)
-        self.fh.write(text)
+        self._write(text.encode())
         self.rows += text.count("\n")
         self._chunks.append({k: np.asarray(columns[k], dtype=float) for k in self.names})
 
@@ -74,13 +104,15 @@ class SeriesFile:
                 for k in self.names}
 
     def sync(self) -> None:
-        self.fh.flush()
-        os.fsync(self.fh.fileno())
+        os.fsync(self.fd)
 
     def close(self) -> None:
-        if not self.fh.closed:
-            self.sync()
-            self.fh.close()
+        if self.fd >= 0:
+            fd, self.fd = self.fd, -1
+            try:
+                os.fsync(fd)
+            finally:
+                os.close(fd)
 
 
 @dataclass
@@ -126,50 +158,157 @@ class _Fields:
         self.writer.close()
 
 
-def _atomic_savez(path: Path, **arrays) -> None:
-    tmp = path.with_name(path.name + ".tmp.npz")
-    np.savez(tmp, **arrays)
-    with open(tmp, "rb") as fh:
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
+def _digest(arrays: dict) -> str:
+    """sha256 of every array (name, dtype, shape, bytes), in name order."""
+    h = hashlib.sha256()
+    for k in sorted(arrays):
+        a = np.ascontiguousarray(arrays[k])
+        h.update(f"{k}:{a.dtype.str}:{a.shape}".encode())
+        h.update(a.tobytes())
+    return h.hexdigest()
 
 
-def _checkpoint(run: Run, rows: int, used: int) -> dict:
+def write_checkpoint(path: Path, arrays: dict, config: dict) -> None:
+    """The arrays, the run's configuration (JSON) and their sha256, atomically: written to
+    a hidden sibling, fsynced, renamed into place (a stopped write leaves the old one)."""
+    arrays = {k: np.asarray(v) for k, v in arrays.items()}
+    arrays["config"] = np.array(json.dumps(_plain(config), sort_keys=True))
+    arrays["format"] = np.array(CHECKPOINT_FORMAT)
+    arrays["sha256"] = np.array(_digest(arrays))
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp.npz")
+    try:
+        np.savez(tmp, **arrays)
+        with open(tmp, "rb") as fh:
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+
+def read_checkpoint(folder: Path) -> dict:
+    """The checkpoint in ``folder``, read without pickle and checked against its sha256;
+    anything else is one InputError naming the file and what is wrong."""
+    path = Path(folder) / CHECKPOINT
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            ck = {k: z[k] for k in z.files}
+    except Exception as e:     # zip, zlib, npy header, pickle refusal, I/O: all unreadable
+        raise InputError(f"{path} is unreadable ({type(e).__name__}: {e}); "
+                         "cannot resume, nothing was changed") from None
+    missing = [k for k in ("sha256", "config", "format", "n", "rows", "nbytes", "crc")
+               if k not in ck]
+    if missing:
+        raise InputError(f"{path} has no {missing[0]!r} (not a checkpoint of this version); "
+                         "cannot resume, nothing was changed")
+    if int(ck["format"]) != CHECKPOINT_FORMAT or \
+            _digest({k: v for k, v in ck.items() if k != "sha256"}) != str(ck["sha256"]):
+        raise InputError(f"{path} does not match its sha256 checksum (changed or cut); "
+                         "cannot resume, nothing was changed")
+    ck["config"] = json.loads(str(ck["config"]))
+    return ck
+
+
+def read_summary(folder: Path) -> dict:
+    path = Path(folder) / SUMMARY
+    try:
+        summary = json.loads(path.read_bytes().decode("utf-8"))
+        if not isinstance(summary, dict) or not isinstance(summary.get("config"), dict):
+            raise ValueError("no 'config' object")
+    except (OSError, ValueError) as e:   # UnicodeDecodeError and JSONDecodeError included
+        raise InputError(f"{path} is not a readable summary ({type(e).__name__}: {e}); "
+                         "cannot resume, nothing was changed") from None
+    return summary
+
+
+def check_resumable(folder: Path, summary: dict, ck: dict, extend: bool) -> None:
+    """Refuse a resume whose summary, checkpoint and rows on disk do not agree."""
+    name = f"{Path(folder) / SUMMARY}"
+    mine, theirs = _plain(summary["config"]), ck["config"]
+    diff = sorted(k for k in set(mine) | set(theirs) if mine.get(k) != theirs.get(k)
+                  # an extension (--T longer) stopped before its first checkpoint
+                  and not (k == "T" and _longer(mine.get(k), theirs.get(k))))
+    if diff:
+        k = diff[0]
+        raise InputError(f"{name}: {k}={mine.get(k)!r} differs from the checkpoint's "
+                         f"{k}={theirs.get(k)!r}; cannot resume, nothing was changed")
+    status, n = summary.get("status"), int(ck["n"])
+    if status == "unstable":
+        raise InputError(f"{name}: the run went unstable; there is nothing to resume")
+    step = summary.get("checkpoint_step")
+    if status != "running" and step != n or status == "running" and (step or 0) > n:
+        raise InputError(f"{name} says the checkpoint is at step {step}, "
+                         f"{CHECKPOINT} holds step {n}; cannot resume, nothing was changed")
+    if status == "success" and not extend:
+        raise InputError(f"{folder} holds a finished run (status success): nothing to "
+                         f"resume; give a longer --T to extend it")
+    csv = Path(folder) / "timeseries.csv"
+    size = csv.stat().st_size if csv.is_file() else -1
+    nbytes = int(ck["nbytes"])
+    if size < nbytes:
+        raise InputError(f"{csv} has {max(size, 0)} bytes, fewer than the {nbytes} of the "
+                         f"checkpoint's {int(ck['rows'])} rows; cannot resume")
+    with open(csv, "rb") as fh:
+        if zlib.crc32(fh.read(nbytes)) != int(ck["crc"]):
+            raise InputError(f"{csv}: its first {int(ck['rows'])} rows are not the ones the "
+                             "checkpoint was written with; cannot resume, nothing was changed")
+
+
+def _longer(a, b) -> bool:
+    return isinstance(a, (int, float)) and isinstance(b, (int, float)) and a > b
+
+
+def _checkpoint(run: Run, rows: SeriesFile, used: int) -> dict:
     """The run's state, the rows written, and the saved rows the series has not used yet
     (and one before them): a resumed run computes only what comes after the checkpoint."""
     first = max(0, used - 1)
     keep = run.n // run.save_every + 1
     pending = {f"pending_{k}": getattr(run, k)[first:keep] for k in BUFFERS}
-    return {**run.checkpoint(), "rows": rows, "used": used, "pending_from": first, **pending}
+    return {**run.checkpoint(), "rows": rows.rows, "nbytes": rows.nbytes, "crc": rows.crc,
+            "used": used, "pending_from": first, **pending}
 
 
 def _restore(run: Run, ck: dict) -> int:
     """Restore ``run`` from a checkpoint; return the saved rows the series has used."""
-    run.restore(ck)
-    first = int(ck.get("pending_from", 0))
-    for k in BUFFERS:
-        if f"pending_{k}" in ck:
+    try:
+        run.restore(ck)
+        first = int(ck["pending_from"])
+        for k in BUFFERS:
             part = ck[f"pending_{k}"]
             getattr(run, k)[first:first + len(part)] = part
-    return int(ck.get("used", ck["rows"]))
+    except (KeyError, ValueError, IndexError) as e:
+        raise InputError(f"{CHECKPOINT} does not fit this run ({type(e).__name__}: {e}); "
+                         "cannot resume") from None
+    return int(ck["used"])
+
+
+OUTPUT_FLAGS = ("frames", "save_every", "flush_every")
+
+
+def check_output_flags(args) -> None:
+    """The output flags every command shares (with skfem_beam.checks)."""
+    for flag in OUTPUT_FLAGS:
+        if hasattr(args, flag):
+            check_count(f"--{flag.replace('_', '-')}", getattr(args, flag))
+    if getattr(args, "checkpoint_every", None) is not None:
+        check_nonnegative("--checkpoint-every", args.checkpoint_every)
+    check_format(getattr(args, "format", "none"))
 
 
 def prepare(args) -> Path:
     """Check ``--out`` (or the ``--resume`` folder) and the output flags before anything is
     computed; return the folder."""
+    check_output_flags(args)
     if getattr(args, "resume", None):
-        out = Path(args.resume)
-        if not (out / CHECKPOINT).is_file() or not (out / "summary.json").is_file():
-            raise InputError(f"--resume {out}: no {CHECKPOINT} and summary.json there to resume from")
-        return out
-    if getattr(args, "checkpoint_every", None) is not None and not args.checkpoint_every >= 0:
-        raise InputError(f"--checkpoint-every={args.checkpoint_every:g} must be ≥ 0 seconds")
-    check_format(getattr(args, "format", "none"))
-    for flag in ("flush_every", "frames"):
-        value = getattr(args, flag, 1)
-        if isinstance(value, bool) or int(value) != value or value < 1:
-            raise InputError(f"--{flag.replace('_', '-')}={value} must be a whole number ≥ 1")
+        return _resume_folder(args.resume)
     return check_output_dir(args.out, args.overwrite)
+
+
+def _resume_folder(out) -> Path:
+    out = Path(out)
+    if not (out / CHECKPOINT).is_file() or not (out / SUMMARY).is_file():
+        raise InputError(f"--resume {out}: no {CHECKPOINT} and {SUMMARY} there to resume from")
+    return out
 
 
 def outcome(result, data: dict) -> dict:
@@ -189,32 +328,82 @@ def outcome(result, data: dict) -> dict:
     }
 
 
+class _Signals:
+    """SIGINT and SIGTERM set a flag, read between chunks: the run stops at a whole chunk,
+    not in the middle of a write (a compiled chunk cannot be stopped anyway)."""
+
+    def __init__(self):
+        self.signum, self._old = None, {}
+
+    def _catch(self, signum, frame):
+        self.signum = signum
+
+    def __enter__(self):
+        if threading.current_thread() is threading.main_thread():
+            for sig in (signal.SIGINT, signal.SIGTERM):
+                self._old[sig] = signal.signal(sig, self._catch)
+        return self
+
+    def __exit__(self, *exc):
+        for sig, old in self._old.items():
+            signal.signal(sig, old)
+        return False
+
+
+def _command(summary: dict) -> str:
+    return f"python -m skfem_beam.cases.{summary.get('case', '<case>')}"
+
+
 def execute(run: Run, out: Path, args, summary: dict, series, finish) -> int:
     """Drive ``run`` with streaming output into ``out``; return the exit code.
 
     ``series``: a :class:`Series` (or just its ``columns`` function).  ``finish(folder,
     data, run)``: charts and extra files from the rows in memory (``data``: name →
     column); it may return summary entries, which override the run's own.
+
+    SIGINT/SIGTERM stop the run at the next chunk: the rows and frames so far are kept,
+    a checkpoint is written, summary.json says "interrupted", one line says how to resume,
+    and the exit code is 130/143.  A failed write (full disk) cuts the series back to its
+    last whole row, marks the folder "failed" and says what is kept (exit 3).
     """
     if not isinstance(series, Series):
         series = Series(series)
     resume = bool(getattr(args, "resume", None))
     every = getattr(args, "checkpoint_every", None)
-    if every is not None:
+    try:
         run.checkpoint()            # refuses a solver that cannot checkpoint: before any file
+        can_checkpoint = True
+    except InputError:
+        if every is not None:
+            raise
+        can_checkpoint = False
     names = list(series.columns(run, 0, 0))
-    used = 0
+    used, ck = 0, None
     if resume:
-        ck = dict(np.load(Path(out) / CHECKPOINT))
+        ck = read_checkpoint(out)       # checked again: the lock is held since the parse
         used = _restore(run, ck)
-        folder = Folder.open(out, summary, resume=True)
-        rows = SeriesFile(folder / "timeseries.csv", names, keep_rows=int(ck["rows"]))
-    else:
-        folder = Folder.open(out, summary, overwrite=getattr(args, "overwrite", False))
-        rows = SeriesFile(folder / "timeseries.csv", names)
+    with _Signals() as stop:
+        folder = Folder.open(out, summary, overwrite=getattr(args, "overwrite", False),
+                             resume=resume)
+        try:
+            return _stream(run, folder, args, series, finish, stop, used, ck, can_checkpoint)
+        finally:
+            folder.release()
+
+
+def _stream(run, folder, args, series, finish, stop, used, ck, can_checkpoint) -> int:
+    """The body of :func:`execute`, in the open ``folder``."""
+    names = list(series.columns(run, 0, 0))
+    every = getattr(args, "checkpoint_every", None)
     fmt = getattr(args, "format", "none")
     last_ck = time.monotonic()
-    fields = None
+    fields = rows = None
+    kept = {"step": int(ck["n"]) if ck is not None else None}
+
+    def save_checkpoint():
+        write_checkpoint(folder / CHECKPOINT, _checkpoint(run, rows, used), folder.summary["config"])
+        kept["step"] = run.n
+        folder.write(checkpoint_step=run.n)
 
     def on_chunk(run):
         nonlocal last_ck, used
@@ -225,38 +414,112 @@ def execute(run: Run, out: Path, args, summary: dict, series, finish) -> int:
         rows.sync()
         if fields is not None:
             fields.update()
+        if stop.signum is not None and not run.done:
+            raise Interrupted(stop.signum)
         if every is not None and time.monotonic() - last_ck >= every and not run.done:
-            _atomic_savez(folder / CHECKPOINT, **_checkpoint(run, rows.rows, used))
+            save_checkpoint()
             last_ck = time.monotonic()
+
+    def what_is_kept() -> str:
+        t = (rows.rows - 1) * run.save_every * run.dt if rows is not None and rows.rows else 0.0
+        ck_line = (f"the checkpoint at step {kept['step']} (t={kept['step'] * run.dt:.6g} s)"
+                   if kept["step"] is not None else "no checkpoint")
+        frames = f", {fields.written} field frames" if fields is not None else ""
+        return (f"kept {rows.rows if rows is not None else 0} whole rows of timeseries.csv "
+                f"(to t={t:.6g} s){frames} and {ck_line} in {folder.path}")
 
     try:
         try:
+            rows = SeriesFile(folder / "timeseries.csv", names, keep=ck)
             fields = _Fields(folder.path, run, fmt, series) if fmt != "none" else None
             on_chunk(run)                      # state 1 (and, on resume, the frames so far)
             drive(run, chunk=getattr(args, "flush_every", 20000), on_chunk=on_chunk)
+            if can_checkpoint and run.status == "success":
+                save_checkpoint()              # so that --resume DIR --T longer extends it
         finally:
-            rows.close()
+            if rows is not None:
+                rows.close()
             if fields is not None:
                 fields.close()
         data = rows.data()
         entries = outcome(run.result(), data)
         entries.update(finish(folder.path, data, run) or {})
-    except (SolverError, OSError) as e:
+    except Interrupted as e:
+        name = signal.Signals(e.signum).name
+        why = ""
+        if can_checkpoint:
+            try:
+                save_checkpoint()
+            except OSError as err:
+                why = f" (no new checkpoint: {err.strerror})"
+        entries = outcome(run.result(), rows.data())
+        folder.close(**{**entries, "status": "interrupted", "steps": run.n,
+                        "message": f"interrupted by {name} at step {run.n} "
+                                   f"(t={run.n * run.dt:.6g} s)"})
+        resume = (f"continue with: {_command(folder.summary)} --resume {folder.path}"
+                  if kept["step"] is not None else "no checkpoint: it cannot be resumed")
+        print(f"interrupted by {name}: {what_is_kept()}{why}; {resume}", file=sys.stderr)
+        return e.code
+    except SolverError as e:
         folder.fail(e, steps=run.n)
         raise
+    except OSError as e:
+        folder.fail(e, steps=run.n, kept=what_is_kept())
+        resume = (f"once there is room, continue with: {_command(folder.summary)} --resume "
+                  f"{folder.path}" if kept["step"] is not None else
+                  "without a checkpoint (--checkpoint-every) it cannot be resumed")
+        print(f"error: could not write the results: {e}; {what_is_kept()}; {resume}",
+              file=sys.stderr)
+        return EXIT_SOLVER
     final = folder.close(**entries)
-    return report(final, out)
+    return report(final, folder.path)
 
 
-def stored_args(args, parser):
-    """For ``--resume DIR``: the flags of the run stored in DIR/summary.json."""
+def _given(parser, argv) -> dict:
+    """The flags written on the command line (not the defaults)."""
+    actions = [a for a in parser._actions if a.default is not argparse.SUPPRESS]
+    saved = [a.default for a in actions]
+    try:
+        for a in actions:
+            a.default = argparse.SUPPRESS
+        return vars(parser.parse_args(argv))
+    finally:
+        for a, d in zip(actions, saved):
+            a.default = d
+
+
+def stored_args(args, parser, argv=None):
+    """For ``--resume DIR``: the flags of the run stored in DIR/summary.json, once DIR is
+    locked and its summary, checkpoint and rows agree.  ``--T`` may grow (extending the
+    run); any other flag that differs from the stored one is refused by name."""
     if not getattr(args, "resume", None):
         return args
-    prepare(args)
-    config = json.loads((Path(args.resume) / "summary.json").read_text()).get("config", {})
+    out = _resume_folder(args.resume)
+    lock_folder(out)
+    summary, ck = read_summary(out), read_checkpoint(out)
+    config = summary["config"]
+    given = _given(parser, argv)
+    T = config.get("T")
+    for k, v in given.items():
+        if k == "resume" or k == "out" and Path(v).resolve() == out.resolve():
+            continue
+        if k == "T" and T is not None and check_positive("T", v) >= T:
+            T = v
+            continue
+        flag = f"--{k.replace('_', '-')}"
+        if k == "T":
+            raise InputError(f"--resume {out}: {flag} {v:g} is shorter than the run's T={T:g} "
+                             "(a run can only be extended)")
+        if k not in config or config[k] != v:
+            raise InputError(f"--resume {out}: {flag} {v} differs from the run's "
+                             f"{config.get(k)!r}; a resumed run keeps its flags (only --T "
+                             "may grow)")
+    check_resumable(out, summary, ck, extend=T is not None and T > config.get("T", T))
     stored = vars(parser.parse_args([]))
     for k in stored:
         if k in config:
             stored[k] = config[k]
-    stored.update(resume=args.resume, out=args.resume, overwrite=False)
-    return type(args)(**stored)
+    stored.update(resume=args.resume, out=args.resume, overwrite=False, T=T)
+    stored = type(args)(**stored)
+    prepare(stored)
+    return stored

@@ -333,13 +333,23 @@ class Run:
         return {**{k: getattr(self.st, v).copy() for k, v in self._STATE.items()},
                 **{k: getattr(self.out, v).copy() for k, v in self._FRAMES.items()},
                 "events": self._all_events(), "n": self.n, "load_bound": self.load_bound,
-                "wall": self.wall, "E1": self.E1}
+                "wall": self.wall, "E1": self.E1, "frame_every": self.frame_every}
 
     def restore(self, ck: dict) -> None:
+        """Continue from ``checkpoint()``: of this run, or of the same run with a shorter
+        T (extending it).  The checkpoint's frame spacing is kept, so its frames stay
+        valid (a run extended to 2T keeps every frame_every-th step: twice the frames)."""
+        every = int(ck.get("frame_every", self.frame_every))
+        if every != self.frame_every:
+            nframes, out = self.n_steps // every + 1, self.out
+            self.frame_every, self.ops = every, self.ops._replace(frame_every=every)
+            self.out = out._replace(**{v: np.full((nframes, getattr(out, v).shape[1]),
+                                                  0.0 if v == "frames_f" else np.nan)
+                                       for v in self._FRAMES.values()})
         for k, v in self._STATE.items():
             getattr(self.st, v)[...] = ck[k]
         for k, v in self._FRAMES.items():
-            getattr(self.out, v)[...] = ck[k]
+            getattr(self.out, v)[:len(ck[k])] = ck[k]
         ops = self.ops
         csr_product(ops.Cp, ops.Ci, ops.Cx, self.st.u_prev, self.st.y_prev)
         csr_product(ops.Cp, ops.Ci, ops.Cx, self.st.u_cur, self.st.y_cur)

@@ -1,0 +1,286 @@
+"""Faults a long run meets, and what each leaves on disk (docs/design.md §5).
+
+SIGKILL, SIGINT and SIGTERM at several moments, then --resume: identical, byte for byte,
+to an uninterrupted run; two writers on one folder; spoiled checkpoints and summaries
+refused in one line, touching nothing; a full disk (a 2 MB tmpfs, as root) leaves whole
+rows and resumes once there is room; every output flag checked.
+"""
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from conftest import exit_code
+from skfem_beam.cases import impacting_bar, point_stops
+
+CASE = [sys.executable, "-m", "skfem_beam.cases.point_stops"]
+LONG = ["--dt", "1e-5", "--T", "2", "--flush-every", "2000", "--frames", "10"]
+SHORT = ["--dt", "1e-4", "--T", "0.1", "--flush-every", "200", "--format", "none"]
+
+
+def summary(folder):
+    return json.loads((folder / "summary.json").read_text())
+
+
+def whole_rows(folder):
+    """The rows of timeseries.csv, each one whole (every value a finite number)."""
+    text = (folder / "timeseries.csv").read_text()
+    assert text.endswith("\n")
+    lines = text.splitlines()
+    width = len(lines[0].split(","))
+    data = np.array([[float(v) for v in r.split(",")] for r in lines[1:]]).reshape(-1, width)
+    assert np.isfinite(data).all()
+    return lines
+
+
+def checkpoint(folder):
+    with np.load(folder / "checkpoint.npz", allow_pickle=False) as z:
+        return {k: z[k] for k in ("n", "rows")}
+
+
+def snapshot(folder):
+    return {p.name: p.read_bytes() for p in sorted(folder.iterdir()) if p.is_file()}
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    out = tmp_path_factory.mktemp("ref") / "run"
+    assert exit_code(point_stops.main, LONG + ["--out", str(out)]) == 0
+    return out
+
+
+def stop_when(p, csv, nbytes, sig):
+    """Send ``sig`` once ``csv`` has ``nbytes``; the exit code and stderr lines."""
+    deadline = time.monotonic() + 60
+    while p.poll() is None and time.monotonic() < deadline:
+        if csv.exists() and csv.stat().st_size >= nbytes and \
+                (csv.parent / "checkpoint.npz").exists():
+            break
+        time.sleep(0.002)
+    if p.poll() is not None:
+        pytest.skip("the run ended before it could be stopped (machine too fast or slow)")
+    os.kill(p.pid, sig)
+    _, err = p.communicate(timeout=60)
+    return p.returncode, err.strip().splitlines()
+
+
+def test_kill_interrupt_terminate_then_resume_is_identical(reference, tmp_path):
+    """SIGKILL at ~1/5, SIGINT at ~2/5, SIGTERM at ~3/5, each followed by --resume: the
+    files are whole at every stop, and the end is the uninterrupted run, byte for byte."""
+    out = tmp_path / "run"
+    csv = out / "timeseries.csv"
+    ref = whole_rows(reference)
+    total = (reference / "timeseries.csv").stat().st_size
+    popen = dict(stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+
+    p = subprocess.Popen(CASE + LONG + ["--checkpoint-every", "0", "--out", str(out)], **popen)
+    code, _ = stop_when(p, csv, total // 5, signal.SIGKILL)
+    assert code == -signal.SIGKILL and summary(out)["status"] == "running"
+    kept = whole_rows(out)
+    assert kept == ref[:len(kept)]       # whole rows up to the last flush, as computed
+
+    for frac, sig, exit_ in ((2, signal.SIGINT, 130), (3, signal.SIGTERM, 143)):
+        p = subprocess.Popen(CASE + ["--resume", str(out)], **popen)
+        code, err = stop_when(p, csv, total * frac // 5, sig)
+        name = signal.Signals(sig).name
+        assert code == exit_ and len(err) == 1, err
+        assert err[0].startswith(f"interrupted by {name}: kept ") and f"--resume {out}" in err[0]
+        s, ck, kept = summary(out), checkpoint(out), whole_rows(out)
+        assert s["status"] == "interrupted" and name in s["message"]
+        # the checkpoint is the last state kept: its step and its rows are the files'
+        assert s["steps"] == s["checkpoint_step"] == int(ck["n"]) > 0
+        assert int(ck["rows"]) == len(kept) - 1 and f"kept {len(kept) - 1} whole rows" in err[0]
+        assert kept == ref[:len(kept)]
+
+    p = subprocess.run(CASE + ["--resume", str(out)], capture_output=True, text=True, timeout=60)
+    assert p.returncode == 0, p.stderr
+    assert csv.read_bytes() == (reference / "timeseries.csv").read_bytes()
+    a, b = summary(reference), summary(out)
+    for key in ("status", "steps", "impacts", "max_nodal_violation", "energy_final"):
+        assert a[key] == b[key]
+    assert (out / "fields.h5").stat().st_size == (reference / "fields.h5").stat().st_size
+
+
+HOLD = ("import fcntl, os, sys, time; fd = os.open(sys.argv[1], os.O_RDWR | os.O_CREAT); "
+        "fcntl.flock(fd, fcntl.LOCK_EX); print('locked', flush=True); time.sleep(60)")
+
+
+def test_one_writer_per_folder(tmp_path, capsys):
+    """While another process holds the folder, a run into it, an overwrite and a resume
+    are refused in one line naming it, touching nothing; once that process is killed its
+    lock is gone and the resume goes on."""
+    out = tmp_path / "run"
+    assert exit_code(point_stops.main, SHORT + ["--out", str(out)]) == 0
+    capsys.readouterr()
+    before = snapshot(out)
+    holder = subprocess.Popen([sys.executable, "-c", HOLD, str(out / ".lock")],
+                              stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "locked"
+        for argv in (SHORT + ["--out", str(out)], SHORT + ["--out", str(out), "--overwrite"],
+                     ["--resume", str(out), "--T", "0.2"]):
+            assert exit_code(point_stops.main, argv) == 2
+            err = capsys.readouterr().err.splitlines()
+            assert len(err) == 1 and f"{out} is being written by another run" in err[0], err
+        assert snapshot(out) == before
+    finally:
+        holder.kill()
+        holder.wait()
+    assert exit_code(point_stops.main, ["--resume", str(out), "--T", "0.2"]) == 0
+    assert summary(out)["steps"] == 2000
+
+
+def test_two_runs_started_at_once_into_one_folder(tmp_path):
+    out = tmp_path / "run"
+    argv = CASE + SHORT + ["--out", str(out)]
+    ps = [subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+          for _ in range(2)]
+    done = [(p.wait(timeout=60), p.stderr.read().strip()) for p in ps]
+    codes = sorted(c for c, _ in done)
+    assert codes == [0, 2], done
+    err = [e for c, e in done if c == 2][0]
+    assert err.count("\n") == 0 and str(out) in err and \
+        ("another run" in err or "already holds files" in err), err
+    ref = tmp_path / "ref"
+    assert exit_code(point_stops.main, SHORT + ["--out", str(ref)]) == 0
+    assert (out / "timeseries.csv").read_bytes() == (ref / "timeseries.csv").read_bytes()
+
+
+# ---------------------------------------------------------------- spoiled resumes
+
+@pytest.fixture(scope="module")
+def finished(tmp_path_factory):
+    out = tmp_path_factory.mktemp("finished") / "run"
+    assert exit_code(point_stops.main, SHORT + ["--out", str(out)]) == 0
+    return out
+
+
+def _edit_json(path, edit):
+    data = json.loads(path.read_text())
+    edit(data)
+    path.write_text(json.dumps(data))
+
+
+def _resave(path, edit):
+    with np.load(path, allow_pickle=False) as z:
+        arrays = {k: z[k] for k in z.files}
+    edit(arrays)
+    np.savez(path, **arrays)
+
+
+SPOIL = {
+    "truncated checkpoint": ("checkpoint.npz is unreadable", lambda d: (d / "checkpoint.npz")
+                             .write_bytes((d / "checkpoint.npz").read_bytes()[:3000])),
+    "random checkpoint": ("checkpoint.npz is unreadable", lambda d: (d / "checkpoint.npz")
+                          .write_bytes(np.random.default_rng(1).bytes(5000))),
+    "pickled checkpoint": ("checkpoint.npz is unreadable", lambda d: np.savez(
+        d / "checkpoint.npz", u_cur=np.array([{"x": 1}], dtype=object))),
+    "edited checkpoint": ("does not match its sha256", lambda d: _resave(
+        d / "checkpoint.npz", lambda a: a["u_cur"].__setitem__(0, 1.0))),
+    "edited summary dt": ("summary.json: dt=2e-05 differs from the checkpoint's dt=0.0001",
+                          lambda d: _edit_json(d / "summary.json",
+                                               lambda s: s["config"].update(dt=2e-5))),
+    "edited summary step": ("says the checkpoint is at step 7", lambda d: _edit_json(
+        d / "summary.json", lambda s: s.update(checkpoint_step=7))),
+    "random summary": ("summary.json is not a readable summary (UnicodeDecodeError",
+                       lambda d: (d / "summary.json").write_bytes(b"\xff\xfe\x00garbage")),
+    "cut series": ("fewer than the", lambda d: (d / "timeseries.csv").write_bytes(
+        (d / "timeseries.csv").read_bytes()[:-500])),
+    "edited series": ("are not the ones the checkpoint was written with", lambda d: (
+        d / "timeseries.csv").write_text((d / "timeseries.csv").read_text().replace(
+            "\n0.0050000000000000001,", "\n0.0050000000000000002,", 1))),
+}
+
+
+@pytest.mark.parametrize("spoil", list(SPOIL))
+def test_spoiled_resume_is_refused_touching_nothing(finished, tmp_path, capsys, spoil):
+    out = tmp_path / "run"
+    shutil.copytree(finished, out)
+    word, spoil_it = SPOIL[spoil]
+    spoil_it(out)
+    before = snapshot(out)
+    assert exit_code(point_stops.main, ["--resume", str(out), "--T", "0.2"]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and word in err[0], err
+    assert snapshot(out) == before
+
+
+def test_resume_refuses_changed_flags_and_extends_T(finished, tmp_path, capsys):
+    out = tmp_path / "run"
+    shutil.copytree(finished, out)
+    before = snapshot(out)
+    for argv, word in ((["--T", "0.2", "--dt", "1e-6"], "--dt 1e-06 differs from the run's"),
+                       (["--frames", "-1"], "--frames -1 differs from the run's"),
+                       (["--T", "0.05"], "--T 0.05 is shorter than the run's T=0.1"),
+                       ([], "holds a finished run (status success): nothing to resume")):
+        assert exit_code(point_stops.main, ["--resume", str(out)] + argv) == 2
+        err = capsys.readouterr().err.splitlines()
+        assert len(err) == 1 and word in err[0], err
+    assert snapshot(out) == before
+    # --T longer: the same rows as a run made that long from the start
+    assert exit_code(point_stops.main, ["--resume", str(out), "--T", "0.25"]) == 0
+    longer = tmp_path / "longer"
+    assert exit_code(point_stops.main, SHORT[:2] + ["--T", "0.25"] + SHORT[4:]
+                     + ["--out", str(longer)]) == 0
+    assert (out / "timeseries.csv").read_bytes() == (longer / "timeseries.csv").read_bytes()
+    assert summary(out)["T"] == summary(longer)["T"] == 0.25
+
+
+# ---------------------------------------------------------------- a full disk
+
+@pytest.fixture
+def small_disk(tmp_path):
+    disk = tmp_path / "disk"
+    disk.mkdir()
+    if os.geteuid() != 0:
+        pytest.skip("mounting a 2 MB tmpfs needs root")
+    p = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=2m", "tmpfs", str(disk)],
+                       capture_output=True, text=True)
+    if p.returncode:
+        pytest.skip(f"cannot mount a tmpfs here: {p.stderr.strip()}")
+    yield disk
+    subprocess.run(["umount", "-l", str(disk)], capture_output=True)
+
+
+def test_full_disk_keeps_whole_rows_and_resumes_once_there_is_room(small_disk, tmp_path,
+                                                                   capsys):
+    argv = ["--dt", "5e-5", "--T", "2", "--flush-every", "1000", "--format", "none"]
+    out = small_disk / "run"
+    assert exit_code(point_stops.main, argv + ["--checkpoint-every", "0",
+                                               "--out", str(out)]) == 3
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and "No space left on device" in err[0], err
+    assert "whole rows of timeseries.csv" in err[0] and f"--resume {out}" in err[0]
+    s = summary(out)
+    assert s["status"] == "failed" and "No space left" in s["message"]
+    ref = tmp_path / "ref"
+    assert exit_code(point_stops.main, argv + ["--out", str(ref)]) == 0
+    kept, full = whole_rows(out), whole_rows(ref)
+    assert 1000 < len(kept) < len(full) and kept == full[:len(kept)]
+    assert int(checkpoint(out)["rows"]) <= len(kept) - 1
+    subprocess.run(["mount", "-o", "remount,size=16m", str(small_disk)], check=True)
+    assert exit_code(point_stops.main, ["--resume", str(out)]) == 0
+    assert (out / "timeseries.csv").read_bytes() == (ref / "timeseries.csv").read_bytes()
+    assert summary(out)["status"] == "success"
+
+
+# ---------------------------------------------------------------- output flags
+
+@pytest.mark.parametrize("main", [point_stops.main, impacting_bar.main])
+@pytest.mark.parametrize("flag, value", [
+    ("--frames", "-1"), ("--frames", "0"), ("--save-every", "0"), ("--flush-every", "0"),
+    ("--flush-every", "-5"), ("--checkpoint-every", "nan"), ("--checkpoint-every", "-1"),
+    ("--checkpoint-every", "inf"), ("--format", "png")])
+def test_output_flags_are_checked(tmp_path, capsys, main, flag, value):
+    argv = ["--T", "0.1", flag, value, "--out", str(tmp_path / "run")]
+    assert exit_code(main, argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and value in err and \
+        flag.lstrip("-") in err.replace("_", "-"), err
+    assert not list(tmp_path.iterdir())

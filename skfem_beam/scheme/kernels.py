@@ -6,7 +6,9 @@ Three named tuples travel through the loop (numba compiles them as plain structs
   observer and penetration-sample rows as CSR triples, the law's constants);
 - ``State``: uⁿ⁻¹, uⁿ and what the next step needs (the law's warm start, y = Cu of
   both states, contact flags, counters and running diagnostics), plus scratch;
-- ``Series``: the saved series and field frames.
+- ``Series``: the saved series, field frames and impact events;
+- ``Inputs``: what the chunk's steps take from outside: the load coefficients Gⁿ and
+  φ(t_{n+1}), the motion that moves the bounds (zero when they do not move).
 
 A step (the module docstring of :mod:`skfem_beam.scheme` has the equations):
 
@@ -24,13 +26,12 @@ from numba import njit, objmode
 
 from ..linalg import band_solve, rows_dot, rows_matvec
 
-FAILED, UNSTABLE = 1, 2
-
 Ops = namedtuple("Ops", [
     "dt", "beta", "save_every", "frame_every",
     "Kb", "Bb", "Achol", "Eb",        # K, damping B (0 rows: none), A's factor, M/Δt² + βK
     "loads",                          # (n, k) load vectors b_k
-    "Cp", "Ci", "Cx", "lo", "hi",     # constrained values y = C u and their bounds
+    "Cp", "Ci", "Cx", "lo", "hi",     # constrained values y = C u and their bounds at rest
+    "shift", "sshift",                # bounds at t: lo + shift·φ(t) (and samples); () if fixed
     "W", "D",                         # A⁻¹Cᵀ and the Delassus matrix C A⁻¹ Cᵀ
     "Op", "Oi", "Ox",                 # observed values (e.g. the tip)
     "Sp", "Si", "Sx", "slo", "shi",   # penetration samples between the nodes and their bounds
@@ -39,14 +40,23 @@ Ops = namedtuple("Ops", [
 State = namedtuple("State", [
     "u_prev", "u_cur",                # uⁿ⁻¹, uⁿ
     "y_prev", "y_cur",                # C uⁿ⁻¹, C uⁿ
+    "lo", "hi", "slo", "shi",         # the bounds now (moved with the support, or as at rest)
     "law_state", "active", "active_prev",
     "stats",      # [max nodal violation, max (g1−u)⁺ sampled, max (u−g2)⁺ sampled, -]
-    "counters",   # [impacts, steps in contact, law iterations, step where it stopped]
+    "counters",   # [impacts, steps in contact, law iterations, step where it stopped,
+                  #  impact events written]
+    "work",       # Σ over the steps of [damping, load input, contact] work (energy units)
+    "impact",     # per constrained value: [start step, approach velocity, peak |λ|,
+                  #  Σ λΔt, max violation] of the contact under way (start −1: none)
     "r_e",                            # the law's explicit force (see contact.base)
-    "x", "yf", "mu", "Ku", "d",       # the step's free solution (then uⁿ⁺¹), C x, μ, K uⁿ, scratch
-])
-Series = namedtuple("Series", ["obs", "obsv", "energy", "lam", "frames_u", "frames_v",
-                               "frames_f"])
+    "x", "yf", "mu", "Ku", "d", "dy", # the step's free solution (then uⁿ⁺¹), C x, μ, K uⁿ,
+])                                    # scratch (n), C(uⁿ⁺¹ − uⁿ⁻¹)
+Series = namedtuple("Series", ["obs", "obsv", "energy", "work", "lam", "frames_u", "frames_v",
+                               "frames_f", "events"])
+Inputs = namedtuple("Inputs", ["G", "phi"])
+EVENT_COLUMNS = ("value", "start_step", "end_step", "velocity", "peak_force", "impulse",
+                 "max_violation")
+FAILED, UNSTABLE, EVENTS_FULL = 1, 2, 3
 
 
 @njit(cache=True)
@@ -86,19 +96,37 @@ def free_step(ops, st, Gn):
 
 
 @njit(cache=True, inline="always")
-def finish_step(ops, st):
-    """uⁿ⁺¹ = x_free + W μ; shift (uⁿ⁻¹, uⁿ) ← (uⁿ, uⁿ⁺¹) and their constrained values."""
-    x, mu = st.x, st.mu
+def finish_step(ops, st, Gn):
+    """uⁿ⁺¹ = x_free + W μ; the step's damping and load work (below); shift
+    (uⁿ⁻¹, uⁿ) ← (uⁿ, uⁿ⁺¹) and their constrained values, st.dy ← C(uⁿ⁺¹ − uⁿ⁻¹).
+
+    The scheme's energy identity, from its equation times (uⁿ⁺¹ − uⁿ⁻¹)ᵀ/Δt²:
+        ½E_β^{n+1} − ½E_β^n + δᵀBδ/(4Δt) = ½ Gⁿ·Lᵀδ + ½ λᵀCδ,   δ = uⁿ⁺¹ − uⁿ⁻¹,
+    (L the load vectors), so the saved energy, the damping work and the load and contact
+    work add up to round-off at every step (``st.work``)."""
+    x, mu, d = st.x, st.mu, st.d
     for j in range(mu.size):
         if mu[j] != 0.0:
             for i in range(x.size):
                 x[i] += ops.W[i, j] * mu[j]
     for i in range(x.size):
+        d[i] = x[i] - st.u_prev[i]
+    if ops.Bb.shape[0]:
+        st.work[0] += rows_dot(ops.Bb, d, d) / (4.0 * ops.dt)
+    for k in range(Gn.size):
+        s = 0.0
+        for i in range(x.size):
+            s += ops.loads[i, k] * d[i]
+        st.work[1] += 0.5 * Gn[k] * s
+    for i in range(x.size):
         st.u_prev[i] = st.u_cur[i]
         st.u_cur[i] = x[i]
     for j in range(mu.size):
+        st.dy[j] = -st.y_prev[j]
         st.y_prev[j] = st.y_cur[j]
     csr_product(ops.Cp, ops.Ci, ops.Cx, st.u_cur, st.y_cur)
+    for j in range(mu.size):
+        st.dy[j] += st.y_cur[j]
 
 
 @njit(cache=True)
@@ -120,17 +148,17 @@ def record(n, ops, st, out):
     """Diagnostics after state n: penetration (every step), saved series, frames."""
     stats, u_cur, u_prev, dt = st.stats, st.u_cur, st.u_prev, ops.dt
     for r in range(st.y_cur.size):
-        v = max(ops.lo[r] - st.y_cur[r], st.y_cur[r] - ops.hi[r])
+        v = max(st.lo[r] - st.y_cur[r], st.y_cur[r] - st.hi[r])
         if v > stats[0]:
             stats[0] = v
-    for r in range(ops.slo.size):
+    for r in range(st.slo.size):
         s = 0.0
         for p in range(ops.Sp[r], ops.Sp[r + 1]):
             s += ops.Sx[p] * u_cur[ops.Si[p]]
-        if ops.slo[r] - s > stats[1]:
-            stats[1] = ops.slo[r] - s
-        if s - ops.shi[r] > stats[2]:
-            stats[2] = s - ops.shi[r]
+        if st.slo[r] - s > stats[1]:
+            stats[1] = st.slo[r] - s
+        if s - st.shi[r] > stats[2]:
+            stats[2] = s - st.shi[r]
     dt2 = dt * dt
     if n % ops.save_every == 0:
         k = n // ops.save_every
@@ -143,6 +171,8 @@ def record(n, ops, st, out):
             out.obs[k, r] = s
             out.obsv[k, r] = sv / dt
         out.energy[k] = 0.5 * energy_beta(ops.Eb, u_prev, u_cur, st.Ku, st.d)
+        for c in range(3):
+            out.work[k, c] = st.work[c]
         for j in range(st.mu.size):
             out.lam[k, j] = st.mu[j] / dt2
     if n % ops.frame_every == 0:
@@ -157,60 +187,117 @@ def record(n, ops, st, out):
 @njit(cache=True, inline="always")
 def call_law(law, ops, st):
     """One call of a compiled law on the state's free step (the start step uses it)."""
-    return law(ops.D, st.yf, st.y_cur, st.y_prev, ops.lo, ops.hi, ops.params, st.law_state,
+    return law(ops.D, st.yf, st.y_cur, st.y_prev, st.lo, st.hi, ops.params, st.law_state,
                st.mu, st.active)
 
 
 @njit(cache=True)
-def call_explicit(explicit, ops, y_cur, y_prev, r):
-    return explicit(y_cur, y_prev, ops.lo, ops.hi, ops.params, r)
+def call_explicit(explicit, ops, st, y_cur, y_prev, r):
+    return explicit(y_cur, y_prev, st.lo, st.hi, ops.params, r)
 
 
 @njit(cache=True, inline="always")
-def end_step(ops, st, out, step, Ebound):
-    """After the law: uⁿ⁺¹, the contact bookkeeping and the diagnostics of state step+1.
-    Returns UNSTABLE when its saved energy is non-finite or above Ebound, else 0."""
-    counters = st.counters
-    finish_step(ops, st)
-    for j in range(st.r_e.size):   # the contact force: explicit and implicit parts
-        if st.r_e[j] != 0.0:
-            st.mu[j] += ops.dt * ops.dt * st.r_e[j]
+def move_bounds(ops, st, phi):
+    """The bounds at t_{n+1}: at rest plus shift·φ(t_{n+1}) (obstacles that move with a
+    support, seen in the lifted variable)."""
+    for j in range(ops.shift.size):
+        st.lo[j] = ops.lo[j] + ops.shift[j] * phi
+        st.hi[j] = ops.hi[j] + ops.shift[j] * phi
+    for r in range(ops.sshift.size):
+        st.slo[r] = ops.slo[r] + ops.sshift[r] * phi
+        st.shi[r] = ops.shi[r] + ops.sshift[r] * phi
+
+
+@njit(cache=True, inline="always")
+def track_impacts(ops, st, out, step):
+    """Contact bookkeeping after state step+1: impacts counted when a value enters
+    contact, and one event row (see EVENT_COLUMNS) when it leaves.  Returns
+    EVENTS_FULL when the event buffer has no room left for another row."""
+    counters, ev, dt = st.counters, st.impact, ops.dt
     any_active = False
     for j in range(st.active.size):
         a = st.active[j]
         if a and not st.active_prev[j]:
             counters[0] += 1
+            ev[j, 0] = step + 1
+            # approach velocity (yⁿ − yⁿ⁻¹)/Δt, with yⁿ⁻¹ = yⁿ⁺¹ − dy
+            ev[j, 1] = (st.y_prev[j] - st.y_cur[j] + st.dy[j]) / dt
+            ev[j, 2] = 0.0
+            ev[j, 3] = 0.0
+            ev[j, 4] = 0.0
+        if a:
+            lam = st.mu[j] / (dt * dt)
+            ev[j, 2] = max(ev[j, 2], abs(lam))
+            ev[j, 3] += lam * dt
+            ev[j, 4] = max(ev[j, 4], st.lo[j] - st.y_cur[j], st.y_cur[j] - st.hi[j])
+        elif st.active_prev[j]:
+            write_event(out, counters, j, ev[j], step + 1)
         st.active_prev[j] = a
         any_active = any_active or a
     if any_active:
         counters[1] += 1
+    return EVENTS_FULL if counters[4] + st.active.size > out.events.shape[0] else 0
+
+
+@njit(cache=True, inline="always")
+def write_event(out, counters, j, e, end_step):
+    k = counters[4]
+    out.events[k, 0] = j
+    out.events[k, 1] = e[0]
+    out.events[k, 2] = end_step
+    for c in range(1, 5):
+        out.events[k, c + 2] = e[c]
+    counters[4] = k + 1
+    e[0] = -1.0
+
+
+@njit(cache=True, inline="always")
+def end_step(ops, st, out, step, Gn, Ebound):
+    """After the law: uⁿ⁺¹, the contact bookkeeping and the diagnostics of state step+1.
+    Returns UNSTABLE when its saved energy is non-finite or above Ebound, EVENTS_FULL
+    when the event buffer must be emptied before the next step, else 0."""
+    counters, dt2 = st.counters, ops.dt * ops.dt
+    finish_step(ops, st, Gn)
+    for j in range(st.r_e.size):   # the contact force: explicit and implicit parts
+        if st.r_e[j] != 0.0:
+            st.mu[j] += dt2 * st.r_e[j]
+    for j in range(st.mu.size):
+        if st.mu[j] != 0.0:
+            st.work[2] += 0.5 * st.mu[j] / dt2 * st.dy[j]
+    full = track_impacts(ops, st, out, step)
     record(step + 1, ops, st, out)
     if (step + 1) % ops.save_every == 0 \
             and not abs(out.energy[(step + 1) // ops.save_every]) <= Ebound:
         counters[3] = step + 1
         return UNSTABLE
-    return 0
+    if full:
+        counters[3] = step + 1
+    return full
 
 
 # Compiled without numba's reference counting: the loop allocates nothing, and the
 # refcount operations on the named tuples' arrays cost 0.6 µs of a 1.3 µs step (measured).
 @njit(cache=True, _nrt=False)
-def run_steps(law, explicit, ops, st, out, n0, n1, G, Ebound):
-    """Steps n = n0..n1−1 (computing uⁿ⁺¹) with a compiled law: its explicit force, the
-    free step, the law, then `end_step`.  ``G[n − n0]``: the load coefficients Gⁿ.
+def run_steps(law, explicit, ops, st, out, n0, n1, inputs, Ebound):
+    """Steps n = n0..n1−1 (computing uⁿ⁺¹) with a compiled law: the bounds at t_{n+1},
+    the law's explicit force, the free step, the law, then `end_step`.  ``inputs``
+    (Inputs) hold Gⁿ and φ(t_{n+1}) at row n − n0.
 
-    Returns 0, FAILED (the law failed at step counters[3]) or UNSTABLE (the energy saved
-    at state counters[3] is non-finite or above Ebound).
+    Returns 0, FAILED (the law failed at step counters[3]), UNSTABLE (the energy saved
+    at state counters[3] is non-finite or above Ebound) or EVENTS_FULL (stopped after
+    state counters[3] for the caller to take the impact events).
     """
     for step in range(n0, n1):
-        explicit(st.y_cur, st.y_prev, ops.lo, ops.hi, ops.params, st.r_e)
-        free_step(ops, st, G[step - n0])
+        Gn = inputs.G[step - n0]
+        move_bounds(ops, st, inputs.phi[step - n0])
+        explicit(st.y_cur, st.y_prev, st.lo, st.hi, ops.params, st.r_e)
+        free_step(ops, st, Gn)
         its = call_law(law, ops, st)
         if its < 0:
             st.counters[3] = step + 1
             return FAILED
         st.counters[2] += its
-        code = end_step(ops, st, out, step, Ebound)
+        code = end_step(ops, st, out, step, Gn, Ebound)
         if code:
             return code
     return 0
@@ -234,11 +321,12 @@ def _solve_in_python(x, yf, mu) -> int:
 
 
 @njit(cache=True)
-def run_steps_python(ops, st, out, n0, n1, G, Ebound):
+def run_steps_python(ops, st, out, n0, n1, inputs, Ebound):
     """The same steps as `run_steps` with the law solved in Python (`PythonLaw.solver`,
-    e.g. OSQP or daqp): the compiled loop calls it for μ at each step."""
+    e.g. OSQP or daqp, set up for bounds at rest): the compiled loop calls it for μ."""
     for step in range(n0, n1):
-        free_step(ops, st, G[step - n0])
+        Gn = inputs.G[step - n0]
+        free_step(ops, st, Gn)
         x, yf, mu = st.x, st.yf, st.mu
         with objmode(its="int64"):
             its = _solve_in_python(x, yf, mu)
@@ -248,11 +336,7 @@ def run_steps_python(ops, st, out, n0, n1, G, Ebound):
         for j in range(mu.size):
             st.active[j] = mu[j] != 0.0
         st.counters[2] += its
-        code = end_step(ops, st, out, step, Ebound)
+        code = end_step(ops, st, out, step, Gn, Ebound)
         if code:
             return code
     return 0
-
-
-def empty_csr(n_rows: int = 0):
-    return (np.zeros(n_rows + 1, np.int64), np.zeros(0, np.int64), np.zeros(0))

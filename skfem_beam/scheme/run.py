@@ -14,8 +14,8 @@ from ..contact.registry import Auto
 from ..errors import InputError, SolverError
 from ..linalg import band_solve, rows_matvec
 from ..stability import kappa_h, linear_limit
-from .kernels import (FAILED, UNSTABLE, Ops, PythonLaw, Series, State, call_explicit,
-                      call_law, csr_product,
+from .kernels import (EVENTS_FULL, FAILED, UNSTABLE, Inputs, Ops, PythonLaw, Series,
+                      State, call_explicit, call_law, move_bounds, csr_product,
                       energy_beta, record, run_steps, run_steps_python)
 from .operators import csr_arrays, step_operators
 from .stepping import Result, Stepping
@@ -70,31 +70,37 @@ class Run:
         else:
             samples = (np.zeros(1, np.int64), np.zeros(0, np.int64), np.zeros(0))
             slo = shi = np.zeros(0)
+        moving = system.bound_motion is not None
+        if moving and self.pysolver is not None:
+            raise InputError(f"solver={law.name!r} is set up for bounds at rest; with obstacles "
+                             f"that move with a support use active-set or projection")
+        shift = np.ascontiguousarray(system.bound_shift, dtype=float) if moving else np.zeros(0)
+        sshift = np.ascontiguousarray(system.sample_shift, dtype=float) \
+            if moving and slo.size else np.zeros(0)
         self.ops = Ops(s.dt, s.beta, s.save_every, s.frame_every, op.Kb.rows, op.Bb,
                        op.Ab.chol, op.Eb.rows, self.loads, *csr_arrays(op.C), step.lo, step.hi,
-                       op.W, op.D, *csr_arrays(Orows), *samples, slo, shi, params)
+                       shift, sshift, op.W, op.D, *csr_arrays(Orows), *samples, slo, shi, params)
         n = system.n
         self.st = State(np.empty(n), np.empty(n), np.empty(m), np.empty(m),
+                        step.lo.copy(), step.hi.copy(), slo.copy(), shi.copy(),
                         np.zeros(m, np.int8), np.zeros(m, np.bool_), np.zeros(m, np.bool_),
-                        np.zeros(4), np.zeros(4, np.int64), np.zeros(m),
-                        np.empty(n), np.empty(m), np.zeros(m), np.empty(n), np.empty(n))
+                        np.zeros(4), np.zeros(5, np.int64), np.zeros(3),
+                        np.full((m, 5), -1.0), np.zeros(m),
+                        np.empty(n), np.empty(m), np.zeros(m), np.empty(n), np.empty(n),
+                        np.zeros(m))
         nsave, nframes = n_steps // s.save_every + 1, n_steps // s.frame_every + 1
         nobs = Orows.shape[0]
         self.out = Series(np.full((nsave, nobs), np.nan), np.full((nsave, nobs), np.nan),
-                          np.full(nsave, np.nan), np.zeros((nsave, m)),
+                          np.full(nsave, np.nan), np.zeros((nsave, 3)), np.zeros((nsave, m)),
                           np.full((nframes, n), np.nan), np.full((nframes, n), np.nan),
-                          np.zeros((nframes, m)))
+                          np.zeros((nframes, m)), np.zeros((max(4096, 4 * m), 7)))
+        self.events = []       # impact event rows taken from the compiled loop's buffer
         self._start(Orows, law.setup(step, first=True))
-        self.work = 0.0        # Σ‖Gⁿ‖_{M⁻¹}Δt so far: the a-priori energy bound grows with it
+        self.load_bound = 0.0  # Σ‖Gⁿ‖_{M⁻¹}Δt so far: the a-priori energy bound grows with it
         self.n = 1             # the last computed state
         self.wall = 0.0
         self.status, self.message = "running", ""
-        # load the compiled loop now, outside the timed loop
-        no_loads = np.zeros((0, self.loads.shape[1]))
-        if self.pysolver is None:
-            run_steps(*self._kernels, self.ops, self.st, self.out, 1, 1, no_loads, 0.0)
-        else:
-            run_steps_python(self.ops, self.st, self.out, 1, 1, no_loads, 0.0)
+        self._steps(1, 1, 0.0)   # load the compiled loop now, outside the timed loop
 
     @property
     def _kernels(self):
@@ -123,10 +129,11 @@ class Run:
         if B is not None:
             F0 -= 0.5 * dt**2 * (B @ v0)
         csr_product(self.ops.Cp, self.ops.Ci, self.ops.Cx, u0, st.y_prev)
+        move_bounds(self.ops, st, self.motion(np.array([dt]))[0])   # the bounds at t₁
         kernel, explicit = self._kernels
         first = self.ops._replace(params=first_params)
         if explicit is not no_explicit:   # its force at u⁰ as load, implicit at u¹ (as K)
-            call_explicit(explicit, first, st.y_prev, st.y_prev, st.r_e)
+            call_explicit(explicit, first, st, st.y_prev, st.y_prev, st.r_e)
             F0 += dt**2 * (op.C.T @ st.r_e)
             st.r_e[:] = 0.0
         u1 = F0.copy()
@@ -160,6 +167,11 @@ class Run:
                              f"the first step's energy is {self.E1:g}")
         out.energy[0] = self.E1
 
+    def motion(self, t):
+        """φ(t) that moves the bounds (zero when they do not move)."""
+        phi = self.system.bound_motion
+        return np.asarray(phi(t), dtype=float) if phi is not None else np.zeros(np.shape(t))
+
     def load_coefficients(self, n0, n1):
         """Gⁿ = βf^{n+1} + (1−2β)fⁿ + βf^{n−1} for n = n0..n1−1 (per chunk: flat memory)."""
         nk = self.loads.shape[1]
@@ -178,6 +190,46 @@ class Run:
                                     + _GAUSS_W[2] * v[2] + _GAUSS_W[3] * v[3]) / 2.0
         return np.ascontiguousarray(beta * f[2:] + (1 - 2 * beta) * f[1:-1] + beta * f[:-2])
 
+    def _steps(self, n0, n1, Ebound, inputs=None):
+        """The compiled loop over steps n0..n1−1 (see kernels.run_steps)."""
+        if inputs is None:
+            inputs = Inputs(np.zeros((0, self.loads.shape[1])), np.zeros(0))
+        if self.pysolver is None:
+            return run_steps(*self._kernels, self.ops, self.st, self.out, n0, n1, inputs, Ebound)
+        PythonLaw.solver, PythonLaw.error = self.pysolver, None
+        try:
+            return run_steps_python(self.ops, self.st, self.out, n0, n1, inputs, Ebound)
+        finally:
+            PythonLaw.solver = None
+
+    def _take_events(self) -> None:
+        k = int(self.st.counters[4])
+        if k:
+            self.events.append(self.out.events[:k].copy())
+            self.st.counters[4] = 0
+
+    def _all_events(self) -> np.ndarray:
+        return np.concatenate(self.events) if self.events else np.zeros((0, 7))
+
+    def impact_events(self) -> dict:
+        """One row per impact of a constrained value so far (contacts still under way end
+        at the last state): ``value`` (its index), ``x``, ``t_start``, ``t_end``,
+        ``velocity`` (approach velocity (yⁿ − yⁿ⁻¹)/Δt before contact), ``peak_force``
+        (max |λ|), ``impulse`` (Σ λΔt), ``max_violation`` (m), in the system's units."""
+        rows = [self._all_events()]
+        open_ = self.st.impact[:, 0] >= 0
+        if open_.any():
+            j = np.flatnonzero(open_)
+            e = self.st.impact[j]
+            rows.append(np.column_stack([j, e[:, 0], np.full(j.size, self.n), e[:, 1:]]))
+        table = np.concatenate(rows)
+        table = table[np.lexsort((table[:, 0], table[:, 1]))]
+        x = np.asarray(self.system.x_contact, dtype=float)
+        value = table[:, 0].astype(int)
+        return {"value": value, "x": x[value], "t_start": table[:, 1] * self.dt,
+                "t_end": table[:, 2] * self.dt, "velocity": table[:, 3],
+                "peak_force": table[:, 4], "impulse": table[:, 5], "max_violation": table[:, 6]}
+
     @property
     def done(self) -> bool:
         return self.status != "running"
@@ -189,20 +241,21 @@ class Run:
             return
         t0 = time.perf_counter()
         G = self.load_coefficients(n0, n1)
-        self.work += float((np.abs(G) @ self.Minv_norm).sum()) * self.dt if G.shape[1] else 0.0
+        self.load_bound += float((np.abs(G) @ self.Minv_norm).sum()) * self.dt \
+            if G.shape[1] else 0.0
         # the bound grows with n: its chunk-end value is the loosest for the chunk
-        Ebound = self.stepping.growth_limit * (math.sqrt(abs(self.E1)) + self.work) ** 2 + 1e-300
+        Ebound = self.stepping.growth_limit * (math.sqrt(abs(self.E1)) + self.load_bound) ** 2 \
+            + 1e-300
         if not math.isfinite(Ebound):
             raise InputError(f"the load is too large for floating point: its work by step {n1} "
-                             f"is {self.work:g}")
-        if self.pysolver is None:
-            code = run_steps(*self._kernels, self.ops, self.st, self.out, n0, n1, G, Ebound)
-        else:
-            PythonLaw.solver, PythonLaw.error = self.pysolver, None
-            try:
-                code = run_steps_python(self.ops, self.st, self.out, n0, n1, G, Ebound)
-            finally:
-                PythonLaw.solver = None
+                             f"is {self.load_bound:g}")
+        inputs = Inputs(G, self.motion(np.arange(n0 + 1, n1 + 1) * self.dt))
+        code, at = self._steps(n0, n1, Ebound, inputs), n0
+        while code == EVENTS_FULL:       # take the impact events, go on from where it stopped
+            self._take_events()
+            at, k = int(self.st.counters[3]), int(self.st.counters[3]) - n0
+            code = self._steps(at, n1, Ebound, Inputs(G[k:], inputs.phi[k:]))
+        self._take_events()
         self.wall += time.perf_counter() - t0
         k = int(self.st.counters[3])
         if code == FAILED:
@@ -236,7 +289,9 @@ class Run:
     u_cur = property(lambda self: self.st.u_cur)
 
     _STATE = {"u_prev": "u_prev", "u_cur": "u_cur", "state": "law_state",
-              "active_prev": "active_prev", "stats": "stats", "counters": "counters"}
+              "active_prev": "active_prev", "stats": "stats", "counters": "counters",
+              "lo": "lo", "hi": "hi", "slo": "slo", "shi": "shi", "work_sums": "work",
+              "impact": "impact"}
     _FRAMES = {"fr": "frames_u", "frv": "frames_v", "frf": "frames_f"}
 
     def checkpoint(self) -> dict:
@@ -247,7 +302,8 @@ class Run:
                              f"active-set, penalty), not {self.solver!r}")
         return {**{k: getattr(self.st, v).copy() for k, v in self._STATE.items()},
                 **{k: getattr(self.out, v).copy() for k, v in self._FRAMES.items()},
-                "n": self.n, "work": self.work, "wall": self.wall, "E1": self.E1}
+                "events": self._all_events(), "n": self.n, "load_bound": self.load_bound,
+                "wall": self.wall, "E1": self.E1}
 
     def restore(self, ck: dict) -> None:
         for k, v in self._STATE.items():
@@ -257,7 +313,8 @@ class Run:
         ops = self.ops
         csr_product(ops.Cp, ops.Ci, ops.Cx, self.st.u_prev, self.st.y_prev)
         csr_product(ops.Cp, ops.Ci, ops.Cx, self.st.u_cur, self.st.y_cur)
-        self.n, self.work, self.wall, self.E1 = int(ck["n"]), float(ck["work"]), \
+        self.events = [np.asarray(ck["events"], dtype=float).reshape(-1, 7)]
+        self.n, self.load_bound, self.wall, self.E1 = int(ck["n"]), float(ck["load_bound"]), \
             float(ck["wall"]), float(ck["E1"])
 
     def result(self) -> Result:
@@ -279,4 +336,6 @@ class Run:
             max_penetration=float(max(st[1], st[2], st[0], 0.0)),
             max_penetration_below=float(st[1]), max_penetration_above=float(st[2]),
             impacts=int(c[0]), contact_fraction=float(c[1]) / max(1, self.n - 1),
-            qp_iterations=int(c[2]), system=self.system)
+            qp_iterations=int(c[2]),
+            work={k: out.work[:keep, i] for i, k in enumerate(("damping", "input", "contact"))},
+            impact_events=self.impact_events(), system=self.system)

@@ -68,7 +68,11 @@ class Result:
     length, m²/s² for the beam); ``frames_t``, ``frames_u``, ``frames_v`` (backward
     difference velocity), ``frames_force`` (λ): decimated coefficient vectors;
     ``status``: "success" or "unstable"; ``message`` says why; ``solver``: the contact
-    law's name.
+    law's name; ``work``: the damping, load-input and contact work done since state 1
+    (at the saved times, in the units of ``energy``): the scheme's identity
+    energy − energy[0] + work["damping"] = work["input"] + work["contact"] holds to
+    round-off (impacts lose energy: the contact work is ≤ 0 for exact contact);
+    ``impact_events``: one row per impact (see ``Run.impact_events``).
     """
     t: np.ndarray
     observed: dict
@@ -94,6 +98,8 @@ class Result:
     impacts: int
     contact_fraction: float
     qp_iterations: int
+    work: dict = field(repr=False)
+    impact_events: dict = field(repr=False)
     system: object = field(repr=False)
 
     @property

@@ -124,6 +124,14 @@ def static_lifting(space, at: float, k2: float) -> np.ndarray:
     return c_p + T @ z
 
 
+def _evaluator(space, c: np.ndarray, derivative: int) -> Callable:
+    """x ↦ d^k/dx^k of the full-space function with coefficients c, for x of any shape."""
+    def f(x):
+        x = np.asarray(x, dtype=float)
+        return (space.point_rows(x.ravel(), derivative, full=True) @ c).reshape(x.shape)
+    return f
+
+
 def _lifting(problem: BeamProblem, space) -> tuple[Lifting, list, list]:
     """The lifting and its load terms (profiles or vectors, times) f = −m(h,·)φ'' − a(h,·)φ."""
     sup, L, k2 = problem.support, problem.beam.L, problem.beam.k2
@@ -135,8 +143,7 @@ def _lifting(problem: BeamProblem, space) -> tuple[Lifting, list, list]:
             [sup.phi_dd, sup.phi]
     c = static_lifting(space, sup.at, k2)
     Mf, Sf = space.full_matrices()
-    lift = Lifting("static", *(lambda x, k=k: space.point_rows(x, k, full=True) @ c
-                               for k in range(3)), sup)
+    lift = Lifting("static", *(_evaluator(space, c, k) for k in range(3)), sup)
     # a(h, ·) vanishes on V_h up to round-off (or is the shift's s·m(h, ·)): kept, exact
     return lift, [-(space.T.T @ (Mf @ c)), -(k2 * (space.T.T @ (Sf @ c)))], \
         [sup.phi_dd, sup.phi]

@@ -125,11 +125,17 @@ def observe_constraints(system):
 def test_moving_support_with_obstacles_over_the_span(carried, lifting):
     s = observe_constraints(beam_system(span_problem(carried, lifting)))
     h = s.view.lift.h(s.x_contact)
-    np.testing.assert_allclose(s.bound_shift, (1.0 if carried else 0.0) - h, atol=1e-12)
+    want = (1.0 if carried else 0.0) - h
+    if s.bound_shift is None:   # carried on a rigidly translating cantilever: at rest in u
+        assert carried and lifting == "static" and np.abs(want).max() < 1e-9
+        phi, shift0 = (lambda t: np.zeros_like(t)), np.zeros_like(h)
+    else:
+        np.testing.assert_allclose(s.bound_shift, want, atol=1e-12)
+        phi, shift0 = s.bound_motion, s.bound_shift
     r = solve(s, dt=1e-4, T=1.0, solver="active-set")
     assert r.success and r.impacts > 5
     y = np.column_stack([r.observed[f"y{i}"] for i in range(s.C.shape[0])])
-    shift = np.outer(s.bound_motion(r.t), s.bound_shift)
+    shift = np.outer(phi(r.t), shift0)
     violation = np.maximum(s.lo + shift - y, y - s.hi - shift).max()
     assert violation <= 1e-10, violation
     assert r.max_nodal_violation <= 1e-10

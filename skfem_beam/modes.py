@@ -1,7 +1,8 @@
 """Natural frequencies and mode shapes of a beam with its end conditions and supports.
 
-The free vibrations u(x, t) = φ(x) cos(ωt) of u_tt + k² u_xxxx = 0 solve the discrete
-generalised eigenproblem  K φ = ω² M φ  with K = k² S on the space of the problem
+The free vibrations u(x, t) = φ(x) cos(ωt) of ρA u_tt + (EI u'')'' = 0 solve the discrete
+generalised eigenproblem  K φ = ω² M φ  (K = k² S, both weighted per element for a
+stepped beam, mass-normalised by ρA_ref) on the space of the problem
 (Hermite or B-spline, with ``ends`` and ``supports``).  Obstacles, loads, the support
 motion and the initial state are ignored.
 
@@ -27,8 +28,8 @@ from skfem.refdom import RefLine
 
 from .errors import InputError
 from .problem import BeamProblem
-from .spaces import make_space
-from .spaces.ends import fixed_dofs
+from .semidiscrete import beam_space
+from .spaces import has_rigid_motion  # noqa: F401  (kept importable from here)
 
 DENSE_MAX = 400   # up to this many dofs a dense solve is fast and needs no iteration
 
@@ -49,16 +50,9 @@ class Modes:
     space: Any
 
 
-def has_rigid_motion(space) -> bool:
-    """Whether some w = a + b·x ≠ 0 meets the fixed conditions (then K is singular)."""
-    value, slope = fixed_dofs(space.J, space.ends, space.support_nodes)
-    rows = [[1.0, x] for x in space.nodes[value]] + [[0.0, 1.0]] * int(slope.sum())
-    return not rows or np.linalg.matrix_rank(np.array(rows)) < 2
-
-
 def modes(problem: BeamProblem, n: int = 6, samples_per_element: int = 10) -> Modes:
     """The ``n`` lowest natural frequencies and mode shapes of ``problem``'s beam."""
-    space = make_space(problem.element, problem.nodes, problem.ends, problem.supports)
+    space = beam_space(problem)
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 1 <= n <= space.n:
         raise InputError(f"n={n!r} modes: must be a whole number in [1, {space.n}] (the "
                          f"number of degrees of freedom of this mesh)")
@@ -85,7 +79,9 @@ def modes(problem: BeamProblem, n: int = 6, samples_per_element: int = 10) -> Mo
     # at J = 80); the Rayleigh quotient is second order in the eigenvector's error.
     X, W = get_quadrature(RefLine, 4)                          # exact: (v'')² is quadratic
     E2 = space.sampler(X[0]).E2
-    wq = (np.asarray(space.h)[:, None] * W[None, :]).ravel()
+    # EI(x)/ρA_ref per element for a stepped beam (k2 · the bending factor)
+    bend = np.ones(space.J) if space.weights is None else np.asarray(space.weights[1])
+    wq = ((bend * np.asarray(space.h))[:, None] * W[None, :]).ravel()
     polished = k2 * np.einsum("q,qm->m", wq, (E2 @ V) ** 2)
     w2 = np.where(w2 > 1e-6 * k2 / L**4, polished, w2)        # rigid modes: keep ~0
     omega = np.sqrt(np.clip(w2, 0.0, None))

@@ -6,13 +6,16 @@ Python API and the command line refuse bad values the same way: an
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
 
-from .checks import check_beta, check_choice, check_finite, check_positive  # noqa: F401
+from .checks import (check_beta, check_choice, check_finite, check_nonnegative,  # noqa: F401
+                     check_positive)
 from .errors import InputError
+from .timefunctions import Constant, derivative
 from .spaces.ends import DEFAULT_ENDS, END_CONDITIONS, check_ends, fixed_dofs, support_nodes
 
 Profile = Callable[[np.ndarray], np.ndarray]   # g(x), u0(x), ...: vectorised in x
@@ -24,40 +27,170 @@ def _constant(c: float) -> Profile:
 
 
 @dataclass(frozen=True)
-class Beam:
-    """Euler–Bernoulli beam u_tt + k² u_xxxx = f on [0, L] (end conditions: BeamProblem.ends).
+class Material:
+    """Young's modulus ``E`` (Pa) and density ``rho`` (kg/m³)."""
+    E: float
+    rho: float
 
-    ``rho_S`` (kg/m, mass per unit length) is only used to report forces in newtons.
+    def __post_init__(self):
+        object.__setattr__(self, "E", check_positive("E", self.E))
+        object.__setattr__(self, "rho", check_positive("rho", self.rho))
+
+
+@dataclass(frozen=True)
+class Section:
+    """Second moment of area ``I`` (m⁴) and area ``A`` (m²) of a cross-section."""
+    I: float  # noqa: E741  (the engineer's name)
+    A: float
+
+    def __post_init__(self):
+        object.__setattr__(self, "I", check_positive("I", self.I))
+        object.__setattr__(self, "A", check_positive("A", self.A))
+
+    @classmethod
+    def tube(cls, outer_diameter: float, wall: float) -> "Section":
+        """A round tube: I = π(D⁴ − d⁴)/64, A = π(D² − d²)/4, d = D − 2·wall."""
+        D = check_positive("outer_diameter", outer_diameter)
+        wall = check_positive("wall", wall)
+        if wall >= D / 2:
+            raise InputError(f"wall={wall:g} must be less than the outer radius {D / 2:g} "
+                             "(a solid rod: Section.rod)")
+        d = D - 2 * wall
+        return cls(math.pi * (D**4 - d**4) / 64, math.pi * (D**2 - d**2) / 4)
+
+    @classmethod
+    def rod(cls, diameter: float) -> "Section":
+        """A solid round rod: I = πD⁴/64, A = πD²/4."""
+        D = check_positive("diameter", diameter)
+        return cls(math.pi * D**4 / 64, math.pi * D**2 / 4)
+
+    @classmethod
+    def rect(cls, b: float, h: float) -> "Section":
+        """A b × h rectangle bending about the axis parallel to b: I = bh³/12, A = bh."""
+        b, h = check_positive("b", b), check_positive("h", h)
+        return cls(b * h**3 / 12, b * h)
+
+
+@dataclass(frozen=True)
+class Beam:
+    """Euler–Bernoulli beam ρA u_tt + (EI u'')'' = ρA f on [0, L] (end conditions:
+    BeamProblem.ends), solved mass-normalised: divided by ρA_ref (docs/design.md, Units).
+
+    ``Beam(L, k2, rho_S)``: the papers' uniform form, k2 = EI/(ρA) (m⁴/s²); ``rho_S``
+    (ρA, kg/m) only converts forces to newtons and energies to joules, and is needed for
+    loads given in N or N/m.  :meth:`physical` builds it from a Material and a Section;
+    :meth:`stepped` a piecewise-uniform beam, whose ``segments`` are (x_end, EI, ρA) and
+    whose k2, rho_S are the first segment's (the reference of the mass-normalisation).
     """
     L: float
     k2: float
     rho_S: float | None = None
+    segments: tuple[tuple[float, float, float], ...] = ()
 
     def __post_init__(self):
         object.__setattr__(self, "L", check_positive("L", self.L))
         object.__setattr__(self, "k2", check_positive("k2", self.k2))
         if self.rho_S is not None:
             object.__setattr__(self, "rho_S", check_positive("rho_S", self.rho_S))
+        if self.segments and (self.rho_S is None or abs(self.segments[-1][0] - self.L)
+                              > 1e-12 * self.L):
+            raise InputError("Beam.segments: build a stepped beam with Beam.stepped(...)")
+
+    @classmethod
+    def physical(cls, L: float, material: Material, section: Section) -> "Beam":
+        """Uniform beam: k2 = EI/(ρA), rho_S = ρA."""
+        EI, rhoA = material.E * section.I, material.rho * section.A
+        return cls(L, EI / rhoA, rhoA)
+
+    @classmethod
+    def stepped(cls, parts) -> "Beam":
+        """Piecewise-uniform beam from ``parts`` = [(length, Material, Section), ...], left
+        to right; the mesh must have a node at every step (BeamProblem refuses it otherwise)."""
+        parts = list(parts)
+        if not parts:
+            raise InputError("Beam.stepped needs at least one (length, Material, Section)")
+        segs, x = [], 0.0
+        for i, part in enumerate(parts):
+            if len(part) != 3 or not isinstance(part[1], Material) \
+                    or not isinstance(part[2], Section):
+                raise InputError(f"Beam.stepped part {i} must be (length, Material, Section)")
+            x += check_positive(f"length of part {i}", part[0])
+            segs.append((x, part[1].E * part[2].I, part[1].rho * part[2].A))
+        EI0, rhoA0 = segs[0][1], segs[0][2]
+        if all(s[1] == EI0 and s[2] == rhoA0 for s in segs):
+            return cls(x, EI0 / rhoA0, rhoA0)   # uniform after all
+        return cls(x, EI0 / rhoA0, rhoA0, tuple(segs))
+
+    @property
+    def EI(self) -> float | None:
+        """Bending stiffness (N·m²) of the (first) segment, when ρA is known."""
+        return None if self.rho_S is None else self.k2 * self.rho_S
+
+    @property
+    def steps(self) -> tuple[float, ...]:
+        """Abscissae where the section or material changes (mesh nodes needed there)."""
+        return tuple(s[0] for s in self.segments[:-1])
+
+    def factors(self, x) -> tuple[np.ndarray, np.ndarray]:
+        """(ρA(x)/ρA_ref, EI(x)/EI_ref): ones for a uniform beam."""
+        x = np.asarray(x, dtype=float)
+        if not self.segments:
+            return np.ones(x.shape), np.ones(x.shape)
+        seg = np.asarray(self.segments)
+        i = np.clip(np.searchsorted(seg[:, 0], x, side="left"), 0, len(seg) - 1)
+        return seg[i, 2] / seg[0, 2], seg[i, 1] / seg[0, 1]
+
+
+LIFTINGS = ("auto", "paper", "static")
 
 
 @dataclass(frozen=True)
 class Support:
-    """Clamped support moving as φ(t) = amplitude · sin(omega · t)."""
+    """A support whose transverse displacement is prescribed as φ(t).
+
+    ``amplitude``, ``omega``: φ = amplitude · sin(omega · t) (the papers' default); or
+    ``motion``: any time function of :mod:`skfem_beam.timefunctions` (Sine, SumOfSines,
+    Table, ...; a plain callable gets φ', φ'' by finite differences).  ``at``: where it
+    moves: x = 0 or x = L (a clamped or pinned end) or an intermediate support's x.
+    ``lifting``: "paper" (the first paper's h: clamped end at x = 0, free or pinned end at
+    L, uniform beam, no intermediate supports), "static" (h solves the discrete static
+    problem with u = 1 at the moving support, docs/design.md §1), or "auto" (the paper's
+    h where it applies, static elsewhere).
+    """
     amplitude: float = 0.0
     omega: float = 0.0
+    motion: TimeFunction | None = None
+    at: float = 0.0
+    lifting: str = "auto"
 
     def __post_init__(self):
         check_finite("amplitude", self.amplitude)
         check_finite("omega", self.omega)
+        object.__setattr__(self, "at", check_finite("at", self.at))
+        check_choice("lifting", self.lifting, LIFTINGS)
+        if self.motion is not None:
+            if not callable(self.motion):
+                raise InputError(f"motion={self.motion!r} must be a function of t")
+            if self.amplitude != 0.0 or self.omega != 0.0:
+                raise InputError("give either amplitude/omega (a sine) or motion, not both")
 
     @property
     def moves(self) -> bool:
-        return self.amplitude != 0.0 and self.omega != 0.0
+        return self.motion is not None or (self.amplitude != 0.0 and self.omega != 0.0)
 
     def phi(self, t):
+        if self.motion is not None:
+            return np.asarray(self.motion(np.asarray(t, dtype=float)), dtype=float)
         return self.amplitude * np.sin(self.omega * np.asarray(t, dtype=float))
 
+    def phi_d(self, t):
+        if self.motion is not None:
+            return np.asarray(derivative(self.motion, 1)(np.asarray(t, dtype=float)))
+        return self.amplitude * self.omega * np.cos(self.omega * np.asarray(t, dtype=float))
+
     def phi_dd(self, t):
+        if self.motion is not None:
+            return np.asarray(derivative(self.motion, 2)(np.asarray(t, dtype=float)))
         return -self.omega ** 2 * self.phi(t)
 
 
@@ -67,20 +200,96 @@ def lifting(x, L):
     return 1 - 2 * s**2 + 4 / 3 * s**3 - s**4 / 3
 
 
+def lifting_d(x, L):
+    """h'(x) of :func:`lifting`: (−4s + 4s² − 4/3 s³)/L."""
+    s = np.asarray(x, dtype=float) / L
+    return (-4 * s + 4 * s**2 - 4 / 3 * s**3) / L
+
+
+def lifting_dd(x, L):
+    """h''(x) of :func:`lifting`: −4(1 − s)²/L²."""
+    s = np.asarray(x, dtype=float) / L
+    return -4 * (1 - s) ** 2 / L**2
+
+
 @dataclass(frozen=True)
 class Obstacles:
     """Obstacles g1(x) ≤ u(x) ≤ g2(x), enforced at the mesh nodes (the papers' K_h).
 
     ``g1``/``g2`` are numbers or vectorised functions of x; ±inf means no obstacle.
     ``breakpoints`` are abscissae the mesh must contain (ends of flat obstacles, point
-    stops, kinks): a mesh without them is refused.
+    stops, kinks): a mesh without them is refused.  ``carried``: the obstacle moves
+    with the moving support (False: fixed to the ground); see docs/design.md §1 for the
+    bounds this gives in the lifted variable.  :meth:`stops`, :meth:`span` and
+    :meth:`combine` build several obstacles (e.g. baffle clearances) as one.
     """
     g1: float | Profile = -np.inf
     g2: float | Profile = np.inf
     breakpoints: tuple[float, ...] = ()
+    carried: bool = False
+    parts: tuple["Obstacles", ...] = ()
+
+    def __post_init__(self):
+        if not isinstance(self.carried, (bool, np.bool_)):
+            raise InputError(f"carried={self.carried!r} must be True or False")
 
     @classmethod
-    def point_stops(cls, x: float, g1: float, g2: float) -> "Obstacles":
+    def stops(cls, x, g1, g2, carried: bool = False) -> "Obstacles":
+        """Point stops g1[i] ≤ u(x[i]) ≤ g2[i] (numbers apply to every x; ±inf: one-sided)."""
+        xs = np.atleast_1d(np.asarray(x, dtype=float))
+        lo = np.broadcast_to(np.asarray(g1, dtype=float), xs.shape)
+        hi = np.broadcast_to(np.asarray(g2, dtype=float), xs.shape)
+        parts = [cls.point_stops(check_finite(f"x[{i}]", xi), lo[i], hi[i], carried)
+                 for i, xi in enumerate(xs)]
+        return parts[0] if len(parts) == 1 else cls.combine(*parts)
+
+    @classmethod
+    def span(cls, a: float, b: float, g1=-np.inf, g2=np.inf, carried: bool = False) \
+            -> "Obstacles":
+        """A profile g1(x) ≤ u ≤ g2(x) over [a, b] (numbers or functions of x), none elsewhere."""
+        a, b = check_finite("a", a), check_finite("b", b)
+        if b <= a:
+            raise InputError(f"span [a={a:g}, b={b:g}] needs a < b")
+
+        def within(g, outside):
+            return lambda x: np.where((x >= a) & (x <= b),
+                                      g(x) if callable(g) else float(g), outside)
+        return cls(within(g1, -np.inf), within(g2, np.inf), (a, b), carried)
+
+    @classmethod
+    def combine(cls, *obstacles: "Obstacles") -> "Obstacles":
+        """All of ``obstacles`` at once: the highest g1 and the lowest g2 at each x."""
+        parts = tuple(q for o in obstacles for q in (o.parts or (o,)))
+        if not parts or not all(isinstance(o, Obstacles) for o in parts):
+            raise InputError("Obstacles.combine needs one or more Obstacles")
+
+        def g1(x):
+            return np.max([o.bounds(x)[0] for o in parts], axis=0)
+
+        def g2(x):
+            return np.min([o.bounds(x)[1] for o in parts], axis=0)
+        br = tuple(sorted({b for o in parts for b in o.breakpoints}))
+        return cls(g1, g2, br, any(o.carried for o in parts), parts)
+
+    def carried_at(self, x: np.ndarray) -> np.ndarray:
+        """Whether the obstacle at each x moves with the support (one line if a carried and
+        a fixed obstacle both act at one x: their bounds would move differently)."""
+        x = np.asarray(x, dtype=float)
+        if not self.parts:
+            return np.full(x.shape, bool(self.carried))
+        on = [(np.isfinite(lo) | np.isfinite(hi), o.carried)
+              for o in self.parts for lo, hi in [o.bounds(x)]]
+        carried = np.any([f & c for f, c in on], axis=0)
+        fixed = np.any([f & (not c) for f, c in on], axis=0)
+        both = carried & fixed
+        if both.any():
+            raise InputError(f"a carried and a fixed obstacle both act at x={x[both][0]:g}; "
+                             "each node's obstacles must all be carried or all fixed")
+        return carried
+
+    @classmethod
+    def point_stops(cls, x: float, g1: float, g2: float, carried: bool = False) \
+            -> "Obstacles":
         """Two stops at one abscissa x (the first paper's scene at x = L)."""
         g1 = check_finite("g1", g1) if np.isfinite(g1) else g1
         g2 = check_finite("g2", g2) if np.isfinite(g2) else g2
@@ -90,7 +299,7 @@ class Obstacles:
 
         def upper(z, x=x, g=g2):
             return np.where(np.isclose(z, x, rtol=0, atol=1e-12 * max(1.0, abs(x))), g, np.inf)
-        return cls(lower, upper, (float(x),))
+        return cls(lower, upper, (float(x),), carried)
 
     def bounds(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(g1(x), g2(x)) as float arrays, checked: no NaN, g1 < g2 everywhere."""
@@ -114,12 +323,84 @@ class Obstacles:
 
 @dataclass(frozen=True)
 class Load:
-    """External load f̃(x, t) = Σ_k b_k(x) a_k(t): separable terms (spatial, temporal)."""
+    """External load, sum of separable terms profile(x) · a(t).
+
+    ``terms``: per unit mass (m/s², the papers' f̃ of the mass-normalised equation);
+    ``forces``: distributed forces in N/m; ``points``: (x, a) point forces a(t) in N;
+    ``g``: gravity (m/s², acting as −g·ρA(x) on u).  ``forces`` and ``points`` need the
+    beam's ρA (``Beam.physical``, ``Beam.stepped`` or ``rho_S``).  Loads add with ``+``.
+    """
     terms: tuple[tuple[Profile, TimeFunction], ...] = ()
+    forces: tuple[tuple[Profile, TimeFunction], ...] = ()
+    points: tuple[tuple[float, TimeFunction], ...] = ()
+    g: float = 0.0
+
+    def __post_init__(self):
+        object.__setattr__(self, "g", check_finite("g", self.g))
+        for i, (x, a) in enumerate(self.points):
+            check_finite(f"points[{i}] x", x)
+            if not callable(a):
+                raise InputError(f"points[{i}]: the force {a!r} must be a function of t")
+        for name in ("terms", "forces"):
+            for i, (b, a) in enumerate(getattr(self, name)):
+                if not (callable(b) and callable(a)):
+                    raise InputError(f"{name}[{i}] must be (profile(x), function of t)")
 
     @classmethod
     def uniform(cls, a: TimeFunction) -> "Load":
         return cls(((_constant(1.0), a),))
+
+    @classmethod
+    def distributed(cls, q, time: TimeFunction | None = None) -> "Load":
+        """q(x)·time(t) in N/m (q a number or a function of x; time defaults to 1)."""
+        b = q if callable(q) else _constant(check_finite("q", q))
+        return cls(forces=((b, time or Constant(1.0)),))
+
+    @classmethod
+    def point(cls, x: float, P: float, time: TimeFunction | None = None) -> "Load":
+        """A point force P·time(t) in N at x (time defaults to 1)."""
+        P = check_finite("P", P)
+        a = time or Constant(1.0)
+        return cls(points=((check_finite("x", x), lambda t: P * np.asarray(a(t))),))
+
+    @classmethod
+    def gravity(cls, g: float = 9.81) -> "Load":
+        """Self-weight: −g ρA(x) on u (u measured upwards)."""
+        return cls(g=g)
+
+    def __add__(self, other: "Load") -> "Load":
+        return Load(self.terms + other.terms, self.forces + other.forces,
+                    self.points + other.points, self.g + other.g)
+
+
+@dataclass(frozen=True)
+class Damping:
+    """Rayleigh damping B = alpha·M + alpha_K·K (alpha in 1/s, alpha_K in s).
+
+    The modal damping ratio at ω is ζ(ω) = alpha/(2ω) + alpha_K·ω/2; :meth:`ratio`
+    gives the pair with ζ at two frequencies.
+    """
+    alpha: float = 0.0
+    alpha_K: float = 0.0
+
+    def __post_init__(self):
+        object.__setattr__(self, "alpha", check_nonnegative("alpha", self.alpha))
+        object.__setattr__(self, "alpha_K", check_nonnegative("alpha_K", self.alpha_K))
+
+    @classmethod
+    def ratio(cls, zeta: float, f1: float, f2: float) -> "Damping":
+        """ζ(2πf1) = ζ(2πf2) = zeta (f in Hz, f1 ≠ f2); between them ζ is a little lower."""
+        zeta = check_nonnegative("zeta", zeta)
+        w1, w2 = 2 * math.pi * check_positive("f1", f1), 2 * math.pi * check_positive("f2", f2)
+        if f1 == f2:
+            raise InputError(f"f1={f1:g} and f2={f2:g} must differ (two frequencies fix "
+                             "alpha and alpha_K)")
+        # [1/(2ω1) ω1/2; 1/(2ω2) ω2/2] (alpha, alpha_K) = (ζ, ζ)
+        return cls(2 * zeta * w1 * w2 / (w1 + w2), 2 * zeta / (w1 + w2))
+
+    @property
+    def none(self) -> bool:
+        return self.alpha == 0.0 and self.alpha_K == 0.0
 
 
 @dataclass(frozen=True)
@@ -128,10 +409,13 @@ class InitialState:
 
     ``du0`` (the slope of u0) is used by the interpolants (Hermite: slopes at the nodes;
     B-spline: the tip slope); when omitted it is computed by a five-point difference.
+    By default u0, v0 are the lifted u = ũ − hφ (the papers'); ``fixed_frame=True`` reads
+    them as the physical ũ, ũ_t (e.g. zero: at rest in the fixed frame).
     """
     u0: Profile | None = None
     v0: Profile | None = None
     du0: Profile | None = None
+    fixed_frame: bool = False
 
 
 @dataclass(frozen=True)
@@ -153,6 +437,7 @@ class BeamProblem:
     nodes: np.ndarray | None = None   # x_0 = 0 < x_1 < ... < x_J = L; uniform when None
     ends: tuple[str, str] = DEFAULT_ENDS
     supports: tuple[float, ...] = ()
+    damping: Damping = field(default_factory=Damping)
 
     def __post_init__(self):
         object.__setattr__(self, "ends", check_ends(self.ends))
@@ -181,6 +466,12 @@ class BeamProblem:
             if d > 1e-9 * self.beam.L:
                 raise InputError(f"the mesh has no node at the obstacle break point x={b:g} "
                                  f"(nearest node {d:.3g} m away); choose J so that it is a node")
+        for b in self.beam.steps:
+            d = np.abs(self.nodes - b).min()
+            if d > 1e-9 * self.beam.L:
+                raise InputError(f"the mesh has no node at the beam's step x={b:g} (nearest "
+                                 f"node {d:.3g} m away); choose J or nodes so that it is one")
+        self._check_load()
         J = self.nodes.size - 1
         value_fixed, slope_fixed = fixed_dofs(J, self.ends,
                                               support_nodes(self.nodes, self.supports))
@@ -201,15 +492,50 @@ class BeamProblem:
                 raise InputError(f"the obstacles exclude u=0 at the support "
                                  f"x={self.supports[i]:g} (g1={s_lo[i]:g}, g2={s_hi[i]:g})")
         if self.support.moves:
-            if self.ends[0] != "clamped" or self.ends[1] not in ("free", "pinned") \
-                    or self.supports:
-                raise InputError(f"a moving support needs ends=('clamped', 'free') or "
-                                 f"('clamped', 'pinned') and no intermediate supports (the "
-                                 f"lifting h is the clamped–free one); got ends={self.ends!r}, "
-                                 f"supports={self.supports!r}")
-            if (np.isfinite(lo) | np.isfinite(hi))[free < J].any():
-                raise InputError("a moving support is only supported with obstacles at the "
-                                 "tip x = L (where the lifting h vanishes)")
+            self._check_moving_support()
+        self.obstacles.carried_at(self.nodes[free])   # carried and fixed may not meet
+
+    @property
+    def lifting(self) -> str:
+        """"paper", "static", or "none" (the support does not move): docs/design.md §1."""
+        sup = self.support
+        if not sup.moves:
+            return "none"
+        if sup.lifting == "auto":
+            return "paper" if self._paper_lifting_applies() else "static"
+        return sup.lifting
+
+    def _paper_lifting_applies(self) -> bool:
+        return (self.support.at == 0.0 and self.ends[0] == "clamped"
+                and self.ends[1] in ("free", "pinned") and not self.supports
+                and not self.beam.segments)
+
+    def _check_moving_support(self) -> None:
+        """The moving support must be a clamped/pinned end or an intermediate support."""
+        at, L = self.support.at, self.beam.L
+        end = 0 if abs(at) <= 1e-9 * L else 1 if abs(at - L) <= 1e-9 * L else None
+        if end is not None:
+            e = self.ends[end]
+            if not END_CONDITIONS[e][0]:
+                raise InputError(f"the support moving at x={at:g} is a {e} end, whose "
+                                 "displacement is free; only clamped or pinned ends and "
+                                 "intermediate supports can move")
+        elif not any(abs(at - xs) <= 1e-9 * L for xs in self.supports):
+            raise InputError(f"the moving support at={at:g} is neither an end (0 or "
+                             f"L={L:g}) nor one of supports={self.supports!r}")
+        if self.support.lifting == "paper" and not self._paper_lifting_applies():
+            raise InputError(f"lifting='paper' needs the clamped end x=0 moving, a free or "
+                             f"pinned end at L, a uniform beam and no intermediate "
+                             f"supports (got at={at:g}, ends={self.ends!r}); use 'static'")
+
+    def _check_load(self) -> None:
+        ld, L = self.load, self.beam.L
+        if (ld.forces or ld.points) and self.beam.rho_S is None:
+            raise InputError("forces in N or N/m need the beam's mass per length: build it "
+                             "with Beam.physical(...) or give rho_S")
+        for x, _ in ld.points:
+            if not 0.0 <= x <= L:
+                raise InputError(f"point force at x={x:g} lies outside [0, L={L:g}]")
 
     def _check_supports(self) -> tuple[float, ...]:
         """``supports`` as sorted floats strictly inside (0, L), pairwise distinct."""

@@ -13,9 +13,28 @@ from typing import Any, Callable
 import numpy as np
 import scipy.sparse as sp
 
+import scipy.sparse.linalg as spla
+
 from .errors import InputError
-from .problem import BeamProblem, lifting
-from .spaces import make_space
+from .problem import BeamProblem, lifting, lifting_d, lifting_dd
+from .spaces import has_rigid_motion, make_space
+from .spaces.ends import fixed_dofs
+from .spaces.hermite import five_point_slope
+from .timefunctions import Constant
+
+
+@dataclass(frozen=True)
+class Lifting:
+    """The lifting of a moving support: ũ = u + h(x)φ(t) (docs/design.md §1).
+
+    ``kind``: "paper" or "static"; ``h(x)``, ``h_d(x)``, ``h_dd(x)``: h, h', h'' at any
+    abscissae; ``motion``: the support (``phi``, ``phi_d``, ``phi_dd`` of t).
+    """
+    kind: str
+    h: Callable
+    h_d: Callable
+    h_dd: Callable
+    motion: Any
 
 
 @dataclass(frozen=True)
@@ -24,15 +43,24 @@ class SceneView:
 
     ``kind``: "beam" or "bar"; ``L``: length; ``k2``: bending stiffness per unit mass
     (beams, for the bending moment; None otherwise); ``support``: the moving support
-    (with ``phi(t)``, optionally ``phi_d(t)``), None when it does not move; ``obstacles``:
-    an object with ``bounds(x) -> (g1, g2)``, None when the obstacles are the bounds of
-    the constrained values alone.
+    (with ``phi(t)``, optionally ``phi_d(t)``) when the lifting is the first paper's h,
+    None otherwise; ``obstacles``: an object with ``bounds(x) -> (g1, g2)``, None when
+    the obstacles are the bounds of the constrained values alone.
+
+    Units (docs/design.md §1, Units): the beam's equation is divided by ``rho_S`` = ρA_ref
+    (kg/m; None when unknown), so forces × rho_S are in N (per length: N/m) and energies
+    × rho_S in J; ``EI`` = k2·rho_S (N·m², the first segment's for a stepped beam).
+    ``lift``: the lifting (:class:`Lifting`) when the support moves, whatever its kind;
+    the physical displacement is u + lift.h(x)·φ(t).
     """
     kind: str = "beam"
     L: float | None = None
     k2: float | None = None
     support: Any = None
     obstacles: Any = None
+    rho_S: float | None = None
+    EI: float | None = None
+    lift: Lifting | None = None
 
 
 @dataclass
@@ -68,60 +96,165 @@ class SemiDiscrete:
         return self.M.shape[0]
 
 
+def beam_space(problem: BeamProblem):
+    """The space of ``problem`` (weighted per element when the beam is stepped)."""
+    weights = None
+    if problem.beam.segments:
+        x = problem.nodes
+        weights = problem.beam.factors(0.5 * (x[:-1] + x[1:]))
+    return make_space(problem.element, problem.nodes, problem.ends, problem.supports, weights)
+
+
+def static_lifting(space, at: float, k2: float) -> np.ndarray:
+    """Full coefficients of the discrete static lifting: u = 1 at the node ``at``, every
+    other fixed value and slope 0, and a(h, w) = 0 for every w of V_h (when the fixed
+    conditions leave a rigid motion, a(h, w) + s(h, w) = 0 with s = k2/L⁴ instead)."""
+    value, slope = fixed_dofs(space.J, space.ends, space.support_nodes)
+    x = space.nodes
+    G = sp.vstack([space.point_rows(x[value], 0, full=True),
+                   space.point_rows(x[slope], 1, full=True)]).toarray()
+    e = np.zeros(G.shape[0])
+    e[int(np.abs(x[value] - at).argmin())] = 1.0
+    c_p = np.linalg.lstsq(G, e, rcond=None)[0]          # any function meeting the conditions
+    Mf, Sf = space.full_matrices()
+    L = x[-1] - x[0]
+    Af = k2 * Sf + (k2 / L**4 if has_rigid_motion(space) else 0.0) * Mf
+    T = space.T
+    z = spla.spsolve((T.T @ Af @ T).tocsc(), -(T.T @ (Af @ c_p)))
+    return c_p + T @ z
+
+
+def _evaluator(space, c: np.ndarray, derivative: int) -> Callable:
+    """x ↦ d^k/dx^k of the full-space function with coefficients c, for x of any shape."""
+    def f(x):
+        x = np.asarray(x, dtype=float)
+        return (space.point_rows(x.ravel(), derivative, full=True) @ c).reshape(x.shape)
+    return f
+
+
+def _lifting(problem: BeamProblem, space) -> tuple[Lifting, list, list]:
+    """The lifting and its load terms (profiles or vectors, times) f = −m(h,·)φ'' − a(h,·)φ."""
+    sup, L, k2 = problem.support, problem.beam.L, problem.beam.k2
+    if problem.lifting == "paper":
+        # f = f̃ − h φ'' − k² h φ, with h = −8/L⁴
+        lift = Lifting("paper", lambda x: lifting(x, L), lambda x: lifting_d(x, L),
+                       lambda x: lifting_dd(x, L), sup)
+        return lift, [lambda x: -lifting(x, L), lambda x: np.full(np.shape(x), 8 * k2 / L**4)], \
+            [sup.phi_dd, sup.phi]
+    c = static_lifting(space, sup.at, k2)
+    Mf, Sf = space.full_matrices()
+    lift = Lifting("static", *(_evaluator(space, c, k) for k in range(3)), sup)
+    # a(h, ·) vanishes on V_h up to round-off (or is the shift's s·m(h, ·)): kept, exact
+    return lift, [-(space.T.T @ (Mf @ c)), -(k2 * (space.T.T @ (Sf @ c)))], \
+        [sup.phi_dd, sup.phi]
+
+
+def _load_columns(problem: BeamProblem, space, profiles, times):
+    """Load vectors: profiles (functions of x: (b, φᵢ); arrays: already vectors), then
+    the problem's loads in the mass-normalised units (÷ ρA_ref, docs/design.md §1)."""
+    beam, ld = problem.beam, problem.load
+    profiles, times = list(profiles), list(times)
+    for b, a in ld.terms:
+        profiles.append(b)
+        times.append(a)
+    rho = beam.rho_S
+    for b, a in ld.forces:
+        profiles.append(lambda x, b=b: np.asarray(b(x), dtype=float) / rho)
+        times.append(a)
+    for x, a in ld.points:
+        profiles.append(space.point_rows([x]).toarray().ravel() / rho)
+        times.append(a)
+    if ld.g:
+        profiles.append(lambda x: -ld.g * beam.factors(x)[0])
+        times.append(Constant(1.0))
+    cols = [b if isinstance(b, np.ndarray) else space.load_vector(b) for b in profiles]
+    return (np.column_stack(cols) if cols else np.zeros((space.n, 0))), times
+
+
+def _initial(problem: BeamProblem, space, lift: Lifting | None):
+    """(u0, v0): interpolated u0, L²-projected v0; in the fixed frame, minus h φ(0), h φ'(0)."""
+    ini = problem.initial
+    u0f, du0f, v0f = ini.u0, ini.du0, ini.v0
+    if ini.fixed_frame and lift is not None:
+        p0, dp0 = float(lift.motion.phi(0.0)), float(lift.motion.phi_d(0.0))
+        zero = lambda x: np.zeros(np.shape(x))  # noqa: E731
+        ut, vt = u0f or zero, v0f or zero
+        dut = du0f or (five_point_slope(ut, 1e-3 * problem.beam.L) if u0f else zero)
+        dh = lift.h_d
+        u0f = lambda x: ut(x) - lift.h(x) * p0  # noqa: E731
+        du0f = lambda x: dut(x) - dh(x) * p0  # noqa: E731
+        v0f = lambda x: vt(x) - lift.h(x) * dp0  # noqa: E731
+    u0 = space.interpolate(u0f, du0f) if u0f is not None else np.zeros(space.n)
+    # initial velocity: L² projection (v0 need not be in V: the first paper's v0 = −2h has
+    # v0(0) = −2 ≠ 0; (2.1) asks for convergence in H, which the L² projection gives best)
+    v0 = space.project(v0f) if v0f is not None else np.zeros(space.n)
+    if not (np.isfinite(u0).all() and np.isfinite(v0).all()):
+        raise InputError("the initial state u0, v0 is not finite")
+    return u0, v0
+
+
+def _snap(shift: np.ndarray) -> np.ndarray:
+    """Shifts within 1e-9 of 0 are 0: h is 1 or 0 there up to round-off (the paper's h(L)
+    is −5.6e-17 in floating point, the static h of a cantilever 1 ± 1e-11), and an exactly
+    zero shift keeps bounds at rest (the papers' runs unchanged)."""
+    return np.where(np.abs(shift) <= 1e-9, 0.0, shift)
+
+
 def beam_system(problem: BeamProblem, samples_per_element: int = 20) -> SemiDiscrete:
     """Discretise a beam scene (the papers' V_h, K_h of (8), loads with the lifting)."""
     beam, sup = problem.beam, problem.support
-    space = make_space(problem.element, problem.nodes, problem.ends, problem.supports)
+    space = beam_space(problem)
     x_nodes = problem.nodes[space.value_nodes]     # where u is free (x_1..x_J when clamped)
     lo_all, hi_all = problem.obstacles.bounds(x_nodes)
     finite = np.isfinite(lo_all) | np.isfinite(hi_all)
     C = space.nodal[space.value_nodes[finite]]
 
-    # f = f̃ − h φ'' − k² h'''' φ, with h'''' = −8/L⁴
     L, k2 = beam.L, beam.k2
-    profiles, times = [], []
-    if sup.moves:
-        profiles += [lambda x: -lifting(x, L), lambda x: np.full(np.shape(x), 8 * k2 / L**4)]
-        times += [sup.phi_dd, sup.phi]
-    for b, a in problem.load.terms:
-        profiles.append(b)
-        times.append(a)
-    loads = np.column_stack([space.load_vector(b) for b in profiles]) if profiles \
-        else np.zeros((space.n, 0))
+    lift, profiles, times = _lifting(problem, space) if sup.moves else (None, [], [])
+    loads, times = _load_columns(problem, space, profiles, times)
+    u0, v0 = _initial(problem, space, lift)
 
-    ini = problem.initial
-    u0 = space.interpolate(ini.u0, ini.du0) if ini.u0 is not None else np.zeros(space.n)
-    # initial velocity: L² projection (v0 need not be in V: the first paper's v0 = −2h has
-    # v0(0) = −2 ≠ 0; (2.1) asks for convergence in H, which the L² projection gives best)
-    v_phys = ini.v0
-    v0 = space.project(v_phys) if v_phys is not None else np.zeros(space.n)
-    if not (np.isfinite(u0).all() and np.isfinite(v0).all()):
-        raise InputError("the initial state u0, v0 is not finite")
+    lo, hi = lo_all[finite], hi_all[finite]
+    x_c = x_nodes[finite]
+    sampler = space.sampler(np.linspace(0.0, 1.0, samples_per_element + 1))
+    s_lo, s_hi = problem.obstacles.bounds(sampler.x)
+    keep = np.isfinite(s_lo) | np.isfinite(s_hi)
+    # bounds on u = ũ − hφ: g − hφ (fixed to the ground), g + (1 − h)φ (carried)
+    motion = shift = s_shift = None
+    if lift is not None:
+        xs = sampler.x[keep]
+        shift, s_shift = (_snap(problem.obstacles.carried_at(x) - lift.h(x)) for x in (x_c, xs))
+        if np.any(shift != 0) or np.any(s_shift != 0):
+            motion = sup.phi
+        else:
+            shift = s_shift = None
 
     y0 = C @ u0
-    lo, hi = lo_all[finite], hi_all[finite]
+    lo0, hi0 = (lo, hi) if motion is None else (lo + shift * float(sup.phi(0.0)),
+                                                hi + shift * float(sup.phi(0.0)))
     tol = 1e-12 * max(1.0, np.abs(y0).max(initial=0.0))
-    bad = (y0 < lo - tol) | (y0 > hi + tol)
+    bad = (y0 < lo0 - tol) | (y0 > hi0 + tol)
     if bad.any():
         i = int(np.argmax(bad))
-        raise InputError(f"u0 violates the obstacles at x={x_nodes[finite][i]:g}: "
-                         f"u0={y0[i]:g} not in [{lo[i]:g}, {hi[i]:g}]")
+        raise InputError(f"u0 violates the obstacles at x={x_c[i]:g}: "
+                         f"u0={y0[i]:g} not in [{lo0[i]:g}, {hi0[i]:g}]")
 
     with np.errstate(over="ignore", invalid="ignore"):
         K = (k2 * space.S).tocsr()
     if not np.isfinite(K.data).all():
         raise InputError(f"k2={k2:g} on this mesh gives a stiffness outside floating-point range")
+    damp = problem.damping
+    B = None if damp.none else (damp.alpha * space.M + damp.alpha_K * K).tocsr()
 
-    sampler = space.sampler(np.linspace(0.0, 1.0, samples_per_element + 1))
-    s_lo, s_hi = problem.obstacles.bounds(sampler.x)
-    keep = np.isfinite(s_lo) | np.isfinite(s_hi)
     observe = {"tip_displacement": np.asarray(space.C[-1].toarray()).ravel()}
     return SemiDiscrete(
         M=space.M, K=K, C=sp.csr_matrix(C), lo=lo, hi=hi,
-        x_contact=x_nodes[finite], loads=loads, load_time=times, u0=u0, v0=v0,
-        observe=observe, space=space,
+        x_contact=x_c, loads=loads, load_time=times, u0=u0, v0=v0,
+        observe=observe, B=B, space=space,
         sample_x=sampler.x[keep], sample_E=sampler.E0[np.flatnonzero(keep)].tocsr(),
         sample_lo=s_lo[keep], sample_hi=s_hi[keep],
         meta={"kind": "beam", "L": L, "k2": k2, "rho_S": beam.rho_S,
               "element": problem.element, "J": problem.J, "problem": problem},
-        view=SceneView("beam", L, k2, sup if sup.moves else None, problem.obstacles))
+        view=SceneView("beam", L, k2, sup if problem.lifting == "paper" else None,
+                       problem.obstacles, beam.rho_S, beam.EI, lift),
+        bound_motion=motion, bound_shift=shift, sample_shift=s_shift)

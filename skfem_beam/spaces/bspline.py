@@ -129,7 +129,7 @@ class BSplineSpace:
     name = "bspline"
     kd = 3  # half bandwidth of M and S (set per instance from the matrices)
 
-    def __init__(self, nodes, ends=DEFAULT_ENDS, supports=()):
+    def __init__(self, nodes, ends=DEFAULT_ENDS, supports=(), weights=None):
         x = np.asarray(nodes, dtype=float)
         if x.ndim != 1 or x.size < 2:
             raise InputError("B-spline space: nodes must be a 1-D array of at least 2 abscissae")
@@ -165,9 +165,12 @@ class BSplineSpace:
         # element e touches B_{e-1}..B_{e+2}, i.e. full indices e..e+3
         self._dofs = np.arange(J)[:, None] + np.arange(4)[None, :]
 
+        self.n_full, self.T, self.weights = J + 3, T, weights
         Me, Se = element_matrices(h)
-        self.M = self._assemble(Me)
-        self.S = self._assemble(Se)
+        wm, wk = (None, None) if weights is None else weights
+        self._Am, self._As = self._assemble_full(Me, wm), self._assemble_full(Se, wk)
+        self.M = self._reduce_cols(self._T.T @ self._Am)
+        self.S = self._reduce_cols(self._T.T @ self._As)
         band = sp.triu(self.M).tocoo()
         self.kd = int((band.col - band.row).max(initial=0))
         # nodal values u(x_0..x_J): B_j(x_{j∓1}) = 1/6, B_j(x_j) = 4/6, with exact zero rows
@@ -181,12 +184,30 @@ class BSplineSpace:
         A.eliminate_zeros()
         return A
 
-    def _assemble(self, Ae: np.ndarray) -> sp.csr_matrix:
+    def _assemble_full(self, Ae: np.ndarray, weight=None) -> sp.csr_matrix:
+        """Σ_e weight_e A_e on all J+3 B-splines (weight 1 when None)."""
         d = self._dofs
         r = np.repeat(d, 4, axis=1).ravel()
         c = np.tile(d, (1, 4)).ravel()
-        A = sp.csr_matrix((np.tile(Ae.ravel(), self.J), (r, c)), shape=(self.J + 3,) * 2)
-        return self._reduce_cols(self._T.T @ A)
+        v = np.tile(Ae.ravel(), self.J) if weight is None else \
+            (np.asarray(weight, dtype=float)[:, None] * Ae.ravel()[None, :]).ravel()
+        return sp.csr_matrix((v, (r, c)), shape=(self.J + 3,) * 2)
+
+    def full_matrices(self):
+        """(M, S) on all J+3 B-splines, before the end conditions and supports."""
+        return self._Am, self._As
+
+    def point_rows(self, x, derivative: int = 0, full: bool = False) -> sp.csr_matrix:
+        """Rows evaluating d^k u/dx^k (k = 0, 1, 2) at abscissae x."""
+        x = np.atleast_1d(np.asarray(x, dtype=float))
+        e = np.clip(np.searchsorted(self.nodes, x, side="right") - 1, 0, self.J - 1)
+        xi = (x - self.nodes[e]) / self._hu
+        N = np.column_stack([p.deriv(derivative)(xi) if derivative else p(xi)
+                             for p in SHAPES]) / self._hu ** derivative
+        rows = np.repeat(np.arange(x.size), 4)
+        A = sp.csr_matrix((N.ravel(), (rows, self._dofs[e].ravel())),
+                          shape=(x.size, self.J + 3))
+        return A if full else self._reduce_cols(A)
 
     def _element_rows(self, N: np.ndarray) -> sp.csr_matrix:
         """Rows (element-major, then ξ) of point evaluations with local shape values N (nq, 4)."""

@@ -35,6 +35,16 @@ def bending(u, v, w):
     return dd(u)[0, 0] * dd(v)[0, 0]
 
 
+@BilinearForm
+def weighted_mass(u, v, w):
+    return w["c"] * u * v
+
+
+@BilinearForm
+def weighted_bending(u, v, w):
+    return w["c"] * dd(u)[0, 0] * dd(v)[0, 0]
+
+
 @LinearForm
 def load(v, w):
     return w["b"] * v
@@ -58,7 +68,7 @@ class HermiteSpace:
     name = "hermite"
     kd = 3  # half bandwidth of M and S
 
-    def __init__(self, nodes, ends=DEFAULT_ENDS, supports=()):
+    def __init__(self, nodes, ends=DEFAULT_ENDS, supports=(), weights=None):
         x = np.asarray(nodes, dtype=float)
         self.nodes = x
         self.J = J = x.size - 1
@@ -86,8 +96,21 @@ class HermiteSpace:
         self.n = free.size
         #: nodes whose displacement is free (obstacle rows may only sit there)
         self.value_nodes = np.flatnonzero(~value_fixed)
-        self.M = self._gather(mass.assemble(self._basis))
-        self.S = self._gather(bending.assemble(self._basis))
+        self._Pall = P
+        self.n_full = 2 * J + 2
+        self.T = sp.csr_matrix((np.ones(free.size), (free, np.arange(free.size))),
+                               shape=(self.n_full, free.size))
+        self.weights = weights
+        if weights is None:
+            self._Am, self._As = mass.assemble(self._basis), bending.assemble(self._basis)
+        else:   # per element ρA_e/ρA_ref, EI_e/EI_ref (a stepped beam)
+            nq = self._basis.X.shape[1]
+            wm, wk = (np.broadcast_to(np.asarray(w, dtype=float)[:, None], (J, nq))
+                      for w in weights)
+            self._Am = weighted_mass.assemble(self._basis, c=wm)
+            self._As = weighted_bending.assemble(self._basis, c=wk)
+        self.M = self._gather(self._Am)
+        self.S = self._gather(self._As)
         # nodal values u(x_0..x_J) = nodal @ c (zero rows where u is fixed); C: x_1..x_J
         col = np.searchsorted(free, 2 * self.value_nodes)
         self.nodal = sp.csr_matrix((np.ones(col.size), (self.value_nodes, col)),
@@ -96,6 +119,31 @@ class HermiteSpace:
 
     def _gather(self, A):
         return (self._P.T @ A @ self._P).tocsr()
+
+    def full_matrices(self):
+        """(M, S) on every dof, fixed ones included (2 per node, value first)."""
+        return (self._Pall.T @ self._Am @ self._Pall).tocsr(), \
+            (self._Pall.T @ self._As @ self._Pall).tocsr()
+
+    def point_rows(self, x, derivative: int = 0, full: bool = False) -> sp.csr_matrix:
+        """Rows evaluating d^k u/dx^k (k = 0, 1, 2) at abscissae x, from the closed-form
+        cubic Hermite shape functions on the element holding each x."""
+        x = np.atleast_1d(np.asarray(x, dtype=float))
+        e = np.clip(np.searchsorted(self.nodes, x, side="right") - 1, 0, self.J - 1)
+        h = self.h[e]
+        s = (x - self.nodes[e]) / h
+        one = np.ones_like(s)
+        N = {0: (1 - 3 * s**2 + 2 * s**3, h * (s - 2 * s**2 + s**3), 3 * s**2 - 2 * s**3,
+                 h * (s**3 - s**2)),
+             1: ((6 * s**2 - 6 * s) / h, 1 - 4 * s + 3 * s**2, (6 * s - 6 * s**2) / h,
+                 3 * s**2 - 2 * s),
+             2: ((12 * s - 6) / h**2, (6 * s - 4) / h, (6 - 12 * s) / h**2,
+                 (6 * s - 2) / h)}[derivative]
+        rows = np.tile(np.arange(x.size), 4)
+        cols = np.concatenate([2 * e + k for k in range(4)])
+        A = sp.csr_matrix((np.concatenate([v * one for v in N]), (rows, cols)),
+                          shape=(x.size, self.n_full))
+        return A if full else (A @ self.T).tocsr()
 
     def sampler(self, xi) -> Sampler:
         xi = np.atleast_1d(np.asarray(xi, dtype=float))

@@ -12,14 +12,17 @@ from typing import Callable
 
 import numpy as np
 
-from .checks import (check_beta, check_choice, check_finite, check_nonnegative,  # noqa: F401
-                     check_positive)
+from .checks import (check_beta, check_choice, check_count, check_finite,  # noqa: F401
+                     check_nonnegative, check_positive)
 from .errors import InputError
 from .timefunctions import Constant, derivative
 from .spaces.ends import DEFAULT_ENDS, END_CONDITIONS, check_ends, fixed_dofs, support_nodes
 
 Profile = Callable[[np.ndarray], np.ndarray]   # g(x), u0(x), ...: vectorised in x
 TimeFunction = Callable[[np.ndarray], np.ndarray]  # a(t): vectorised in t
+
+
+L_RANGE = (1e-6, 1e6)   # metres: from a micro-beam to a 1000 km line
 
 
 def _constant(c: float) -> Profile:
@@ -88,7 +91,10 @@ class Beam:
     segments: tuple[tuple[float, float, float], ...] = ()
 
     def __post_init__(self):
-        object.__setattr__(self, "L", check_positive("L", self.L))
+        L = check_positive("L", self.L)
+        if not L_RANGE[0] <= L <= L_RANGE[1]:   # the cubic bases lose all accuracy outside
+            raise InputError(f"L={L:g} m must lie in [{L_RANGE[0]:g}, {L_RANGE[1]:g}] m")
+        object.__setattr__(self, "L", L)
         object.__setattr__(self, "k2", check_positive("k2", self.k2))
         if self.rho_S is not None:
             object.__setattr__(self, "rho_S", check_positive("rho_S", self.rho_S))
@@ -443,8 +449,7 @@ class BeamProblem:
         object.__setattr__(self, "ends", check_ends(self.ends))
         object.__setattr__(self, "supports", self._check_supports())
         if self.nodes is None:
-            if isinstance(self.J, bool) or not isinstance(self.J, (int, np.integer)) or self.J < 1:
-                raise InputError(f"J={self.J!r} must be a whole number ≥ 1")
+            check_count("J", self.J)
             object.__setattr__(self, "nodes", np.linspace(0.0, self.beam.L, int(self.J) + 1))
         else:
             x = np.asarray(self.nodes, dtype=float)

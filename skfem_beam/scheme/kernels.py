@@ -305,18 +305,21 @@ def run_steps(law, explicit, ops, st, out, n0, n1, inputs, Ebound):
 
 class PythonLaw:
     """The law solved in Python that `run_steps_python` calls (one run at a time per
-    process), and the error it raised, if any."""
+    process), the state's arrays it reads and writes (the same memory as the compiled
+    loop's: nothing is boxed per step), and the error it raised, if any."""
     solver = None
+    state = None
     error = None
 
 
-def _solve_in_python(x, yf, mu) -> int:
+def _solve_in_python() -> int:
+    st = PythonLaw.state
     try:
-        m, its = PythonLaw.solver.solve(x, yf)
+        m, its = PythonLaw.solver.solve(st.x, st.yf)
     except Exception as e:        # handed back to the run, which raises it with the step
         PythonLaw.error = e
         return -1
-    mu[:] = m
+    st.mu[:] = m
     return its
 
 
@@ -327,14 +330,13 @@ def run_steps_python(ops, st, out, n0, n1, inputs, Ebound):
     for step in range(n0, n1):
         Gn = inputs.G[step - n0]
         free_step(ops, st, Gn)
-        x, yf, mu = st.x, st.yf, st.mu
         with objmode(its="int64"):
-            its = _solve_in_python(x, yf, mu)
+            its = _solve_in_python()
         if its < 0:
             st.counters[3] = step + 1
             return FAILED
-        for j in range(mu.size):
-            st.active[j] = mu[j] != 0.0
+        for j in range(st.mu.size):
+            st.active[j] = st.mu[j] != 0.0
         st.counters[2] += its
         code = end_step(ops, st, out, step, Gn, Ebound)
         if code:

@@ -226,11 +226,11 @@ class Run:
             inputs = Inputs(np.zeros((0, self.loads.shape[1])), np.zeros(0))
         if self.pysolver is None:
             return run_steps(*self._kernels, self.ops, self.st, self.out, n0, n1, inputs, Ebound)
-        PythonLaw.solver, PythonLaw.error = self.pysolver, None
+        PythonLaw.solver, PythonLaw.state, PythonLaw.error = self.pysolver, self.st, None
         try:
             return run_steps_python(self.ops, self.st, self.out, n0, n1, inputs, Ebound)
         finally:
-            PythonLaw.solver = None
+            PythonLaw.solver = PythonLaw.state = None
 
     def _take_events(self) -> None:
         k = int(self.st.counters[4])

@@ -24,7 +24,8 @@ from .operators import csr_arrays, step_operators
 from .stepping import Result, Stepping
 
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(4)
-MAX_SAVED = 2 * 10**7     # saved rows × constrained values kept in memory (~1 GB)
+FIRST_ROWS = 1 << 15      # saved rows allocated at first; more as a chunk needs them
+SAVED = ("obs", "obsv", "energy", "work", "lam")   # the saved series (rows × columns)
 
 
 _NOTICE = "compiling numerical kernels (first run only) …"
@@ -49,6 +50,39 @@ def compile_notice(after: float = 1.0):
         timer.cancel()
 
 
+class SavedRows:
+    """A saved series indexed by saved-row number k (state k·save_every), whatever rows
+    the run has released: ``run.obs[k0:k1, 0]``, ``run.lam[rows + 1, 0]``."""
+
+    def __init__(self, run, name: str):
+        self.run, self.name = run, name
+
+    def _rows(self, index):
+        rows, rest = (index[0], index[1:]) if isinstance(index, tuple) else (index, ())
+        row0 = self.run.row0
+        if isinstance(rows, slice):
+            start = row0 if rows.start is None else rows.start
+            stop = self.run.n // self.run.save_every + 1 if rows.stop is None else rows.stop
+            if stop <= start:
+                return (slice(0, 0), *rest)
+            if start < row0:
+                raise IndexError(f"saved rows before {row0} were released")
+            return (slice(start - row0, stop - row0, rows.step), *rest)
+        rows = np.asarray(rows) - row0
+        if np.any(rows < 0):
+            raise IndexError(f"saved rows before {row0} were released")
+        return (rows, *rest)
+
+    def __getitem__(self, index):
+        return getattr(self.run.out, self.name)[self._rows(index)]
+
+    def __setitem__(self, index, value):
+        rows = self._rows(index)[0]
+        last = rows.stop - 1 if isinstance(rows, slice) else int(np.max(rows))
+        self.run._hold_rows(last + self.run.row0)
+        getattr(self.run.out, self.name)[self._rows(index)] = value
+
+
 class Run:
     """The scheme's state and saved series for ``system`` on the grid ``stepping``,
     with the contact law ``law`` (a name of ``contact.LAWS``, "auto", or a law object).
@@ -66,10 +100,6 @@ class Run:
     def _build(self, system, stepping, law) -> None:
         s, m = stepping, system.C.shape[0]
         n_steps = s.steps
-        if n_steps // s.save_every * max(1, m) > MAX_SAVED:
-            raise InputError(f"keeping every {s.save_every}-th of {n_steps:.3g} steps would store "
-                             f"{n_steps // s.save_every:.3g} rows: raise --save-every to at least "
-                             f"{math.ceil(n_steps * max(1, m) / MAX_SAVED)}")
         self.system, self.stepping = system, s
         self.dt, self.beta, self.n_steps = s.dt, s.beta, n_steps
         self.save_every, self.frame_every = s.save_every, s.frame_every
@@ -113,14 +143,14 @@ class Run:
         self.st = State(np.empty(n), np.empty(n), np.empty(m), np.empty(m),
                         step.lo.copy(), step.hi.copy(), slo.copy(), shi.copy(),
                         np.zeros(m, np.int8), np.zeros(m, np.bool_), np.zeros(m, np.bool_),
-                        np.zeros(4), np.zeros(5, np.int64), np.zeros(3),
+                        np.zeros(4), np.zeros(6, np.int64), np.zeros(3),
                         np.full((m, 5), -1.0), np.zeros(m),
                         np.empty(n), np.empty(m), np.zeros(m), np.empty(n), np.empty(n),
                         np.zeros(m))
-        nsave, nframes = n_steps // s.save_every + 1, n_steps // s.frame_every + 1
-        nobs = Orows.shape[0]
-        self.out = Series(np.full((nsave, nobs), np.nan), np.full((nsave, nobs), np.nan),
-                          np.full(nsave, np.nan), np.zeros((nsave, 3)), np.zeros((nsave, m)),
+        nframes, nobs = n_steps // s.frame_every + 1, Orows.shape[0]
+        rows = min(n_steps // s.save_every + 1, FIRST_ROWS)   # grown as the run needs them
+        self.out = Series(np.full((rows, nobs), np.nan), np.full((rows, nobs), np.nan),
+                          np.full(rows, np.nan), np.zeros((rows, 3)), np.zeros((rows, m)),
                           np.full((nframes, n), np.nan), np.full((nframes, n), np.nan),
                           np.zeros((nframes, m)), np.zeros((max(4096, 4 * m), 7)))
         self.events = []       # impact event rows taken from the compiled loop's buffer
@@ -220,8 +250,39 @@ class Run:
                                     + _GAUSS_W[2] * v[2] + _GAUSS_W[3] * v[3]) / 2.0
         return np.ascontiguousarray(beta * f[2:] + (1 - 2 * beta) * f[1:-1] + beta * f[:-2])
 
+    @property
+    def row0(self) -> int:
+        """The first saved row still held (rows before it were released)."""
+        return int(self.st.counters[5])
+
+    def release(self, k: int) -> None:
+        """Drop the saved rows before row k (their values were written elsewhere): memory
+        then stays flat however long the run; ``obs[k0:k1]`` etc. keep their indices."""
+        shift = min(int(k), self.n // self.save_every + 1) - self.row0
+        if shift > 0:
+            for name in SAVED:
+                a = getattr(self.out, name)
+                a[:len(a) - shift] = a[shift:]
+            self.st.counters[5] += shift
+
+    def _hold_rows(self, last: int) -> None:
+        """Room in the saved-series buffers for rows up to ``last`` (doubling)."""
+        need = last - self.row0 + 1
+        have = self.out.energy.shape[0]
+        if need > have:
+            size = max(need, 2 * have)
+            grown = {}
+            for name in SAVED:
+                a = getattr(self.out, name)
+                b = np.full((size,) + a.shape[1:], np.nan if name in ("obs", "obsv", "energy")
+                            else 0.0)
+                b[:have] = a
+                grown[name] = b
+            self.out = self.out._replace(**grown)
+
     def _steps(self, n0, n1, Ebound, inputs=None):
         """The compiled loop over steps n0..n1−1 (see kernels.run_steps)."""
+        self._hold_rows(n1 // self.save_every)
         if inputs is None:
             inputs = Inputs(np.zeros((0, self.loads.shape[1])), np.zeros(0))
         if self.pysolver is None:
@@ -298,7 +359,7 @@ class Run:
             limit = linear_limit(kappa_h(self.system), self.beta)
             self.status = "unstable"
             self.message = (f"unstable at step {k} (t={k * self.dt:.6g} s): energy "
-                            f"{self.out.energy[k // self.save_every]:.3g} exceeds {Ebound:.3g}; "
+                            f"{self.energy[k // self.save_every]:.3g} exceeds {Ebound:.3g}; "
                             f"dt={self.dt:g} s, beta={self.beta:g}, linear stability limit "
                             f"2/√(κ_h(1−4β)) = {limit:.4g} s")
             self.n = (k // self.save_every - 1) * self.save_every   # last good saved state
@@ -307,11 +368,12 @@ class Run:
         if n1 == self.n_steps:
             self.status, self.message = "success", "the run reached T"
 
-    # the saved series, by the names the output pipeline reads
-    obs = property(lambda self: self.out.obs)
-    obsv = property(lambda self: self.out.obsv)
-    energy = property(lambda self: self.out.energy)
-    lam = property(lambda self: self.out.lam)
+    # the saved series by saved-row number (see SavedRows), as the output pipeline reads them
+    obs = property(lambda self: SavedRows(self, "obs"))
+    obsv = property(lambda self: SavedRows(self, "obsv"))
+    energy = property(lambda self: SavedRows(self, "energy"))
+    work = property(lambda self: SavedRows(self, "work"))
+    lam = property(lambda self: SavedRows(self, "lam"))
     fr = property(lambda self: self.out.frames_u)
     frv = property(lambda self: self.out.frames_v)
     frf = property(lambda self: self.out.frames_f)
@@ -358,13 +420,15 @@ class Run:
             float(ck["wall"]), float(ck["E1"])
 
     def result(self) -> Result:
-        keep = self.n // self.save_every + 1
+        """The run so far (its saved series from ``row0``: all of them unless an output
+        pipeline released the rows it wrote)."""
+        first, keep = self.row0, self.n // self.save_every + 1 - self.row0
         nf = self.n // self.frame_every + 1
         names = list(self.system.observe)
         out, st, c = self.out, self.st.stats, self.st.counters
         obs, obsv = out.obs[:keep], out.obsv[:keep]
         return Result(
-            t=np.arange(keep) * self.save_every * self.dt,
+            t=np.arange(first, first + keep) * self.save_every * self.dt,
             observed={k: obs[:, i] for i, k in enumerate(names)},
             velocity={k: obsv[:, i] for i, k in enumerate(names)}, energy=out.energy[:keep],
             contact_force=out.lam[:keep], frames_t=np.arange(nf) * self.frame_every * self.dt,

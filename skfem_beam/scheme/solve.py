@@ -1,11 +1,15 @@
 """The one entry point: ``solve(system, dt, T, beta)`` → :class:`Result`."""
 from __future__ import annotations
 
+import math
 import sys
 
 from ..contact import ContactLaw, resolve
+from ..errors import InputError
 from .run import Run
 from .stepping import Result, Stepping
+
+MAX_VALUES = 2 * 10**8    # saved values a Result may hold (1.6 GB)
 
 
 def solve(system, dt: float, T: float, beta: float = 0.5, solver: str | ContactLaw = "auto",
@@ -24,6 +28,13 @@ def solve(system, dt: float, T: float, beta: float = 0.5, solver: str | ContactL
     non-finite; what was computed up to the last good saved state is returned.
     """
     stepping = Stepping(dt, T, beta, save_every, frames, load_window, growth_limit)
+    rows = stepping.steps // stepping.save_every + 1
+    values = rows * (2 * len(system.observe) + system.C.shape[0] + 4)
+    if values > MAX_VALUES:   # a Result holds every saved row; the commands stream them
+        raise InputError(f"keeping every {stepping.save_every}-th of {stepping.steps:.3g} "
+                         f"steps would hold {rows:.3g} rows in memory: raise save_every to at "
+                         f"least {math.ceil(stepping.save_every * values / MAX_VALUES)}, or "
+                         f"run it from the command line, which streams them to disk")
     run = Run(system, stepping, resolve(solver, stiffness))
     drive(run, chunk, progress)
     return run.result()

@@ -245,8 +245,7 @@ def _scene(kind, problem, data, text, files) -> Scene:
     stepping = Stepping(t["dt"], t["T"], beta, out["save_every"], out["frames"])
     scene = Scene(kind, problem, stepping, law, k, contact.get("restitution", 0.0), out,
                   text, files, data)
-    if kind == "beam":
-        scene.contact_law    # the law's own checks (name, stiffness, restitution)
+    scene.contact_law        # the law's own checks (name, stiffness, restitution)
     return scene
 
 
@@ -586,9 +585,9 @@ def run_main(argv) -> int:
     if args.out is None:
         args.out = f"out/{Path(args.scene).stem}"
     penalty = scene.law == "penalty"
-    if scene.restitution and scene.kind == "beam":
+    if scene.restitution:
         raise InputError("[contact] restitution: `run` cannot pass a coefficient of "
-                         "restitution to the beam pipeline yet; use the Python API "
+                         "restitution to the scenes' pipeline yet; use the Python API "
                          "(solve(..., solver=scene.contact_law))")
     args.dt, args.beta = scene.stepping.dt, scene.stepping.beta
     args.method = "penalty" if penalty else "contact"

@@ -253,3 +253,21 @@ def test_scene_files_are_package_data():
     for name in ("point_stops", "flat_obstacles", "convex_obstacles", "impacting_bar",
                  "heat_exchanger_tube"):
         load(example(name))
+
+
+def test_penalty_law_runs_as_the_case_penalty_method(tmp_path):
+    a, b = tmp_path / "scene", tmp_path / "case"
+    assert exit_code(run_main, [str(example("point_stops")), "--out", str(a), "--T", "0.05",
+                                "--format", "none", "--set", 'contact.law="penalty"',
+                                "--set", "contact.stiffness=1e8", "--set", "time.beta=0.25"]) == 0
+    assert exit_code(point_stops.main, ["--T", "0.05", "--out", str(b), "--format", "none",
+                                        "--method", "penalty"]) == 0
+    assert series(a) == series(b)
+
+
+def test_restitution_is_refused_by_run_but_built_for_the_api(tmp_path, capsys):
+    f = write(tmp_path, PIPE + '[contact]\nlaw = "auto"\nrestitution = 0.5\n')
+    assert load(f).contact_law.e == 0.5
+    out = tmp_path / "out"
+    out.mkdir()
+    assert_refused(run_main, [str(f), "--out", str(out / "run")], "restitution", capsys, out)

@@ -34,6 +34,8 @@ class Command(NamedTuple):
 COMMANDS = {
     "export": Command("DIR --to npz|mat [--out FILE]", "a run folder as one .npz or .mat "
                       "(MATLAB) file", "skfem_beam.results:export_main"),
+    "run": Command("SCENE.toml [--out DIR] [--set KEY=VALUE ...]", "run the scene a TOML file describes", "skfem_beam.scenefile:run_main"),
+    "modes": Command("SCENE.toml [--n 6] [--out DIR]", "natural frequencies and mode shapes of its beam", "skfem_beam.scenefile:modes_main"),
 }
 EXIT_INPUT = 2     # as skfem_beam.cli (not imported here: the listing stays instant)
 

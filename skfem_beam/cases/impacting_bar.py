@@ -68,13 +68,20 @@ def main(argv=None) -> int:
     p.add_argument("--mass", default="average", help="average | consistent | lumped")
     args = cli.parse(p, argv)
 
-    cli.check_method(args)
-    dt, T = args.dt, args.T          # checked by the run's Stepping (bar_run)
     u0 = read_profile(args.u0_csv, "--u0-csv") if args.u0_csv else args.u0
     v0 = read_profile(args.v0_csv, "--v0-csv") if args.v0_csv else args.v0
     bar = Bar(a=args.a, b=args.b, rho=args.rho, L=args.L, f=args.f, v0=v0, u0=u0,
               obstacle=args.obstacle, k=args.k, N=args.N, mass=args.mass,
               far_end=args.far_end, obstacle_at=args.obstacle_at, A=args.A)
+    return run_bar_case(bar, args)
+
+
+def run_bar_case(bar: Bar, args, config: dict | None = None) -> int:
+    """Run ``bar`` with the flags in ``args`` (dt, T, beta, method, solver, stiffness,
+    the output flags), write DIR through the streaming pipeline, return the exit code.
+    ``config``: more entries for summary.json's config (beside the flags)."""
+    cli.check_method(args)
+    dt, T = args.dt, args.T          # checked by the run's Stepping (bar_run)
     penalty = args.method == "penalty" and bar.obstacle == "rigid"
     if penalty:   # the rigid obstacle approximated by a spring of stiffness 1/ε
         bar = replace(bar, k=check_positive("stiffness", args.stiffness))
@@ -118,7 +125,7 @@ def main(argv=None) -> int:
                   "wall_time_s": "the time loop alone (one step past T, for R at T)"},
         "notes": ("energy = kinetic + strain + obstacle, the scheme's E_β/2 split; "
                   "energy_final and the energy report add the load potential −fL·ū"),
-        "config": {k: v for k, v in vars(args).items() if k != "resume"},
+        "config": {**(config or {}), **{k: v for k, v in vars(args).items() if k != "resume"}},
     }
 
     def finish(folder, data, run):

@@ -1,0 +1,663 @@
+"""Scene files: a beam or a bar, its time grid, contact law and output, in one TOML file.
+
+    python -m skfem_beam run SCENE.toml [--out DIR] [--set time.dt=1e-5 ...] [--T 4]
+        [--format F] [--frames N] [--save-every N] [--flush-every N]
+        [--checkpoint-every S] [--resume DIR] [--overwrite]
+    python -m skfem_beam modes SCENE.toml [--n 6] [--out DIR] [--set ...]
+
+:func:`load` reads a file into the objects of the Python API, one to one (:class:`Scene`:
+``problem`` a BeamProblem or a Bar, ``stepping`` a scheme.Stepping, the contact law, the
+output options).  Every value is checked by the object it builds; this module checks only
+the file's shape: an unknown section or key is refused in one line naming it and the
+allowed ones.  Relative paths (tables) are relative to the scene file.  The keys are
+:data:`BEAM_KEYS` and :data:`BAR_KEYS` (README, *Scene files*).
+
+Choices a TOML file forces:
+
+- obstacles are numbers, polynomials ``{ poly = [c0, c1, c2, ...], about = x0 }``
+  (Σ c_k (x − x0)^k, the second paper's convex obstacles) or tables ``{ x = [...],
+  g = [...] }`` (linear between the points; its corners need not be mesh nodes), over a
+  point (``x``), a span (``x_from``, ``x_to``) or, with neither, the whole beam;
+- a beam's u0/v0 tables ``{ x = [...], u = [...] }`` are interpolated by a not-a-knot
+  cubic spline (C², its slope gives the Hermite slopes); a bar's linearly (P1);
+- ``[initial]`` of a beam is read in the fixed frame (ũ, ũ_t) unless ``fixed_frame =
+  false``: a scene with no ``[initial]`` starts at rest, as the papers' pipe does.
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import math
+import sys
+import tempfile
+import tomllib
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+from .bar import Bar
+from .errors import InputError
+from .problem import (Beam, BeamProblem, Damping, InitialState, Load, Material, Obstacles,
+                      Section, Support)
+from .scheme import Stepping
+from .timefunctions import Constant, Sine, SumOfSines, Table, band_limited
+
+V = None          # a value (checked by the object it builds)
+
+
+class Either(dict):
+    """In a schema: a value, or a table of these keys."""
+
+
+TIME = {"amplitude": V, "omega": V, "phase": V, "value": V, "sines": V, "table": V,
+        "random": {"rms": V, "f_low": V, "f_high": V, "seed": V, "count": V}}
+SECTION = {"I": V, "A": V, "tube": {"outer_diameter": V, "wall": V},
+           "rod": {"diameter": V}, "rect": {"b": V, "h": V}}
+MATERIAL = {"E": V, "rho": V}
+U0, V0 = {"x": V, "u": V}, {"x": V, "v": V}
+TIME_KEYS = {"dt": V, "T": V, "beta": V}
+OUTPUT = {"format": V, "save_every": V, "frames": V, "flush_every": V, "checkpoint_every": V}
+CONTACT = {"law": V, "stiffness": V, "restitution": V}
+
+BEAM_KEYS = {
+    "kind": V, "material": MATERIAL, "section": SECTION,
+    "mass_normalised": {"k2": V, "rho_S": V},
+    "geometry": {"L": V},
+    "segments": [{"length": V, "material": MATERIAL, "section": SECTION}],
+    "ends": {"left": V, "right": V},
+    "supports": [{"x": V}],
+    "motion": {"end": V, "at": V, "lifting": V, **TIME},
+    "obstacles": [{"x": V, "x_from": V, "x_to": V, "g1": V, "g2": V, "carried": V}],
+    "damping": {"zeta": V, "f1": V, "f2": V, "alpha": V, "alpha_K": V},
+    "loads": [{"x": V, "distributed": V, "per_mass": V, "gravity": V, **TIME}],
+    "initial": {"mode": V, "amplitude": V, "u0": U0, "v0": V0, "fixed_frame": V},
+    "mesh": {"J": V, "element": V, "nodes": V},
+    "time": TIME_KEYS, "contact": CONTACT, "output": OUTPUT,
+}
+BAR_KEYS = {
+    "kind": V, "material": MATERIAL, "section": SECTION, "geometry": {"L": V},
+    "ends": {"left": V, "right": V},
+    "obstacles": [{"x": V, "stiffness": V}],
+    "damping": {"viscosity": V},
+    "loads": [{"value": V}],
+    "initial": {"u0": Either(U0), "v0": Either(V0)},
+    "mesh": {"J": V, "mass": V},
+    "time": TIME_KEYS, "contact": CONTACT, "output": OUTPUT,
+}
+KINDS = {"beam": BEAM_KEYS, "bar": BAR_KEYS}
+OUTPUT_DEFAULTS = {"format": "both", "save_every": 1, "frames": 200, "flush_every": 20000,
+                   "checkpoint_every": None}
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A scene file read into the Python API's objects.
+
+    ``problem``: a BeamProblem or a Bar; ``stepping``: the time grid; ``law``,
+    ``stiffness`` (N/m), ``restitution``: the contact law (``contact_law`` builds it);
+    ``output``: format, save_every, frames, flush_every, checkpoint_every; ``text``: the
+    file as read and ``files`` the tables it read (path as written → text), so that a run
+    can be rebuilt from its summary.json; ``data``: the parsed TOML with the overrides.
+    """
+    kind: str
+    problem: object
+    stepping: Stepping
+    law: str = "auto"
+    stiffness: float | None = None
+    restitution: float = 0.0
+    output: dict = field(default_factory=dict)
+    text: str = ""
+    files: dict = field(default_factory=dict)
+    data: dict = field(default_factory=dict)
+
+    @property
+    def contact_law(self):
+        """The contact law object (a beam's penalty stiffness is divided by ρA: the
+        equation is mass-normalised, docs/design.md §1)."""
+        from .contact import resolve
+        k = self.stiffness
+        if k is not None and self.kind == "beam":
+            k = k / (self.problem.beam.rho_S or 1.0)
+        return resolve(self.law, k, self.restitution or 0.0)
+
+
+# ---------------------------------------------------------------- the file's shape
+
+def _where(path: tuple) -> str:
+    return ".".join(str(p) for p in path)
+
+
+def _check_keys(data, schema, path=()) -> None:
+    """Refuse a key ``schema`` does not allow, naming it and the allowed ones."""
+    for key, value in data.items():
+        if key not in schema:
+            where = f"[{_where(path)}]" if path else "the top level"
+            raise InputError(f"unknown key {_where(path + (key,))!r}; {where} allows: "
+                             f"{', '.join(schema)}")
+        sub = schema[key]
+        if isinstance(sub, Either) and not isinstance(value, dict):
+            continue
+        if isinstance(sub, dict):
+            if not isinstance(value, dict):
+                raise InputError(f"{_where(path + (key,))} must be a table of "
+                                 f"{', '.join(sub)} (got {value!r})")
+            _check_keys(value, sub, path + (key,))
+        elif isinstance(sub, list):
+            if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
+                raise InputError(f"{_where(path + (key,))} must be an array of tables "
+                                 f"[[{_where(path + (key,))}]] of {', '.join(sub[0])}")
+            for i, item in enumerate(value):
+                _check_keys(item, sub[0], path + (key, i))
+
+
+def _toml_value(text: str):
+    """``text`` as a TOML value (number, boolean, array, inline table, quoted string);
+    a bare word is a string (``--set ends.right=free``)."""
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        return text
+
+
+def apply_set(data: dict, assignment: str) -> None:
+    """``KEY=VALUE`` (KEY dotted, array items by index: ``obstacles.0.g1``) into
+    ``data``; a key the scene's kind does not allow is refused by name."""
+    key, eq, text = assignment.partition("=")
+    if not eq or not key.strip():
+        raise InputError(f"--set {assignment!r}: expected KEY=VALUE, e.g. time.dt=1e-5")
+    parts = key.strip().split(".")
+    schema = KINDS.get(data.get("kind", "beam"), BEAM_KEYS)
+    node, sub = data, schema
+    for i, part in enumerate(parts):
+        last = i == len(parts) - 1
+        if isinstance(sub, list):
+            items = node
+            if not part.isdigit() or int(part) > len(items):
+                raise InputError(f"--set {key}: {_where(parts[:i])} has {len(items)} "
+                                 f"item(s); index {part!r} must be 0..{len(items)}")
+            if int(part) == len(items):
+                items.append({})
+            node, sub = items[int(part)], sub[0]
+            if last:
+                raise InputError(f"--set {key}: name a key of the item, e.g. "
+                                 f"{key}.{next(iter(sub))}")
+            continue
+        if not isinstance(sub, dict) or part not in sub:
+            allowed = ", ".join(sub) if isinstance(sub, dict) else "none"
+            raise InputError(f"--set {key}: unknown key {part!r}; "
+                             f"{'[' + _where(parts[:i]) + ']' if i else 'the top level'} "
+                             f"allows: {allowed}")
+        if last:
+            node[part] = _toml_value(text.strip())
+            return
+        child = sub[part]
+        if isinstance(child, list):
+            node = node.setdefault(part, [])
+        else:
+            node = node.setdefault(part, {})
+        sub = child
+
+
+# ---------------------------------------------------------------- reading
+
+def load(path, overrides=(), files: dict | None = None, text: str | None = None) -> Scene:
+    """Read the scene file ``path`` (``overrides``: ``KEY=VALUE`` strings as ``--set``).
+    ``text``/``files``: the file's and its tables' stored texts (a resumed run) instead of
+    the file system."""
+    path = Path(path)
+    if text is None:
+        try:
+            text = path.read_text(encoding="utf-8")
+        except OSError as e:
+            raise InputError(f"cannot read the scene file {path}: {e.strerror}") from None
+        except UnicodeDecodeError:
+            raise InputError(f"{path}: not a UTF-8 text file") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise InputError(f"{path}: not valid TOML: {e}") from None
+    kind = data.get("kind", "beam")
+    if kind not in KINDS:
+        raise InputError(f"{path}: kind={kind!r} must be one of: {', '.join(KINDS)}")
+    for assignment in overrides:
+        apply_set(data, assignment)
+    _check_keys(data, KINDS[data.get("kind", "beam")])
+    kind = data.get("kind", "beam")
+    reader = _Reader(path.parent, dict(files or {}))
+    with tempfile.TemporaryDirectory() as tmp:
+        reader.tmp = Path(tmp)
+        problem = (_beam_problem if kind == "beam" else _bar)(data, reader)
+    return _scene(kind, problem, data, text, reader.read)
+
+
+def _scene(kind, problem, data, text, files) -> Scene:
+    contact = data.get("contact", {})
+    law, k = contact.get("law", "auto"), contact.get("stiffness")
+    if k is not None and law == "auto":
+        law = "penalty"
+    t = data.get("time", {})
+    if "dt" not in t or "T" not in t:
+        raise InputError("[time] needs dt and T (s)")
+    beta = t.get("beta", 0.25 if kind == "bar" or law == "penalty" else 0.5)
+    out = {**OUTPUT_DEFAULTS, **data.get("output", {})}
+    stepping = Stepping(t["dt"], t["T"], beta, out["save_every"], out["frames"])
+    scene = Scene(kind, problem, stepping, law, k, contact.get("restitution", 0.0), out,
+                  text, files, data)
+    scene.contact_law        # the law's own checks (name, stiffness, restitution)
+    return scene
+
+
+class _Reader:
+    """Files named in the scene, relative to it; their texts are kept (``read``) so that a
+    run stores them, and a resumed run reads the stored texts (``stored``)."""
+
+    def __init__(self, base: Path, stored: dict):
+        self.base, self.stored, self.read, self.tmp = base, stored, {}, None
+
+    def path(self, name) -> Path:
+        if not isinstance(name, str):
+            raise InputError(f"table={name!r} must be a file name (a string)")
+        if name in self.stored:
+            p = self.tmp / f"{len(self.read)}_{Path(name).name}"
+            p.write_text(self.stored[name], encoding="utf-8")
+            self.read[name] = self.stored[name]
+            return p
+        p = Path(name) if Path(name).is_absolute() else self.base / name
+        try:
+            self.read[name] = p.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError):
+            pass    # the reader names the file and why (Table.from_csv)
+        return p
+
+
+def _time_function(d: dict, where: str, reader: _Reader):
+    """A time function from the keys of TIME (one form), or None when none is given."""
+    forms = [k for k in ("amplitude", "value", "sines", "table", "random") if k in d]
+    if "omega" in d and "amplitude" not in d:
+        forms.append("omega")
+    if len(forms) > 1:
+        raise InputError(f"[{where}] give one of amplitude/omega, value, sines, table, "
+                         f"random (got {', '.join(forms)})")
+    if not forms:
+        return None
+    form = forms[0]
+    if form in ("amplitude", "omega"):
+        return Sine(d.get("amplitude", 0.0), d.get("omega", 0.0), d.get("phase", 0.0))
+    if form == "value":
+        return Constant(d["value"])
+    if form == "sines":
+        rows = d["sines"]
+        if not isinstance(rows, list) or not all(isinstance(r, list) and len(r) in (2, 3)
+                                                 for r in rows):
+            raise InputError(f"[{where}] sines must be [[amplitude, omega, phase], ...]")
+        return SumOfSines(tuple(r[0] for r in rows), tuple(r[1] for r in rows),
+                          tuple(r[2] if len(r) == 3 else 0.0 for r in rows))
+    if form == "table":
+        return Table.from_csv(reader.path(d["table"]))
+    return band_limited(**d["random"])
+
+
+def _section(d: dict, where: str) -> Section:
+    forms = [k for k in ("tube", "rod", "rect") if k in d] + (["I/A"] if "I" in d or "A" in d
+                                                             else [])
+    if len(forms) != 1:
+        raise InputError(f"[{where}] needs one of I and A, tube, rod, rect "
+                         f"(got {', '.join(forms) or 'none'})")
+    if "tube" in d:
+        return Section.tube(**_need(d["tube"], ("outer_diameter", "wall"), f"{where}.tube"))
+    if "rod" in d:
+        return Section.rod(**_need(d["rod"], ("diameter",), f"{where}.rod"))
+    if "rect" in d:
+        return Section.rect(**_need(d["rect"], ("b", "h"), f"{where}.rect"))
+    return Section(**_need(d, ("I", "A"), where))
+
+
+def _need(d: dict, keys, where: str) -> dict:
+    missing = [k for k in keys if k not in d]
+    if missing:
+        raise InputError(f"[{where}] needs {', '.join(keys)} (missing {', '.join(missing)})")
+    return {k: d[k] for k in keys}
+
+
+def _material(d: dict, where: str) -> Material:
+    return Material(**_need(d, ("E", "rho"), where))
+
+
+def _beam(data: dict) -> Beam:
+    mn, segs = data.get("mass_normalised"), data.get("segments")
+    forms = [k for k in ("mass_normalised", "segments") if k in data] + \
+        (["material/section"] if "material" in data or "section" in data else [])
+    if len(forms) != 1:
+        raise InputError("a beam needs one of [material] with [section], [mass_normalised] "
+                         f"(k2, rho_S) or [[segments]] (got {', '.join(forms) or 'none'})")
+    if segs is not None:
+        if "geometry" in data:
+            raise InputError("[[segments]] give the length: leave out [geometry]")
+        return Beam.stepped([(s.get("length", math.nan), _material(s.get("material", {}),
+                                                                    f"segments.{i}.material"),
+                              _section(s.get("section", {}), f"segments.{i}.section"))
+                             for i, s in enumerate(segs)])
+    L = _need(data.get("geometry", {}), ("L",), "geometry")["L"]
+    if mn is not None:
+        return Beam(L, _need(mn, ("k2",), "mass_normalised")["k2"], mn.get("rho_S"))
+    return Beam.physical(L, _material(data.get("material", {}), "material"),
+                         _section(data.get("section", {}), "section"))
+
+
+def _g(value, where: str):
+    """An obstacle g: a number, {poly, about} or {x, g} (a table, linear between points)."""
+    if not isinstance(value, dict):
+        return value
+    if set(value) == {"poly", "about"} or set(value) == {"poly"}:
+        c = [float(v) for v in value["poly"]]
+        x0 = float(value.get("about", 0.0))
+
+        def poly(x):
+            d = np.asarray(x, dtype=float) - x0
+            out = c[0] + c[1] * d if len(c) > 1 else np.full(d.shape, c[0])
+            for k in range(2, len(c)):
+                out = out + c[k] * d**k
+            return out
+        return poly
+    if set(value) == {"x", "g"}:
+        xs, gs = np.asarray(value["x"], dtype=float), np.asarray(value["g"], dtype=float)
+        if xs.ndim != 1 or xs.shape != gs.shape or xs.size < 2 or np.any(np.diff(xs) <= 0):
+            raise InputError(f"{where} = {{x, g}}: x must increase, with one g per x (at "
+                             "least two)")
+        return lambda x: np.interp(np.asarray(x, dtype=float), xs, gs)
+    raise InputError(f"{where} must be a number, {{ poly = [c0, c1, ...], about = x0 }} or "
+                     f"{{ x = [...], g = [...] }} (got keys {', '.join(value)})")
+
+
+def _obstacle(o: dict, i: int) -> Obstacles:
+    where = f"obstacles.{i}"
+    g1, g2 = _g(o.get("g1", -np.inf), f"{where}.g1"), _g(o.get("g2", np.inf), f"{where}.g2")
+    carried = o.get("carried", False)
+    if "x" in o:
+        if "x_from" in o or "x_to" in o or callable(g1) or callable(g2):
+            raise InputError(f"[{where}] a point stop (x) takes numbers g1, g2 and no "
+                             "x_from/x_to")
+        return Obstacles.stops([o["x"]], g1, g2, carried=carried)
+    if "x_from" in o or "x_to" in o:
+        a, b = _need(o, ("x_from", "x_to"), where).values()
+        return Obstacles.span(a, b, g1, g2, carried=carried)
+    return Obstacles(g1, g2, carried=carried)
+
+
+def _obstacles(data: dict) -> Obstacles:
+    parts = [_obstacle(o, i) for i, o in enumerate(data.get("obstacles", []))]
+    if not parts:
+        return Obstacles()
+    return parts[0] if len(parts) == 1 else Obstacles.combine(*parts)
+
+
+def _support(data: dict, L: float, reader: _Reader) -> Support:
+    m = data.get("motion")
+    if m is None:
+        return Support()
+    if "end" in m and "at" in m:
+        raise InputError("[motion] give end (left | right) or at (x of a support), not both")
+    at = m.get("at", 0.0)
+    if "end" in m:
+        ends = {"left": 0.0, "right": L}
+        if m["end"] not in ends:
+            raise InputError(f"[motion] end={m['end']!r} must be one of: left, right")
+        at = ends[m["end"]]
+    lifting = m.get("lifting", "auto")
+    if set(m) & {"amplitude", "omega"} and not set(m) & {"phase", "value", "sines", "table",
+                                                          "random"}:
+        return Support(m.get("amplitude", 0.0), m.get("omega", 0.0), at=at, lifting=lifting)
+    return Support(motion=_time_function(m, "motion", reader), at=at, lifting=lifting)
+
+
+def _loads(data: dict, reader: _Reader) -> Load:
+    total = Load()
+    for i, d in enumerate(data.get("loads", [])):
+        where = f"loads.{i}"
+        if "gravity" in d:
+            if len(d) > 1:
+                raise InputError(f"[{where}] gravity = g stands alone (got {', '.join(d)})")
+            total = total + Load.gravity(d["gravity"])
+            continue
+        time = _time_function(d, where, reader)
+        if time is None:
+            raise InputError(f"[{where}] needs a time function: amplitude/omega, value, "
+                             "sines, table or random")
+        kinds = [k for k in ("x", "distributed", "per_mass") if d.get(k, False) is not False]
+        if len(kinds) != 1:
+            raise InputError(f"[{where}] needs one of x (a point force, N), distributed = "
+                             "true (N/m) or per_mass = true (m/s²)")
+        if kinds[0] == "x":
+            total = total + Load(points=((d["x"], time),))
+        elif kinds[0] == "distributed":
+            total = total + Load.distributed(1.0, time)
+        else:
+            total = total + Load.uniform(time)
+    return total
+
+
+def _damping(data: dict) -> Damping:
+    d = data.get("damping")
+    if d is None:
+        return Damping()
+    if set(d) & {"zeta", "f1", "f2"}:
+        if set(d) & {"alpha", "alpha_K"}:
+            raise InputError("[damping] give zeta, f1, f2 or alpha, alpha_K, not both")
+        return Damping.ratio(**_need(d, ("zeta", "f1", "f2"), "damping"))
+    return Damping(d.get("alpha", 0.0), d.get("alpha_K", 0.0))
+
+
+def _spline(d: dict, name: str, value: str):
+    """(f, f') of a {x, u} table: a not-a-knot cubic spline."""
+    pairs = _need(d, ("x", value), f"initial.{name}")
+    try:
+        s = CubicSpline(np.asarray(pairs["x"], dtype=float),
+                        np.asarray(pairs[value], dtype=float), bc_type="not-a-knot")
+    except ValueError as e:
+        raise InputError(f"[initial.{name}] table x = [...], {value} = [...]: {e}") from None
+    return s, s.derivative()
+
+
+def _initial(data: dict, problem: BeamProblem) -> BeamProblem:
+    ini = data.get("initial", {})
+    fixed = ini.get("fixed_frame", True)
+    if "mode" in ini:
+        if "u0" in ini:
+            raise InputError("[initial] give mode or u0, not both")
+        u0, du0 = _mode_shape(problem, ini["mode"], ini.get("amplitude", 1.0))
+    elif "u0" in ini:
+        u0, du0 = _spline(ini["u0"], "u0", "u")
+    else:
+        u0 = du0 = None
+    v0 = _spline(ini["v0"], "v0", "v")[0] if "v0" in ini else None
+    return replace(problem, initial=InitialState(u0, v0, du0, fixed_frame=fixed))
+
+
+def _mode_shape(problem: BeamProblem, k, amplitude):
+    """amplitude × the k-th mode shape (its largest |u| 1, on 50 samples per element)."""
+    from .modes import modes
+    if isinstance(k, bool) or not isinstance(k, int) or k < 1:
+        raise InputError(f"[initial] mode={k!r} must be a whole number ≥ 1")
+    m = modes(problem, k, samples_per_element=50)
+    v = m.vectors[:, k - 1] * (float(amplitude) / np.abs(m.shapes[:, k - 1]).max())
+    space = m.space
+
+    def shape(derivative):
+        return lambda x: np.asarray(space.point_rows(np.ravel(x), derivative) @ v).reshape(
+            np.shape(x))
+    return shape(0), shape(1)
+
+
+def _beam_problem(data: dict, reader: _Reader) -> BeamProblem:
+    beam = _beam(data)
+    ends = data.get("ends", {})
+    mesh = data.get("mesh", {})
+    problem = BeamProblem(
+        beam, _obstacles(data), _support(data, beam.L, reader), _loads(data, reader),
+        J=mesh.get("J", 19), element=mesh.get("element", "hermite"), nodes=mesh.get("nodes"),
+        ends=(ends.get("left", "clamped"), ends.get("right", "free")),
+        supports=tuple(s.get("x", math.nan) for s in data.get("supports", [])),
+        damping=_damping(data))
+    return _initial(data, problem)
+
+
+def _bar_profile(d, name: str, value: str):
+    if isinstance(d, dict):
+        pairs = _need(d, ("x", value), f"initial.{name}")
+        if not isinstance(pairs["x"], list) or not isinstance(pairs[value], list) \
+                or len(pairs["x"]) != len(pairs[value]):
+            raise InputError(f"[initial.{name}] x and {value} must be arrays of one length")
+        return list(zip(pairs["x"], pairs[value]))
+    return d
+
+
+def _bar(data: dict, reader: _Reader) -> Bar:
+    L = _need(data.get("geometry", {}), ("L",), "geometry")["L"]
+    mat = _material(data.get("material", {}), "material")
+    A = _section(data["section"], "section").A if "section" in data else None
+    obstacles = data.get("obstacles", [])
+    if len(obstacles) != 1 or "x" not in obstacles[0]:
+        raise InputError("a bar needs one [[obstacles]] with x = 0 or x = L (the end it "
+                         f"hits; stiffness = k for an elastic obstacle), got {len(obstacles)}")
+    o = obstacles[0]
+    ends = {"left": "free", "right": "free", **data.get("ends", {})}
+    side = "left" if o["x"] in (0, "left") else "right"
+    if ends[side] != "free":
+        raise InputError(f"[ends] {side}={ends[side]!r}: the bar's obstacle is at that end, "
+                         "which must be free (the far end is free or clamped)")
+    loads = data.get("loads", [])
+    if len(loads) > 1:
+        raise InputError("a bar takes one [[loads]] value = f (a uniform body force, N/m³)")
+    ini, mesh = data.get("initial", {}), data.get("mesh", {})
+    law = data.get("contact", {}).get("law", "auto")
+    return Bar(a=mat.E, b=data.get("damping", {}).get("viscosity", 0.0), rho=mat.rho, L=L,
+               f=loads[0].get("value", 0.0) if loads else 0.0,
+               v0=_bar_profile(ini.get("v0", 0.0), "v0", "v"),
+               u0=_bar_profile(ini.get("u0", 0.0), "u0", "u"),
+               obstacle="elastic" if "stiffness" in o and law != "penalty" else "rigid",
+               k=o.get("stiffness", 100.0), N=mesh.get("J", 100),
+               mass=mesh.get("mass", "average"),
+               far_end=ends["right" if side == "left" else "left"], obstacle_at=o["x"], A=A)
+
+
+# ---------------------------------------------------------------- commands
+
+def _run_parser() -> argparse.ArgumentParser:
+    from .cli import Parser
+    p = Parser(prog="python -m skfem_beam run",
+               description="Run the scene a TOML file describes (README, Scene files).")
+    p.add_argument("scene", nargs="?", default=None, help="the scene file (TOML)")
+    p.add_argument("--set", action="append", default=None, metavar="KEY=VALUE",
+                   help="override a key of the file, e.g. time.dt=1e-5 (repeatable)")
+    p.add_argument("--T", type=float, default=None, help="final time (s): [time] T")
+    p.add_argument("--out", default=None, help="output folder (default out/<scene name>)")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing --out folder")
+    for flag in ("format", "frames", "save-every", "flush-every", "checkpoint-every"):
+        p.add_argument(f"--{flag}", default=None,
+                       type=str if flag == "format" else float if flag == "checkpoint-every"
+                       else int, help=f"[output] {flag.replace('-', '_')}")
+    p.add_argument("--resume", metavar="DIR", default=None,
+                   help="continue the stopped run in DIR from its last checkpoint")
+    return p
+
+
+def run_main(argv) -> int:
+    """``python -m skfem_beam run``: the scene through the scenes' own pipeline."""
+    from .output.series import read_summary, stored_args
+    p = _run_parser()
+    args = stored_args(p.parse_args(argv), p, argv)
+    stored = {}
+    if args.resume:
+        config = read_summary(Path(args.resume))["config"]
+        if "scene_text" not in config:
+            raise InputError(f"--resume {args.resume}: not a run of python -m skfem_beam run")
+        stored = {"text": config["scene_text"], "files": config.get("scene_files", {})}
+    elif args.scene is None:
+        raise InputError("run needs a scene file: python -m skfem_beam run SCENE.toml")
+    scene = load(args.scene or "scene.toml", args.set or (), **stored)
+    for key, value in scene.output.items():
+        if getattr(args, key) is None:
+            setattr(args, key, value)
+    if args.T is None:
+        args.T = scene.stepping.T
+    if args.out is None:
+        args.out = f"out/{Path(args.scene).stem}"
+    penalty = scene.law == "penalty"
+    if scene.restitution:
+        raise InputError("[contact] restitution: `run` cannot pass a coefficient of "
+                         "restitution to the scenes' pipeline yet; use the Python API "
+                         "(solve(..., solver=scene.contact_law))")
+    args.dt, args.beta = scene.stepping.dt, scene.stepping.beta
+    args.method = "penalty" if penalty else "contact"
+    args.solver = "auto" if penalty else scene.law
+    args.stiffness = scene.stiffness
+    config = {"command": "python -m skfem_beam run", "scene_text": scene.text,
+              "scene_files": scene.files}
+    name = f"scene {Path(args.scene).stem}" if args.scene else "scene"
+    if scene.kind == "bar":
+        from .cases.impacting_bar import run_bar_case
+        return run_bar_case(scene.problem, args, config)
+    from .cases._beam import run_beam_case
+    if penalty and scene.stiffness is None:
+        raise InputError("[contact] law='penalty' needs stiffness (N/m)")
+    stops = _chart_stops(scene.problem)
+    return run_beam_case(name, scene.problem, args, config, stops=stops)
+
+
+def _chart_stops(problem: BeamProblem) -> tuple:
+    """The obstacle at the tip, for the tip chart (none when it has none)."""
+    lo, hi = problem.obstacles.bounds([problem.beam.L])
+    return tuple(float(g) for g in (lo[0], hi[0]) if np.isfinite(g))
+
+
+def modes_main(argv) -> int:
+    """``python -m skfem_beam modes``: natural frequencies of the scene's beam."""
+    from .cli import Parser
+    from .modes import modes
+    p = Parser(prog="python -m skfem_beam modes",
+               description="Natural frequencies and mode shapes of a scene file's beam, with "
+                           "its ends and supports (obstacles ignored).")
+    p.add_argument("scene", help="the scene file (TOML)")
+    p.add_argument("--n", type=int, default=6, help="number of modes")
+    p.add_argument("--set", action="append", default=None, metavar="KEY=VALUE",
+                   help="override a key of the file (repeatable)")
+    p.add_argument("--out", default=None, help="write DIR/modes.csv")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing --out folder")
+    args = p.parse_args(argv)
+    scene = load(args.scene, args.set or ())
+    if scene.kind != "beam":
+        raise InputError(f"modes: {args.scene} is a {scene.kind}; modes are computed for "
+                         "beams")
+    out = None
+    if args.out is not None:
+        from .output.folder import check_output_dir
+        out = check_output_dir(args.out, args.overwrite)
+    m = modes(scene.problem, args.n)
+    print(f"{'mode':>4s} {'f (Hz)':>14s} {'ω (rad/s)':>14s}")
+    for i, (f, w) in enumerate(zip(m.f, m.omega), 1):
+        print(f"{i:4d} {f:14.6g} {w:14.6g}")
+    if out is not None:
+        out.mkdir(parents=True, exist_ok=True)
+        with open(out / "modes.csv", "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(["mode", "f_Hz", "omega_rad_s"] + [f"u({float(x)!r})" for x in m.x])
+            for i in range(m.f.size):
+                w.writerow([i + 1, f"{m.f[i]:.17g}", f"{m.omega[i]:.17g}"]
+                           + [f"{u:.17g}" for u in m.shapes[:, i]])
+        print(f"written: {out / 'modes.csv'}", file=sys.stderr)
+    return 0
+
+
+def example(name: str) -> Path:
+    """The path of a shipped scene file (``skfem_beam/scene_files/NAME.toml``)."""
+    p = Path(__file__).resolve().parent / "scene_files" / f"{Path(name).stem}.toml"
+    if not p.is_file():
+        shipped = sorted(q.stem for q in p.parent.glob("*.toml"))
+        raise InputError(f"no scene file {name!r}; shipped: {', '.join(shipped)}")
+    return p
+
+
+__all__ = ["Scene", "load", "apply_set", "run_main", "modes_main", "example", "BEAM_KEYS",
+           "BAR_KEYS"]

@@ -1,0 +1,273 @@
+"""Scene files: the TOML keys onto the API's objects, `run` and `modes`, refusals."""
+import csv
+import json
+import math
+import shutil
+
+import numpy as np
+import pytest
+
+from conftest import assert_refused, exit_code
+from skfem_beam import beam_system, scenes
+from skfem_beam.cases import flat_obstacles, impacting_bar, point_stops
+from skfem_beam.modes import modes
+from skfem_beam.problem import Beam, Material, Section
+from skfem_beam.scenefile import example, load, modes_main, run_main
+from skfem_beam.scheme import Run
+from skfem_beam.scheme.solve import drive
+from skfem_beam.timefunctions import Table
+
+PIPE = """
+kind = "beam"
+[mass_normalised]
+k2 = 282.84
+rho_S = 0.1194
+[geometry]
+L = 1.501
+[[obstacles]]
+x = 1.501
+g1 = -0.1
+g2 = 0.1
+[time]
+dt = 5e-5
+T = 0.01
+"""
+
+
+def write(folder, text, name="scene.toml"):
+    p = folder / name
+    p.write_text(text)
+    return p
+
+
+def series(folder):
+    return (folder / "timeseries.csv").read_text()
+
+
+@pytest.mark.parametrize("name, case, T", [
+    ("point_stops", point_stops, "0.1"),
+    ("flat_obstacles", flat_obstacles, "0.1"),
+    ("impacting_bar", impacting_bar, "0.1"),
+])
+def test_shipped_scene_runs_bit_for_bit_as_its_case(tmp_path, name, case, T):
+    a, b = tmp_path / "scene", tmp_path / "case"
+    assert exit_code(run_main, [str(example(name)), "--set", f"time.T={T}", "--out", str(a),
+                                "--format", "none"]) == 0
+    assert exit_code(case.main, ["--T", T, "--out", str(b), "--format", "none"]) == 0
+    assert series(a) == series(b)          # the same columns, every digit of every row
+    sa, sb = (json.loads((d / "summary.json").read_text()) for d in (a, b))
+    for key in ("steps", "impacts", "max_nodal_violation", "energy_final"):
+        assert sa[key] == sb[key]
+
+
+def test_convex_obstacles_polynomial_is_the_papers_profile_bit_for_bit():
+    scene = load(example("convex_obstacles"))
+    ref = scenes.convex_obstacles()
+    x = np.linspace(0.0, 10.0, 4001)
+    for ours, theirs in zip(scene.problem.obstacles.bounds(x), ref.obstacles.bounds(x)):
+        assert np.array_equal(ours, theirs)
+    s, r = beam_system(scene.problem), beam_system(ref)
+    G = np.linspace(0, 1, 7)
+    assert np.array_equal(s.loads, r.loads)
+    assert np.array_equal(s.load_time[0](G), r.load_time[0](G))
+
+
+def test_point_stops_objects_are_the_scenes():
+    scene = load(example("point_stops"))
+    pb, ref = scene.problem, scenes.point_stops()
+    assert pb.beam == ref.beam and pb.support == ref.support and pb.J == ref.J
+    s, r = beam_system(pb), beam_system(ref)
+    assert np.array_equal(s.u0, r.u0) and np.array_equal(s.v0, r.v0)  # at rest, fixed frame
+    assert scene.stepping.dt == 5e-5 and scene.stepping.T == 2.0 and scene.law == "auto"
+
+
+def test_physical_stepped_and_sections_map_one_to_one(tmp_path):
+    text = """
+[[segments]]
+length = 0.6
+material = { E = 2e11, rho = 8000.0 }
+section = { tube = { outer_diameter = 0.012, wall = 0.001 } }
+[[segments]]
+length = 0.9
+material = { E = 7e10, rho = 2700.0 }
+section = { rect = { b = 0.02, h = 0.005 } }
+[ends]
+left = "clamped"
+right = "pinned"
+[[supports]]
+x = 0.9
+[mesh]
+J = 15
+[time]
+dt = 1e-4
+T = 0.01
+"""
+    pb = load(write(tmp_path, text)).problem
+    assert pb.beam == Beam.stepped([(0.6, Material(2e11, 8000.0), Section.tube(0.012, 0.001)),
+                                    (0.9, Material(7e10, 2700.0), Section.rect(0.02, 0.005))])
+    assert pb.ends == ("clamped", "pinned") and pb.supports == (0.9,)
+    rod = load(write(tmp_path, PIPE.replace("[mass_normalised]\nk2 = 282.84\nrho_S = 0.1194",
+                                            "[material]\nE = 2e11\nrho = 8000.0\n[section]\n"
+                                            "rod = { diameter = 0.01 }"))).problem
+    assert rod.beam == Beam.physical(1.501, Material(2e11, 8000.0), Section.rod(0.01))
+
+
+def test_motion_table_is_relative_to_the_scene_and_stored_for_resume(tmp_path):
+    t = np.linspace(0.0, 0.3, 301)
+    (tmp_path / "scene").mkdir()
+    np.savetxt(tmp_path / "scene" / "phi.csv", np.column_stack([t, 0.2 * np.sin(10 * t)]),
+               delimiter=",", header="t,phi", comments="")
+    scene_file = write(tmp_path / "scene", PIPE + '[motion]\nend = "left"\ntable = "phi.csv"\n'
+                       "[output]\nformat = \"none\"\n")
+    scene = load(scene_file)
+    motion = scene.problem.support.motion
+    assert isinstance(motion, Table) and motion(0.15) == pytest.approx(0.2 * np.sin(1.5), abs=1e-9)
+    assert set(scene.files) == {"phi.csv"}
+    a, ref = tmp_path / "a", tmp_path / "ref"
+    assert exit_code(run_main, [str(scene_file), "--out", str(ref), "--T", "0.02"]) == 0
+    assert exit_code(run_main, [str(scene_file), "--out", str(a)]) == 0
+    shutil.rmtree(tmp_path / "scene")                  # the stored texts rebuild the run
+    assert exit_code(run_main, ["--resume", str(a), "--T", "0.02"]) == 0
+    assert series(a) == series(ref)
+    config = json.loads((a / "summary.json").read_text())["config"]
+    assert 'table = "phi.csv"' in config["scene_text"]
+    assert config["scene_files"]["phi.csv"].startswith("t,phi")
+
+
+def test_set_overrides_nested_keys_and_array_items(tmp_path):
+    f = write(tmp_path, PIPE)
+    s = load(f, ["time.dt=1e-5", "obstacles.0.g2=0.05", "mesh.element=bspline",
+                 "ends.right=pinned", "obstacles.1.x=0.7505", "obstacles.1.g1=-0.01",
+                 "mesh.J=20"])
+    assert s.stepping.dt == 1e-5 and s.problem.element == "bspline"
+    assert s.problem.ends == ("clamped", "pinned")
+    lo, hi = s.problem.obstacles.bounds(np.array([0.7505, 1.501]))
+    assert lo.tolist() == [-0.01, -0.1] and hi.tolist() == [np.inf, 0.05]
+
+
+def test_initial_mode_is_the_mode_shape_scaled_to_its_amplitude(tmp_path):
+    f = write(tmp_path, PIPE + "[initial]\nmode = 2\namplitude = 0.001\n")
+    pb = load(f).problem
+    m = modes(pb, 2, samples_per_element=50)
+    x = np.linspace(0, pb.beam.L, 3001)
+    u = pb.initial.u0(x)
+    assert np.abs(u).max() == pytest.approx(0.001, rel=1e-3)   # 50 samples per element
+    shape = m.space.point_rows(x) @ m.vectors[:, 1]
+    assert np.abs(u / 0.001 * np.abs(m.shapes[:, 1]).max() - shape).max() < 1e-12
+    # the nodal interpolant of a function of the space is itself: u0 is the mode exactly
+    s = beam_system(pb)
+    v = m.vectors[:, 1] * 0.001 / np.abs(m.shapes[:, 1]).max()
+    assert np.abs(s.u0 - v).max() < 1e-15 and not s.v0.any()
+
+
+def test_modes_command_prints_and_writes_the_cantilever_frequencies(tmp_path, capsys):
+    out = tmp_path / "m"
+    assert exit_code(modes_main, [str(example("point_stops")), "--n", "3", "--out",
+                                  str(out)]) == 0
+    text = capsys.readouterr().out
+    w1 = 1.8751040687119611 ** 2 * math.sqrt(282.84) / 1.501 ** 2   # clamped–free, exact
+    rows = list(csv.reader(open(out / "modes.csv")))
+    assert rows[0][:3] == ["mode", "f_Hz", "omega_rad_s"] and len(rows) == 4
+    assert abs(float(rows[1][2]) / w1 - 1) < 1e-6                  # J = 19 Hermite
+    assert f"{float(rows[1][1]):14.6g}".strip() in text
+    x = [float(h[2:-1]) for h in rows[0][3:]]
+    assert x[0] == 0.0 and x[-1] == pytest.approx(1.501) and float(rows[1][3]) == 0.0
+
+
+def test_heat_exchanger_tube_rattles_in_both_baffles():
+    scene = load(example("heat_exchanger_tube"))
+    pb = scene.problem
+    assert pb.ends == ("pinned", "pinned") and pb.damping.alpha > 0
+    run = Run(beam_system(pb), scene.stepping, scene.contact_law)
+    drive(run)
+    r = run.result()
+    ev = r.impact_events
+    assert r.status == "success" and r.max_nodal_violation <= 1e-10
+    for x in (0.5, 1.0):
+        assert (ev["x"] == x).sum() >= 5, x
+
+
+def test_bar_with_elastic_obstacle_and_profile(tmp_path):
+    text = example("impacting_bar").read_text().replace("x = 0.0  ", "x = 1.0\nstiffness = 50.0")
+    text = text.replace('right = "free"', 'left = "clamped"')
+    text = text.replace("u0 = 0.0 ", "u0 = { x = [0.0, 1.0], u = [0.0, 0.0] }")
+    bar = load(write(tmp_path, text)).problem
+    assert (bar.obstacle, bar.k, bar.obstacle_at, bar.far_end) == ("elastic", 50.0, "right",
+                                                                   "clamped")
+
+
+BAD = {
+    "negative E": (PIPE.replace("[mass_normalised]\nk2 = 282.84\nrho_S = 0.1194",
+                                "[material]\nE = -2e11\nrho = 8000.0\n[section]\n"
+                                "tube = { outer_diameter = 0.01, wall = 0.0005 }"), "E=-2e+11"),
+    "wall ≥ radius": (PIPE.replace("[mass_normalised]\nk2 = 282.84\nrho_S = 0.1194",
+                                   "[material]\nE = 2e11\nrho = 8000.0\n[section]\n"
+                                   "tube = { outer_diameter = 0.01, wall = 0.005 }"), "wall=0.005"),
+    "support outside": (PIPE + "[[supports]]\nx = 2.0\n", "support x=2"),
+    "two supports at one x": (PIPE + "[[supports]]\nx = 0.5\n[[supports]]\nx = 0.5\n",
+                              "two supports at x=0.5"),
+    "unknown end": (PIPE + '[ends]\nright = "glued"\n', "glued"),
+    "unknown key": (PIPE.replace("L = 1.501", "L = 1.501\nwidth = 3"), "'geometry.width'"),
+    "unknown section": (PIPE + "[solver]\nx = 1\n", "'solver'"),
+    "malformed TOML": (PIPE + "[time\n", "not valid TOML"),
+    "table t not increasing": (PIPE + '[motion]\nend = "left"\ntable = "phi.csv"\n',
+                               "t is not increasing at row 4"),
+}
+
+
+@pytest.mark.parametrize("what", sorted(BAD))
+def test_bad_scene_one_line_exit_2_nothing_written(tmp_path, capsys, what):
+    text, word = BAD[what]
+    src = tmp_path / "src"
+    src.mkdir()
+    (src / "phi.csv").write_text("t,phi\n0,0\n0.1,1\n0.1,2\n0.3,0\n0.4,1\n")
+    out = tmp_path / "out"
+    out.mkdir()
+    assert_refused(run_main, [str(write(src, text)), "--out", str(out / "run")], word, capsys,
+                   out)
+
+
+@pytest.mark.parametrize("setting, word", [
+    ("time.dtt=1e-5", "unknown key 'dtt'"), ("nosuch.x=1", "unknown key 'nosuch'"),
+    ("obstacles.3.g1=0", "index '3'"), ("time", "KEY=VALUE"),
+])
+def test_bad_set_key_is_refused_by_name(tmp_path, capsys, setting, word):
+    src = write(tmp_path, PIPE)
+    out = tmp_path / "out"
+    out.mkdir()
+    assert_refused(run_main, [str(src), "--set", setting, "--out", str(out / "run")], word,
+                   capsys, out)
+
+
+def test_unknown_key_message_lists_the_allowed_ones(tmp_path):
+    with pytest.raises(Exception) as e:
+        load(write(tmp_path, PIPE.replace("dt = 5e-5", "dt = 5e-5\nsteps = 3")))
+    assert str(e.value) == "unknown key 'time.steps'; [time] allows: dt, T, beta"
+
+
+def test_scene_files_are_package_data():
+    import tomllib
+    from pathlib import Path
+    pyproject = tomllib.loads((Path(__file__).parent.parent / "pyproject.toml").read_text())
+    assert "scene_files/*.toml" in pyproject["tool"]["setuptools"]["package-data"]["skfem_beam"]
+    for name in ("point_stops", "flat_obstacles", "convex_obstacles", "impacting_bar",
+                 "heat_exchanger_tube"):
+        load(example(name))
+
+
+def test_penalty_law_runs_as_the_case_penalty_method(tmp_path):
+    a, b = tmp_path / "scene", tmp_path / "case"
+    assert exit_code(run_main, [str(example("point_stops")), "--out", str(a), "--T", "0.05",
+                                "--format", "none", "--set", 'contact.law="penalty"',
+                                "--set", "contact.stiffness=1e8", "--set", "time.beta=0.25"]) == 0
+    assert exit_code(point_stops.main, ["--T", "0.05", "--out", str(b), "--format", "none",
+                                        "--method", "penalty"]) == 0
+    assert series(a) == series(b)
+
+
+def test_restitution_is_refused_by_run_but_built_for_the_api(tmp_path, capsys):
+    f = write(tmp_path, PIPE + '[contact]\nlaw = "auto"\nrestitution = 0.5\n')
+    assert load(f).contact_law.e == 0.5
+    out = tmp_path / "out"
+    out.mkdir()
+    assert_refused(run_main, [str(f), "--out", str(out / "run")], "restitution", capsys, out)

@@ -407,7 +407,9 @@ class _Signals:
 
 
 def _command(summary: dict) -> str:
-    return f"python -m skfem_beam.cases.{summary.get('case', '<case>')}"
+    """The command that made the folder (a scene file's run stores its own)."""
+    return summary.get("config", {}).get("command") \
+        or f"python -m skfem_beam.cases.{summary.get('case', '<case>')}"
 
 
 def execute(run: Run, out: Path, args, summary: dict, series, finish) -> int:

@@ -3,13 +3,12 @@ from __future__ import annotations
 
 import math
 import sys
-import threading
 import time
-from contextlib import contextmanager
 
 import numpy as np
 import scipy.sparse
 import scipy.sparse.linalg
+from numba.core import event
 
 from ..contact import ContactLaw, StepData, resolve
 from ..contact.base import NoContact, no_explicit
@@ -28,26 +27,22 @@ FIRST_ROWS = 1 << 15      # saved rows allocated at first; more as a chunk needs
 SAVED = ("obs", "obsv", "energy", "work", "lam")   # the saved series (rows × columns)
 
 
-_NOTICE = "compiling numerical kernels (first run only) …"
-_noticed = []
+class _CompileNotice(event.Listener):
+    """One line on stderr, once per process, when numba starts compiling: the first run
+    of a fresh install compiles the kernels (tens of seconds); later runs load them from
+    numba's cache and compile nothing, so they say nothing."""
+    said = False
+
+    def on_start(self, ev):
+        if not _CompileNotice.said:
+            _CompileNotice.said = True
+            print("compiling numerical kernels (first run only) …", file=sys.stderr, flush=True)
+
+    def on_end(self, ev):
+        pass
 
 
-@contextmanager
-def compile_notice(after: float = 1.0):
-    """One line on stderr, once per process, when building a run takes longer than
-    ``after`` seconds: the first run of a fresh install compiles the numba kernels (tens of
-    seconds); later runs load them from numba's cache in a fraction of a second."""
-    def notice():
-        if not _noticed:
-            _noticed.append(True)
-            print(_NOTICE, file=sys.stderr, flush=True)
-    timer = threading.Timer(after, notice)
-    timer.daemon = True
-    timer.start()
-    try:
-        yield
-    finally:
-        timer.cancel()
+event.register("numba:compile", _CompileNotice())
 
 
 class SavedRows:
@@ -94,10 +89,6 @@ class Run:
     """
 
     def __init__(self, system, stepping: Stepping, law: str | ContactLaw = "auto"):
-        with compile_notice():
-            self._build(system, stepping, law)
-
-    def _build(self, system, stepping, law) -> None:
         s, m = stepping, system.C.shape[0]
         n_steps = s.steps
         self.system, self.stepping = system, s

@@ -146,6 +146,44 @@ def test_case_charts_force_in_newtons(monkeypatch, tmp_path):
     force_N = rows[:, 5]
     y = ax.lines[0].get_ydata()
     assert np.max(np.abs(y)) == np.max(np.abs(force_N)) > 10      # N, not m²/s² ÷ ρS
+    # the energy in J (energy_J = ρS·energy) with the work terms of its balance
+    names = rows_header(out)
+    ax = figures["energy.png"]["ax"]
+    assert ax.get_ylabel() == "energy (J)"
+    lines = {ln.get_label(): ln.get_ydata() for ln in ax.lines}
+    assert set(lines) == {"½E_β", "work of the loads (support motion included)",
+                          "work of the contact forces"}
+    width = charts._columns(figures["energy.png"]["fig"])
+    for label, col in (("½E_β", "energy_J"), ("work of the contact forces", "work_contact_J")):
+        np.testing.assert_array_equal(lines[label],
+                                      envelope(rows[:, 0], rows[:, names.index(col)], width)[1])
     for name, fa in figures.items():
         assert fa["ax"].get_legend() is not None, name
         plt.close(fa["fig"])
+
+
+def rows_header(folder):
+    return (folder / "timeseries.csv").read_text().split("\n", 1)[0].split(",")
+
+
+def test_carried_obstacles_move_with_the_support(monkeypatch, tmp_path):
+    """A stop carried by the shaken frame is drawn at g + φ(t_k) for each drawn frame (in
+    its colour); the stop fixed to the ground once, in black, at g."""
+    import sys
+    sys.path.insert(0, str(__import__("pathlib").Path(__file__).parent))
+    from test_units import SHAKE, _shaken
+    from skfem_beam import Obstacles
+    obs = Obstacles.combine(Obstacles.stops([0.5], -5e-4, 5e-4, carried=True),
+                            Obstacles.point_stops(1.0, -0.004, 0.004))
+    r = solve(beam_system(_shaken(obstacles=obs)), dt=1e-5, T=0.05, frames=10)
+    store = {}
+    monkeypatch.setattr(charts, "figure", lambda *a, **k: kept_figure(store))
+    shape_chart(tmp_path / "shapes.png", r, count=6)
+    marks = [ln for ln in store["ax"].lines if ln.get_marker() in ("^", "v")]
+    moving = sorted((float(ln.get_ydata()[0]) for ln in marks if ln.get_xdata()[0] == 0.5))
+    times = r.frames_t[np.unique(np.linspace(0, r.frames_t.size - 1, 6).astype(int))]
+    want = sorted([g + float(SHAKE(t)) for t in times for g in (-5e-4, 5e-4)])
+    np.testing.assert_allclose(moving, want, rtol=0, atol=1e-15)
+    fixed = {float(ln.get_ydata()[0]) for ln in marks if ln.get_xdata()[0] == 1.0}
+    assert fixed == {-0.004, 0.004}
+    plt.close(store["fig"])

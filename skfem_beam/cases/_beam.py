@@ -8,11 +8,14 @@ import numpy as np
 from .. import cli
 from ..contact import resolve
 from ..output.charts import energy_chart, shape_chart, trajectory_chart
+from ..output.fields import physical_tip
 from ..output.series import execute, prepare
 from ..scheme import Run, Stepping
 from ..checks import check_positive
 from ..semidiscrete import beam_system
 from ..stability import kappa_h, linear_limit
+
+WORK = ("damping", "input", "contact")      # Result.work's terms, in this order
 
 
 def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) -> int:
@@ -38,13 +41,25 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
         stiffness = check_positive("stiffness", args.stiffness) / (rho_S or 1.0)
     run = Run(system, stepping, resolve(args.solver, stiffness))
 
+    view = system.view
+
     def columns(run, k0, k1):
         force = run.lam[k0:k1].sum(axis=1)   # net force on the beam, m²/s² = N/(kg/m)
-        cols = {"t": np.arange(k0, k1) * run.save_every * run.dt,
-                "tip_displacement": run.obs[k0:k1, 0], "tip_velocity": run.obsv[k0:k1, 0],
+        t = np.arange(k0, k1) * run.save_every * run.dt
+        # the physical ũ(L) = u(L) + h(L)φ(t), whatever the lifting (u(L) when h(L) = 0)
+        tip, tip_v = physical_tip(view, t, run.obs[k0:k1, 0], run.obsv[k0:k1, 0])
+        cols = {"t": t, "tip_displacement": tip, "tip_velocity": tip_v,
                 "energy": run.energy[k0:k1], "contact_force": force}
-        if rho_S:
+        if rho_S:                            # physical units: N and J
             cols["contact_force_N"] = force * rho_S
+            cols["energy_J"] = run.energy[k0:k1] * rho_S
+        # work since state 1, in the units of energy: energy − energy[0] + damping
+        # = input + contact (the scheme's identity, docs/design.md §3)
+        work = run.out.work[k0:k1]
+        terms = {f"work_{name}": work[:, i] for i, name in enumerate(WORK)}
+        cols.update(terms)
+        if rho_S:
+            cols.update({f"{k}_J": v * rho_S for k, v in terms.items()})
         return cols
 
     def finish(folder: Path, data: dict, run):
@@ -52,8 +67,11 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
         about = f"β={beta:g}, Δt={dt:g} s, J={problem.J}, {problem.element}"
         trajectory_chart(folder / "tip_displacement.png", t, {"ũ(L, t)": data["tip_displacement"]},
                          stops=stops, title=f"{case}: tip displacement ({about})")
-        energy_chart(folder / "energy.png", t, data["energy"],
-                     title=f"{case}: discrete energy ½E_β ({about})")
+        joules = "energy_J" in data         # in J when the mass per length ρS is known
+        energy_chart(folder / "energy.png", t, data["energy_J" if joules else "energy"],
+                     title=f"{case}: discrete energy ½E_β ({about})",
+                     work={k: data[f"work_{k}" + ("_J" if joules else "")] for k in WORK},
+                     joules=joules)
         if np.any(data["contact_force"]):
             # in newtons when the mass per length ρS is known (the column is λ·ρS)
             newtons = "contact_force_N" in data
@@ -71,10 +89,34 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
         "case": case, "J": problem.J, "dt": run.dt, "T": run.n_steps * run.dt, "beta": run.beta,
         "element": problem.element, "method": args.method,
         "kappa_h": kh, "linear_stability_limit_dt": limit,
-        "units": {"displacement": "m", "energy": "½E_β, m³/s² (per unit mass per length)",
-                  "contact_force": "m²/s² (N per kg/m)",
-                  "contact_force_N": "N (contact_force × rho_S)"},
+        "units": units(rho_S, system),
         "penalty_stiffness_N_per_m": args.stiffness if args.method == "penalty" else None,
         "config": {**config, **{k: v for k, v in vars(args).items() if k != "resume"}},
     }
     return execute(run, out, args, summary, columns, finish)
+
+
+def units(rho_S, system) -> dict:
+    """summary.json's ``units``: what every timeseries column is, in which unit and frame."""
+    lift = system.view.lift if system.view is not None else None
+    frame = ("ũ(L) = u(L) + h(L)φ(t): the physical displacement in the fixed frame, "
+             "support motion included" if lift is not None else "u(L): the support is at rest")
+    per_mass = "per unit mass per length (the equation is divided by ρS)"
+    out = {"t": "s", "displacement": "m",
+           "tip_displacement": f"m, {frame}",
+           "tip_velocity": "m/s, backward difference of u(L)"
+                           + (" plus h(L)φ'(t)" if lift is not None else ""),
+           "energy": f"½E_β, m³/s² {per_mass}; of u, relative to the lifted support motion",
+           "contact_force": f"net nodal λ, m²/s² (N per kg/m), {per_mass}; positive upwards",
+           **{f"work_{k}": f"m³/s² (as energy), {what}, cumulative since t = 0"
+              for k, what in zip(WORK, ("work lost in damping (≥ 0)",
+                                        "work of the loads (the support's motion included)",
+                                        "work of the contact forces (≤ 0 for exact contact)"))},
+           "energy_balance": "energy − energy[0] + work_damping = work_input + work_contact "
+                             "(to round-off)"}
+    if rho_S:
+        out.update({"contact_force_N": "N (contact_force × rho_S)",
+                    "energy_J": "J (energy × rho_S)",
+                    **{f"work_{k}_J": f"J (work_{k} × rho_S)" for k in WORK},
+                    "rho_S": f"{rho_S:g} kg/m"})
+    return out

@@ -88,9 +88,18 @@ def trajectory_chart(path, t, series: dict, stops=(), title="", ylabel="displace
         _frame(ax, "t (s)", ylabel, title, fontsize=9)
 
 
-def energy_chart(path, t, energy, title="discrete energy ½E_β"):
-    trajectory_chart(path, t, {"½E_β (per unit mass per length)": energy}, title=title,
-                     ylabel="energy (m³/s²)")
+def energy_chart(path, t, energy, title="discrete energy ½E_β", work=None, joules=False):
+    """½E_β against t; with ``work`` (the cumulative "damping", "input", "contact" work,
+    in the units of energy) also the terms of its balance that are not all zero
+    (½E_β − ½E_β[0] + damping = input + contact).  ``joules``:
+    the values are in J (× ρS), else per unit mass per length (m³/s²)."""
+    series = {"½E_β" + ("" if joules else " (per unit mass per length)"): energy}
+    if work is not None and any(np.any(w) for w in work.values()):
+        labels = {"input": "work of the loads (support motion included)",
+                  "damping": "work lost in damping", "contact": "work of the contact forces"}
+        series.update({labels[k]: w for k, w in work.items() if np.any(w)})
+    trajectory_chart(path, t, series, title=title,
+                     ylabel="energy (J)" if joules else "energy (m³/s²)")
 
 
 def compare_chart(path, t, computed: dict, exact: dict, title: str, ylabel: str):
@@ -105,27 +114,30 @@ def compare_chart(path, t, computed: dict, exact: dict, title: str, ylabel: str)
         _frame(ax, "t (s)", ylabel, title, fontsize=9)
 
 
-def _obstacle(ax, x, g, name, marker):
+def _obstacle(ax, x, g, name, marker, color="k", label=True):
     """g(x) as a line where it spans an interval, as markers where it is a point stop;
-    one legend entry (NaN: no obstacle)."""
+    one legend entry (NaN: no obstacle; ``label`` False: none)."""
     finite = np.isfinite(g)
     if not finite.any():
         return
     # a run of one finite sample between NaNs is a point stop: a line would not show it
     alone = finite & ~np.r_[False, finite[:-1]] & ~np.r_[finite[1:], False]
-    label = f"obstacle {name} ({'lower' if name == 'g1' else 'upper'})"
+    text = f"obstacle {name} ({'lower' if name.startswith('g1') else 'upper'})" \
+        if label else None
     if alone.any():
-        ax.plot(x[alone], g[alone], ls="none", marker=marker, ms=11, color="k",
-                label=f"{label} (point stop)")
-        label = None
+        ax.plot(x[alone], g[alone], ls="none", marker=marker, ms=11, color=color,
+                label=f"{text} (point stop)" if text else None)
+        text = None
     if (finite & ~alone).any():
-        ax.plot(x, np.where(alone, np.nan, g), color="k", lw=1.6,
-                ls="--" if name == "g1" else "-.", label=label)
+        ax.plot(x, np.where(alone, np.nan, g), color=color, lw=1.6,
+                ls="--" if name.startswith("g1") else "-.", label=text)
 
 
 def shape_chart(path, result, count=14, title=""):
     """The physical displacement ũ(x, t_k) = u + h(x)φ(t_k) at ``count`` saved frames, with
-    the obstacles g1, g2 (papers' Figs 1–3): what ParaView shows, support motion included."""
+    the obstacles g1, g2 (papers' Figs 1–3): what ParaView shows, support motion included,
+    for any lifting.  Obstacles carried by a moving support are drawn at every frame's
+    time in that frame's colour, fixed ones once."""
     from .fields import sample_line
     line = sample_line(result.system)
     good = np.flatnonzero(np.isfinite(result.frames_u).all(axis=1))
@@ -137,13 +149,20 @@ def shape_chart(path, result, count=14, title=""):
         span = [np.inf, -np.inf]
         for k in idx:
             tk = result.frames_t[k]
-            ut = line.fields(tk, result.frames_u[k], result.frames_v[k],
-                             result.frames_force[k])["displacement"]
+            f = line.fields(tk, result.frames_u[k], result.frames_v[k], result.frames_force[k])
+            ut = f["displacement"]
             ax.plot(line.x, ut, lw=1.0, color=cmap(norm(tk)),
                     label=f"ũ(x, t) at {idx.size} times" if k == idx[0] else None)
             span = [min(span[0], ut.min()), max(span[1], ut.max())]
-        _obstacle(ax, line.x, line.g1, "g1", "^")
-        _obstacle(ax, line.x, line.g2, "g2", "v")
+            if line.carried is not None:    # obstacles carried by the support move with it:
+                phi = float(line.motion.phi(tk))                     # drawn at each time
+                for g, name, marker in zip(line.carried, ("g1", "g2"), ("^", "v")):
+                    _obstacle(ax, line.x, np.where(np.isfinite(g), g + phi, np.nan),
+                              f"{name} carried", marker, cmap(norm(tk)), label=k == idx[-1])
+        fixed = (line.g1, line.g2) if line.carried is None else \
+            [np.where(np.isfinite(g), g, np.nan) for g in line.fixed]
+        _obstacle(ax, line.x, fixed[0], "g1", "^")
+        _obstacle(ax, line.x, fixed[1], "g2", "v")
         # the beam's range and the narrowest gap: obstacles far from the beam (the
         # convex ones reach ±0.75 m at the ends) would squash the curves to a line
         for g, pick in ((line.g1, max), (line.g2, min)):

@@ -9,17 +9,24 @@ as VTK needs).  Its points are ``samples_per_element`` sub-points of every eleme
 (ξ = 0, 1/s, …, (s−1)/s, and the end x = L), so the polyline ParaView draws follows
 the cubic of a Hermite or B-spline field instead of its chord.  Arrays, per point:
 
-- ``displacement``: the physical displacement ũ = u + h(x)φ(t) (m); the support motion
-  φ is added only when the scene's support moves; for the bar, the longitudinal u;
+- ``displacement``: the physical displacement ũ = u + h(x)φ(t) (m), in the fixed
+  (ground) frame, for any lifting h of a moving support (``SceneView.lift``: the first
+  paper's h or the static one); for the bar, the longitudinal u;
 - ``displacement_vector``: (0, ũ, 0), for ParaView's *Warp By Vector*;
-- ``velocity``: ũ_t = v + h(x)φ'(t) (m/s; v is the run's backward-difference velocity);
-- ``g1``, ``g2``: the obstacles (m), **NaN where there is none (±∞)** — always present,
-  so every time step of every scene has the same arrays;
+- ``velocity``: ũ_t = v + h(x)φ'(t) (m/s; v is the run's backward-difference velocity,
+  φ' the support's own derivative);
+- ``g1``, ``g2``: the obstacles in the same fixed frame as ũ (m), **NaN where there is
+  none (±∞)**: an obstacle fixed to the ground stays at g, one carried by the moving
+  support is drawn at g + φ(t), where it is at the frame's time; always present, so
+  every time step of every scene has the same arrays;
 - ``contact_force``: the nodal contact force λ at the constrained nodes, 0 elsewhere
-  (m²/s² for the beam: force per unit mass per length; N/m² for the bar);
-- ``bending_moment``: k²ũ'' = k²(u'' + h''φ) (m³/s², per unit mass per length), beams
-  only (spaces whose ``sampler`` gives no second derivatives, e.g. P1, omit it).  Hermite
-  u'' jumps at the nodes; a node shared by two elements gets the mean of both sides.
+  (m²/s² for the beam: force per unit mass per length, × ρS for N; positive upwards);
+  for the bar the obstacle's push R ≥ 0 at either end (Pa, or N with a cross-section A),
+  as in timeseries.csv;
+- ``bending_moment``: EI(x)ũ''/ρA_ref = k²(EI(x)/EI_ref)(u'' + h''φ) (m³/s², per unit
+  mass per length; × ρS for N·m), beams only (spaces whose ``sampler`` gives no second
+  derivatives, e.g. P1, omit it).  Hermite u'' jumps at the nodes (and EI at a step): a
+  node shared by two elements gets the mean of both sides.
 """
 from __future__ import annotations
 
@@ -34,25 +41,24 @@ import scipy.sparse as sp
 from meshio._common import write_xml
 
 from ..errors import InputError
-from ..problem import lifting
+from ..problem import lifting_dd  # noqa: F401  (h'' of the paper's lifting, kept importable here)
 from ..semidiscrete import SceneView
 
 FORMATS = ("xdmf", "vtu", "both", "none")
 
 
-def lifting_dd(x, L):
-    """h''(x) of :func:`~skfem_beam.problem.lifting`: −4(1 − s)²/L², s = x/L."""
-    s = np.asarray(x, dtype=float) / L
-    return -4.0 * (1.0 - s) ** 2 / L**2
-
-
-def _phi_dot(support, t: float) -> float:
-    """φ'(t) of a support: its own ``phi_d`` if it has one, else a 4th-order difference."""
-    if hasattr(support, "phi_d"):
-        return float(support.phi_d(t))
-    d = 1e-5 / max(1.0, abs(getattr(support, "omega", 1.0)))
-    f = support.phi
-    return float((f(t - 2 * d) - 8 * f(t - d) + 8 * f(t + d) - f(t + 2 * d)) / (12 * d))
+def physical_tip(view, t, u_tip, v_tip):
+    """(ũ(L, t), ũ_t(L, t)) from the lifted tip values u(L), v(L) at times t:
+    u + h(L)φ(t) and v + h(L)φ'(t) for any lifting (``view.lift``).  h(L) within 1e-9 of
+    0 is 0 (the paper's h(L) is −5.6e-17 in floating point), and then u, v are returned
+    as they are: the papers' columns stay bit for bit."""
+    lift = None if view is None else view.lift
+    hL = 0.0 if lift is None else float(lift.h(np.array([view.L]))[0])
+    if abs(hL) <= 1e-9:
+        return u_tip, v_tip
+    t = np.asarray(t, dtype=float)
+    return (np.asarray(u_tip) + hL * np.asarray(lift.motion.phi(t), dtype=float),
+            np.asarray(v_tip) + hL * np.asarray(lift.motion.phi_d(t), dtype=float))
 
 
 @dataclass
@@ -61,40 +67,83 @@ class LineSamples:
     x: np.ndarray                 # (P,) abscissae, increasing, x[0] = 0, x[-1] = L
     cells: np.ndarray             # (P−1, 2) line cells
     E0: sp.csr_matrix             # values at the points = E0 @ u
-    E2: sp.csr_matrix | None      # second derivatives = E2 @ u (None: not a beam space)
-    g1: np.ndarray                # obstacles at the points, NaN where infinite
-    g2: np.ndarray
+    E2: sp.csr_matrix | None      # EI(x)/EI_ref · second derivatives = E2 @ u (None: not a beam)
+    g1: np.ndarray                # obstacles at the points with the support at rest, NaN
+    g2: np.ndarray                # where infinite (fixed ones where they are at every t)
     contact: np.ndarray           # (m,) point index of every constrained value
     k2: float | None = None       # bending stiffness per unit mass (beam) or None
-    support: object = None        # a moving Support, or None
     L: float = 1.0
+    motion: object = None         # the moving support (phi, phi_d of t), or None
+    h: np.ndarray | None = None   # the lifting h at the points (None: the support is at rest)
+    h_dd: np.ndarray | None = None   # EI(x)/EI_ref · h'' at the points (beams)
+    carried: tuple | None = None  # (g1, g2) of the obstacles carried by the support at
+    fixed: tuple | None = None    # rest and of those fixed to the ground (±inf: none);
+    #                               None when nothing is carried
+    push: np.ndarray | None = None   # (m,) sign: the field's contact force is push·λ
 
     @property
     def points(self) -> np.ndarray:
         """(P, 3): the abscissae padded to 3-D (VTK and ParaView need 3-D points)."""
         return np.column_stack([self.x, np.zeros_like(self.x), np.zeros_like(self.x)])
 
+    def obstacles_at(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """(g1, g2) at time t in the fixed frame of ũ, NaN where there is none: fixed
+        obstacles where they are, carried ones moved by the support's φ(t)."""
+        if self.carried is None:
+            return self.g1, self.g2
+        phi = float(self.motion.phi(t))
+        lo = np.maximum(self.fixed[0], self.carried[0] + phi)
+        hi = np.minimum(self.fixed[1], self.carried[1] + phi)
+        return _nan_outside(lo), _nan_outside(hi)
+
     def fields(self, t: float, u, v, force) -> dict[str, np.ndarray]:
         """The point arrays of one frame (see the module docstring)."""
         u, v = np.asarray(u, dtype=float), np.asarray(v, dtype=float)
         disp, vel = self.E0 @ u, self.E0 @ v
         moment = self.E2 @ u if self.E2 is not None else None
-        if self.support is not None:
-            h = lifting(self.x, self.L)
-            phi = float(self.support.phi(t))
-            disp = disp + h * phi
-            vel = vel + h * _phi_dot(self.support, t)
+        if self.h is not None:
+            phi = float(self.motion.phi(t))
+            disp = disp + self.h * phi
+            vel = vel + self.h * float(self.motion.phi_d(t))
             if moment is not None:
-                moment = moment + lifting_dd(self.x, self.L) * phi
+                moment = moment + self.h_dd * phi
         lam = np.zeros(self.x.size)
-        lam[self.contact] = np.asarray(force, dtype=float)
+        lam[self.contact] = np.asarray(force, dtype=float) * \
+            (1.0 if self.push is None else self.push)
+        g1, g2 = self.obstacles_at(t)
         out = {"displacement": disp,
                "displacement_vector": np.column_stack([np.zeros_like(disp), disp,
                                                        np.zeros_like(disp)]),
-               "velocity": vel, "g1": self.g1, "g2": self.g2, "contact_force": lam}
+               "velocity": vel, "g1": g1, "g2": g2, "contact_force": lam}
         if moment is not None:
             out["bending_moment"] = self.k2 * moment
         return out
+
+
+def _nan_outside(g: np.ndarray) -> np.ndarray:
+    """±inf (no obstacle) as NaN, which ParaView leaves undrawn."""
+    return np.where(np.isfinite(g), g, np.nan)
+
+
+def _split_obstacles(obstacles, x: np.ndarray):
+    """((g1, g2) of the carried parts, (g1, g2) of the fixed ones) at x, ±inf where none."""
+    parts = obstacles.parts or (obstacles,)
+    out = []
+    for carried in (True, False):
+        b = [o.bounds(x) for o in parts if bool(o.carried) == carried]
+        out.append((np.max([lo for lo, _ in b], axis=0) if b else np.full(x.shape, -np.inf),
+                    np.min([hi for _, hi in b], axis=0) if b else np.full(x.shape, np.inf)))
+    return out[0], out[1]
+
+
+def _side_values(f, space, x_elem: np.ndarray, s: int) -> np.ndarray:
+    """f at the sub-points of every element, taken from inside the element: an element's
+    last sub-point is evaluated 1e-12 of its length before its end node, so a shared node
+    gets both one-sided values (h'' of a static lifting jumps where EI does)."""
+    j = np.arange(x_elem.size) % (s + 1)
+    e = np.arange(x_elem.size) // (s + 1)
+    h = np.diff(space.nodes)[e]
+    return np.asarray(f(np.where(j == s, x_elem - 1e-12 * h, x_elem)), dtype=float)
 
 
 def sample_line(system, samples_per_element: int = 8) -> LineSamples:
@@ -119,27 +168,52 @@ def sample_line(system, samples_per_element: int = 8) -> LineSamples:
     x[point] = smp.x
     x[0], x[-1] = space.nodes[0], space.nodes[-1]
     E0 = (R @ smp.E0).tocsr()
-    E2 = (R @ smp.E2).tocsr() if smp.E2 is not None and smp.E2.nnz else None
 
     view = system.view or SceneView(kind="beam" if system.meta.get("kind", "beam") == "beam"
                                     else "bar")
+    beam = view.kind == "beam" and smp.E2 is not None and smp.E2.nnz > 0
+    # a stepped beam's moment is EI(x)u'': each element's rows carry its EI/EI_ref
+    problem = system.meta.get("problem")
+    EIf = None
+    if beam and problem is not None and problem.beam.segments:
+        EIf = problem.beam.factors(0.5 * (space.nodes[:-1] + space.nodes[1:]))[1][e]
+    E2 = None
+    if beam:
+        E2 = (R @ (smp.E2 if EIf is None else sp.diags(EIf) @ smp.E2)).tocsr()
+
     L = float(view.L if view.L is not None else x[-1])
+    lift, h, h_dd = view.lift, None, None
+    if lift is not None:
+        h = np.asarray(lift.h(x), dtype=float)
+        if beam and lift.kind == "paper":          # smooth: evaluated at the points
+            h_dd = np.asarray(lift.h_dd(x), dtype=float)
+        elif beam:                                 # per side, averaged like u''
+            side = _side_values(lift.h_dd, space, smp.x, s)
+            h_dd = R @ (side if EIf is None else EIf * side)
     g1 = np.full(x.size, -np.inf)
     g2 = np.full(x.size, np.inf)
     contact = np.abs(x[:, None] - np.asarray(system.x_contact)[None, :]).argmin(axis=0)
     near = np.abs(x[contact] - system.x_contact) <= 1e-9 * max(1.0, L)
     if not near.all():
         raise InputError(f"constrained value at x={system.x_contact[~near][0]:g} is not a node")
+    carried = fixed = None
     if view.obstacles is not None:
         g1, g2 = view.obstacles.bounds(x)
+        if lift is not None and view.obstacles.carried:   # combine: any part carried
+            carried, fixed = _split_obstacles(view.obstacles, x)
     else:
         g1[contact], g2[contact] = system.lo, system.hi
-    g1 = np.where(np.isfinite(g1), g1, np.nan)
-    g2 = np.where(np.isfinite(g2), g2, np.nan)
-    k2 = view.k2 if view.kind == "beam" else None
+    # the bar's field force is the obstacle's push R ≥ 0, as in timeseries.csv: λ at a
+    # lower bound (x = 0), −λ at an upper one (x = L, where U = −u(L))
+    push = None
+    if view.kind == "bar":
+        push = np.where(np.isfinite(np.asarray(system.lo, dtype=float)), 1.0, -1.0)
     cells = np.column_stack([np.arange(x.size - 1), np.arange(1, x.size)])
-    return LineSamples(x=x, cells=cells, E0=E0, E2=E2 if k2 is not None else None,
-                       g1=g1, g2=g2, contact=contact, k2=k2, support=view.support, L=L)
+    return LineSamples(x=x, cells=cells, E0=E0, E2=E2, g1=_nan_outside(g1),
+                       g2=_nan_outside(g2), contact=contact,
+                       k2=view.k2 if beam else None, L=L,
+                       motion=None if lift is None else lift.motion, h=h, h_dd=h_dd,
+                       carried=carried, fixed=fixed, push=push)
 
 
 class _XdmfSeries(meshio.xdmf.TimeSeriesWriter):

@@ -293,7 +293,7 @@ def bar_system(bar: Bar) -> SemiDiscrete:
     return system
 
 
-METHODS = ("contact", "penalty")
+METHODS = ("contact", "penalty", "moreau-jean")
 
 
 def spring_step_ratio(bar: Bar, dt: float) -> float:
@@ -358,7 +358,8 @@ def steps_to(T: float, dt: float) -> int:
 
 
 def bar_run(bar: Bar, dt: float, T: float, beta: float = 0.25, method: str = "contact",
-            solver: str = "auto", frames: int = 200, all_states_limit: int = 4_000_000):
+            solver: str = "auto", frames: int = 200, all_states_limit: int = 4_000_000,
+            restitution: float = 0.0):
     """The bar's :class:`~skfem_beam.scheme.Run` (not yet driven), to T + Δt.
 
     rigid + contact: the Signorini condition u(0) ≥ 0 (one constrained value, so the
@@ -379,7 +380,14 @@ def bar_run(bar: Bar, dt: float, T: float, beta: float = 0.25, method: str = "co
     n_steps = to_T.steps
     every_state = (n_steps + 2) * system.n <= all_states_limit
     stepping = replace(to_T, T=n_steps * dt + dt, frames=n_steps + 1 if every_state else frames)
-    return Run(system, stepping, resolve(solver, bar.k if _spring(bar, method) else None))
+    if method == "moreau-jean":    # its energy is its own (½vᵀMv + ½uᵀKu), not the β split
+        from .scheme.moreau_jean import MoreauJean
+        if bar.obstacle != "rigid":
+            raise InputError("law='moreau-jean' enforces a rigid obstacle; the elastic "
+                             "obstacle is a spring (use --law position or penalty)")
+        return MoreauJean(system, replace(stepping, frames=frames), 0.5, restitution)
+    return Run(system, stepping, resolve(solver, bar.k if _spring(bar, method) else None,
+                                         restitution))
 
 
 def _spring(bar: Bar, method: str) -> bool:

@@ -45,6 +45,7 @@ from numba import njit
 from ..checks import check_finite
 from ..contact.active_set import box_qp
 from ..contact.base import ContactLaw
+from ..contact.restitution import Restitution
 from ..errors import InputError
 from ..linalg import Banded, band_solve, rows_dot, rows_matvec
 from .kernels import FAILED, UNSTABLE, Inputs, Series, csr_product, track_impacts
@@ -89,20 +90,16 @@ def mj_record(n, ops, st, out):
     dt2 = ops.dt * ops.dt
     if n % ops.save_every == 0:
         k = n // ops.save_every
-        for r in range(ops.Op.size - 1):
-            s = 0.0
-            sv = 0.0
+        for r in range(ops.Op.size - 1):     # observed values and the velocity v itself
+            out.obs[k, r] = 0.0
+            out.obsv[k, r] = 0.0
             for q in range(ops.Op[r], ops.Op[r + 1]):
-                s += ops.Ox[q] * st.u_cur[ops.Oi[q]]
-                sv += ops.Ox[q] * st.v[ops.Oi[q]]
-            out.obs[k, r] = s
-            out.obsv[k, r] = sv
+                out.obs[k, r] += ops.Ox[q] * st.u_cur[ops.Oi[q]]
+                out.obsv[k, r] += ops.Ox[q] * st.v[ops.Oi[q]]
         out.energy[k] = 0.5 * (rows_dot(ops.Mb, st.v, st.v) + rows_dot(ops.Kb, st.u_cur,
                                                                         st.u_cur))
-        for c in range(3):
-            out.work[k, c] = st.work[c]
-        for j in range(st.mu.size):
-            out.lam[k, j] = st.mu[j] / dt2
+        out.work[k, :] = st.work
+        out.lam[k, :] = st.mu / dt2
     if n % ops.frame_every == 0:
         k = n // ops.frame_every
         for i in range(st.u_cur.size):
@@ -204,18 +201,12 @@ def mj_steps(ops, st, out, n0, n1, inputs, Ebound):
 
 
 def check_theta(theta) -> float:
+    """θ ∈ [1/2, 1], where the θ-scheme is unconditionally stable."""
     theta = check_finite("theta", theta)
-    if not 0.5 <= theta <= 1.0:
-        raise InputError(f"theta={theta:g} must lie in [1/2, 1] (the θ-scheme is "
-                         f"unconditionally stable there)")
-    return theta
-
-
-def check_restitution(e) -> float:
-    e = check_finite("restitution", e)
-    if not 0.0 <= e <= 1.0:
-        raise InputError(f"restitution={e:g} must lie in [0, 1]")
-    return e
+    if 0.5 <= theta <= 1.0:
+        return theta
+    raise InputError(f"theta={theta:g} must lie in [1/2, 1] (the θ-scheme is "
+                     f"unconditionally stable there)")
 
 
 class MoreauJean(Run):
@@ -226,7 +217,7 @@ class MoreauJean(Run):
 
     def __init__(self, system, stepping: Stepping, theta: float = 0.5,
                  restitution: float = 0.0):
-        self.theta, self.e = check_theta(theta), check_restitution(restitution)
+        self.theta, self.e = check_theta(theta), Restitution(restitution).e
         super().__init__(system, stepping, MoreauJeanLaw())
 
     def _build(self, system, stepping, law) -> None:

@@ -72,7 +72,24 @@ def redistribute(M, K, massless, modes) -> sp.csr_matrix:
     keep[massless] = 0.0
     P = sp.diags(keep)
     M0 = (P @ M @ P).tocsr()
-    near = neighbours(abs(M) + abs(sp.csr_matrix(K)), massless)
+    G = abs(M) + abs(sp.csr_matrix(K))
+    live = np.flatnonzero(keep)
+    near = neighbours(G, massless)
+    for _ in range(4):        # widen the neighbourhood until M₀ + Δ is positive definite
+        Mr = _moved(M, M0, near, modes)
+        try:
+            np.linalg.cholesky(Mr[live][:, live].toarray())
+            return Mr
+        except np.linalg.LinAlgError:
+            near = np.setdiff1d(np.unique(G[np.r_[massless, near]].indices), massless)
+    raise InputError("mass='redistributed': moving the contact dofs' mass to their "
+                     "neighbours left a mass matrix that is not positive definite "
+                     "(refine the mesh near the contact)")
+
+
+def _moved(M, M0, near, modes) -> sp.csr_matrix:
+    """M0 + Δ, Δ the smallest symmetric matrix on ``near`` that restores the moments."""
+    n = M.shape[0]
     pairs = [(a, b) for i, a in enumerate(near) for b in near[i:]]
     R = np.asarray(modes, dtype=float)
     rows, rhs = [], []
@@ -80,10 +97,13 @@ def redistribute(M, K, massless, modes) -> sp.csr_matrix:
         rows.append([R[a, r] * R[b, s] + (R[b, r] * R[a, s] if a != b else 0.0)
                      for a, b in pairs])
         rhs.append(R[:, r] @ (M @ R[:, s]) - R[:, r] @ (M0 @ R[:, s]))
-    # least Frobenius norm: an off-diagonal unknown stands for two entries of Δ
-    w = np.array([1.0 if a == b else np.sqrt(2.0) for a, b in pairs])
+    # least Frobenius norm of Δ relative to M's diagonal (Hermite rotation dofs have other
+    # units than values); an off-diagonal unknown stands for two entries of Δ
+    d = M.diagonal()
+    w = np.array([(1.0 if a == b else np.sqrt(2.0)) / np.sqrt(d[a] * d[b]) for a, b in pairs])
     z = np.linalg.lstsq(np.array(rows) / w, np.array(rhs), rcond=None)[0] / w
-    if np.abs(np.array(rows) @ z - rhs).max() > 1e-10 * max(np.abs(rhs).max(), M.diagonal().max()):
+    if np.abs(np.array(rows) @ z - rhs).max() > 1e-10 * max(np.abs(rhs).max(),
+                                                            M.diagonal().max()):
         raise InputError("mass='redistributed': the neighbours of the contact dofs cannot "
                          "take their mass with the centre of mass kept")
     i, j = np.array(pairs).T
@@ -91,13 +111,6 @@ def redistribute(M, K, massless, modes) -> sp.csr_matrix:
                       shape=(n, n))
     Mr = (M0 + D).tocsr()
     Mr.eliminate_zeros()
-    live = np.flatnonzero(keep)
-    try:
-        np.linalg.cholesky(Mr[live][:, live].toarray())
-    except np.linalg.LinAlgError:
-        raise InputError("mass='redistributed': moving the contact dofs' mass to their "
-                         "neighbours left a mass matrix that is not positive definite "
-                         "(refine the mesh near the contact)") from None
     return Mr
 
 

@@ -12,6 +12,7 @@ import threading
 
 from . import __version__
 from .contact import SOLVERS
+from .checks import check_choice, check_finite
 from .errors import InputError, SolverError
 from .output.folder import (EXIT_INPUT, EXIT_SOLVER, EXIT_UNSTABLE, OPENED,  # noqa: F401
                             Interrupted, release, report, stamp)
@@ -25,9 +26,13 @@ class Parser(argparse.ArgumentParser):
         self.exit(EXIT_INPUT, f"{self.prog}: error: {message}\n")
 
 
+LAWS = ("position", "moreau-jean", "penalty")
+
+
 def parser(prog: str, description: str, *, J=None, dt=None, T=None, beta=None,
-           element=True, solver=True) -> Parser:
-    """The flags every scene takes; a scene adds its own."""
+           element=True, solver=True, mass=("consistent", "redistributed")) -> Parser:
+    """The flags every scene takes; a scene adds its own.  ``mass``: the mass options
+    its space allows, the first the default."""
     p = Parser(prog=prog, description=description,
                formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     if J is not None:
@@ -44,8 +49,14 @@ def parser(prog: str, description: str, *, J=None, dt=None, T=None, beta=None,
         p.add_argument("--element", default="hermite", help="hermite | bspline")
     if solver:
         p.add_argument("--solver", default="auto", help=" | ".join(SOLVERS))
+    p.add_argument("--law", default=None, help=" | ".join(LAWS) + ": exact contact at "
+                   "position level (the papers' scheme), at velocity level (Moreau–Jean, "
+                   "θ = 1/2), or one-sided springs (default: from --method)")
     p.add_argument("--method", default="contact",
-                   help="contact (contact-implicit scheme) | penalty (normal compliance)")
+                   help="contact (= --law position) | penalty (= --law penalty)")
+    p.add_argument("--restitution", type=float, default=0.0, metavar="E",
+                   help="Newton coefficient of restitution e in [0, 1] (position, moreau-jean)")
+    p.add_argument("--mass", default=mass[0], help=" | ".join(mass))
     p.add_argument("--stiffness", type=float, default=1e8,
                    help="penalty stiffness 1/ε (N/m) for --method penalty")
     p.add_argument("--save-every", type=int, default=1,
@@ -68,6 +79,7 @@ def parser(prog: str, description: str, *, J=None, dt=None, T=None, beta=None,
 def parse(p: Parser, argv=None):
     """Parse the flags; with --resume, the flags stored by the run being resumed."""
     args = stored_args(p.parse_args(argv), p, argv)
+    check_law(args, p)
     if getattr(args, "beta", 0.5) is None:   # the papers: β = 1/2 for contact, 1/4 for penalty
         args.beta = 0.25 if getattr(args, "method", "contact") == "penalty" else 0.5
     return args
@@ -79,6 +91,36 @@ def mesh_nodes(args):
         return None
     from .meshes import load_mesh
     return load_mesh(args.mesh, args.L)
+
+
+def check_law(args, p: Parser) -> None:
+    """--law (or its alias --method), --restitution and --mass, checked once; sets
+    args.method to "penalty" for the penalty law and "contact" otherwise."""
+    if not hasattr(args, "law"):
+        return
+    check_method(args)
+    if args.law is None:
+        args.law = "penalty" if args.method == "penalty" else "position"
+    check_choice("--law", args.law, LAWS)
+    args.method = "penalty" if args.law == "penalty" else "contact"
+    e = check_finite("--restitution", args.restitution)
+    if not 0.0 <= e <= 1.0:
+        raise InputError(f"--restitution {e:g} must lie in [0, 1]")
+    allowed = next(a.help.split(" | ") for a in p._actions if a.dest == "mass")
+    check_choice("--mass", args.mass, allowed)
+
+
+def make_run(system, stepping, args, stiffness=None):
+    """The run of ``system`` with the law the flags chose (β-scheme or Moreau–Jean)."""
+    from .contact import resolve
+    from .scheme import Run
+    if args.law == "moreau-jean":
+        from .scheme.moreau_jean import MoreauJean
+        if args.solver != "auto":
+            raise InputError(f"--law moreau-jean solves its own impulse problem: "
+                             f"--solver {args.solver} does not apply")
+        return MoreauJean(system, stepping, 0.5, args.restitution)
+    return Run(system, stepping, resolve(args.solver, stiffness, args.restitution))
 
 
 def check_method(args) -> None:

@@ -12,17 +12,20 @@ def test_quick_work_precision(tmp_path):
     assert (tmp_path / "work_precision.png").stat().st_size > 30_000
     by = {}
     for r in rows:
-        by.setdefault((r["scene"], r["method"]), []).append(r)
+        by.setdefault((r["scene"], r["method"], float(r["courant"])), []).append(r)
+    assert len(by) == 2 * 2 * len(work_precision.METHODS)
     assert all(len(v) >= 4 for v in by.values())            # a ladder of four or more
-    err = lambda scene, method: np.array([float(r["error"]) for r in by[(scene, method)]])  # noqa
-    viol = lambda scene, method: max(float(r["violation"]) for r in by[(scene, method)])  # noqa
-    # the contact-implicit scheme converges to the exact bar solution, without penetrating
-    e = err("bar", "contact β=1/4")
-    assert np.all(np.diff(e) < 0) and e[-1] < 1e-3 and viol("bar", "contact β=1/4") < 1e-12
-    # a soft penalty spring converges to the wrong (spring) solution and penetrates
-    assert err("bar", "penalty k=1000 β=1/4")[-1] > 3 * e[-1]
-    assert viol("bar", "penalty k=1000 β=1/4") > 1e-3
-    # convex scene: the finest rung is several times better than the coarsest, both elements
-    for m in ("contact β=1/2 hermite active-set", "contact β=1/2 bspline active-set"):
-        assert err("convex", m)[-1] < err("convex", m)[0] / 4
-    assert viol("point_stops", "contact β=1/2 hermite") <= 1e-15   # round-off of the cubic at L
+    col = lambda key, *k: np.array([float(r[key]) for r in by[k]])  # noqa: E731
+    pos, mj, mm = "position, average, β=1/4", "Moreau–Jean θ=1/2 e=0, average", \
+        "modified mass (redistributed), β=1/2"
+    for scene in ("rod", "bar"):
+        for c in (0.04, 0.4):
+            e = col("error", scene, pos, c)
+            assert np.all(np.diff(e) < 0)                        # converges
+            assert col("penetration", scene, pos, c).max() < 1e-15
+            assert col("penetration", scene, mm, c).max() < 1e-15
+            assert np.all(col("penetration", scene, mj, c) > 1e-6)   # O(Δt)
+            assert np.all(col("energy_drift", scene, pos, c) < 0)   # E_β only falls
+    # a soft penalty spring penetrates; a stiff one at Δt/h = 0.4 gains energy
+    assert col("penetration", "bar", "penalty k=1e3, average, β=1/4", 0.04).min() > 1e-3
+    assert col("energy_drift", "rod", "penalty k=1e5, average, β=1/4", 0.4).max() > 1

@@ -1,155 +1,142 @@
-"""Speed against accuracy: error against wall time for every method, on a ladder of
-resolutions (h and Δt refined together).
+"""Every class of contact time-stepping on one chart: error against the wall time of the
+time loop, on the two benchmarks with exact solutions, at two Courant numbers.
 
-    python -m skfem_beam.bench.work_precision [--scene bar|point_stops|convex|all]
-                                              [--out docs] [--quick]
+    python -m skfem_beam.bench.work_precision [--scene rod|bar|all] [--out docs] [--quick]
 
-- bar: error of u(L,·) (L² in time) against the exact solution (rigid obstacle).
-- convex: L² in time of the tip displacement against a converged reference computed
-  here (J and Δt finer than the ladder); the scene is not chaotic over T = 1 (a 1e-12
-  perturbation stays ~1e-12), so the whole run is compared.
-- point_stops: vibro-impact is chaotic, so the tip is compared only on a horizon that
-  ends at the reference's second impact.
-The wall time is the time loop alone (Result.wall_time_s).  Writes work_precision.csv
-and work_precision.png (log–log, one line per method) into --out.
+Classes (Doyen, Ern & Piperno's four): position-level exact enforcement (our scheme,
+restitution e = 0, two settings of mass and β), penalty (one-sided springs of two
+stiffnesses, β = 1/4, average mass), velocity level (Moreau–Jean, θ = 1/2, e = 0, average
+mass) and modified mass (mass redistributed away from the contact node, β = 1/2).
+
+Benchmarks: the periodic rod (``scenes.periodic_rod``, T = 12 = four periods) and the
+impacting bar (``scenes.impacting_bar``, rigid obstacle, T = 3), each at Δt/h = 0.04 and
+0.4 on a ladder of N (h and Δt refined together).  Errors against the exact solution:
+L²(0, T) of u(0, ·) (the chart's error), of the contact stress, L∞(L²) and L²(L²) of u,
+L²(H¹) of u and L²(L²) of u_t (Gauss points in every element, on about 1500 frames; u_t is
+each scheme's own velocity: backward differences for the position and penalty schemes,
+v for Moreau–Jean), the largest penetration, and the energy drift (E(T) − E)/E against
+the exact energy E (1/8 and 1/2): ½E_β for the β-schemes, ½vᵀMv + ½uᵀKu for
+Moreau–Jean.  The wall time is the time loop alone (Result.wall_time_s).  Writes
+work_precision.csv and work_precision.png into --out.
 """
 from __future__ import annotations
 
 import argparse
 import csv
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from .. import scenes
-from ..bar import errors, run_bar
+from ..bar import bar_system, l2_time
+from ..reference import exact_of
 from ..scheme import solve
-from ..reference import BarExact
-from ..semidiscrete import beam_system
+from ..scheme.moreau_jean import moreau_jean
+
+COURANTS = (0.04, 0.4)
+BENCHMARKS = {"rod": (scenes.periodic_rod, 12.0, 0.125),
+              "bar": (lambda N, mass: scenes.impacting_bar(N=N, mass=mass), 3.0, 0.5)}
+# (label, class, mass, how to run): every class of the chart
+METHODS = [
+    ("position, average, β=1/4", "position", "average", dict(beta=0.25)),
+    ("position, consistent, β=1/2", "position", "consistent", dict(beta=0.5)),
+    ("penalty k=1e3, average, β=1/4", "penalty", "average", dict(beta=0.25, stiffness=1e3)),
+    ("penalty k=1e5, average, β=1/4", "penalty", "average", dict(beta=0.25, stiffness=1e5)),
+    ("Moreau–Jean θ=1/2 e=0, average", "moreau-jean", "average", dict(theta=0.5)),
+    ("modified mass (redistributed), β=1/2", "modified mass", "redistributed", dict(beta=0.5)),
+]
+STYLE = {"position": "-", "penalty": "--", "moreau-jean": "-.", "modified mass": ":"}
 
 
-def l2(e, dt):
-    return float(np.sqrt(dt * np.sum(np.asarray(e) ** 2)))
+def run_method(system, dt, T, kw, frames):
+    if "theta" in kw:
+        return moreau_jean(system, dt, T, theta=kw["theta"], frames=frames, progress=False)
+    return solve(system, dt, T, kw["beta"], stiffness=kw.get("stiffness"), frames=frames,
+                 progress=False)
 
 
-def on_grid(t_ref, y_ref, t):
-    return np.interp(t, t_ref, y_ref)
+def field_errors(result, exact, points: int = 4) -> dict:
+    """L∞(L²) and L²(L²) of u, L²(H¹) of u and L²(L²) of u_t on the result's frames."""
+    space = result.system.space
+    xi, w = np.polynomial.legendre.leggauss(points)
+    smp = space.sampler(0.5 * (xi + 1.0))
+    weights = np.tile(0.5 * w, space.J) * np.repeat(space.h, points)
+    t = result.frames_t
+    dtf = t[1] - t[0]
+    U, V = result.frames_u, result.frames_v
+    X = smp.x[None, :]
+    eu = (smp.E0 @ U.T).T - exact.u(X, t[:, None])
+    ev = (smp.E0 @ V.T).T - exact.velocity(X, t[:, None])
+    # P1 slopes per element at its Gauss points (the nodal values of every node)
+    nodal = (space.C @ U.T).T
+    slope = np.repeat(np.diff(nodal, axis=1) / space.h, points, axis=1)
+    ex_strain = exact.strain(X, t[:, None] + 1e-12)
+    l2 = lambda e: np.sqrt((e * e) @ weights)                       # noqa: E731
+    return {"linf_l2_u": float(l2(eu).max()), "l2_l2_u": l2_time(l2(eu), dtf),
+            "l2_h1_u": l2_time(np.sqrt(l2(eu) ** 2 + l2(slope - ex_strain) ** 2), dtf),
+            "l2_l2_ut": l2_time(l2(ev), dtf)}
 
 
-# ----------------------------------------------------------------------------- bar
-def bar_ladder(quick: bool):
-    Ns = [25, 50, 100, 200] if quick else [25, 50, 100, 200, 400]
-    methods = [("contact β=1/4", dict(beta=0.25)), ("contact β=1/2", dict(beta=0.5))]
-    methods += [(f"penalty k={k:g} β=1/4", dict(beta=0.25, method="penalty", k=k))
-                for k in ((1e3, 1e5) if quick else (1e3, 1e4, 1e5))]
-    if not quick:
-        methods.insert(1, ("contact β=1/4 osqp", dict(beta=0.25, solver="osqp")))
-    T = 3.0
-    for label, kw in methods:
-        for N in Ns:
-            dt = 0.1 / N            # Courant number c·Δt/h = 0.1, as the paper's Δt = 1e-3 at N = 100
-            bar = scenes.impacting_bar(N=N, k=kw.get("k", 100.0))
-            run = run_bar(bar, dt, T, beta=kw["beta"], method=kw.get("method", "contact"),
-                          solver=kw.get("solver", "auto"))
-            exact = BarExact.of(scenes.impacting_bar(N=N), T)   # the rigid obstacle's exact solution
-            e = errors(run, exact)
-            yield {"scene": "bar", "method": label, "J": N, "dt": dt, "error": e["l2_uL"],
-                   "error_u0": e["l2_u0"], "wall_time_s": run.result.wall_time_s,
-                   "violation": float(max(0.0, -np.min(run.u0)))}
+def rung(scene: str, method: tuple, N: int, courant: float) -> dict:
+    label, klass, mass, kw = method
+    make, T, E = BENCHMARKS[scene]
+    bar = make(N, mass=mass)
+    system = bar_system(bar)
+    dt = courant * bar.h / bar.c
+    steps = int(np.ceil(T / dt - 1e-9))
+    r = run_method(system, dt, T, kw, frames=min(steps, 1500))
+    exact = exact_of(replace(bar, mass="average"), T)
+    t = r.t
+    force = r.contact_force[1:, 0]            # the force of the step tₙ → tₙ₊₁, at tₙ
+    return {"scene": scene, "class": klass, "method": label, "courant": courant, "N": N,
+            "dt": dt, "error": l2_time(r.observed["u0"] - exact.u(0.0, t), dt),
+            "l2_stress": l2_time(force - exact.contact_force(t[:-1]), dt),
+            **field_errors(r, exact), "penetration": r.max_penetration,
+            "energy_drift": float((r.energy[-1] - E) / E), "wall_time_s": r.wall_time_s,
+            "status": r.status}
 
 
-# ---------------------------------------------------------------------------- beams
-def beam_rung(scene, label, kw, problem, dt, T, t_ref, y_ref) -> dict:
-    """One run of a beam method; its tip error (L² in time) against the reference.
-    ``violation`` is the largest penetration between nodes (for a penalty spring, its
-    compression)."""
-    stiff = kw.get("stiffness")
-    r = solve(beam_system(problem), dt, T, kw["beta"], solver=kw.get("solver", "auto"),
-              stiffness=stiff / scenes.PIPE_RHO_S if stiff else None, frames=2, progress=False)
-    tip = r.observed["tip_displacement"]
-    return {"scene": scene, "method": label, "J": problem.J, "dt": dt,
-            "error": l2(tip - on_grid(t_ref, y_ref, r.t), dt), "wall_time_s": r.wall_time_s,
-            "violation": r.max_penetration}
-
-
-# -------------------------------------------------------------------------- convex
-def convex_ladder(quick: bool):
-    T = 1.0
-    rungs = [(10, 4e-3), (20, 2e-3), (40, 1e-3), (80, 5e-4)]
-    Jref, dtref = (160, 1.25e-4) if quick else (320, 6.25e-5)
-    ref = solve(beam_system(scenes.convex_obstacles(J=Jref)), dtref, T, 0.5, frames=2, progress=False)
-    t_ref, y_ref = ref.t, ref.observed["tip_displacement"]
-    methods = [("contact β=1/2 hermite active-set", dict(beta=0.5)),
-               ("contact β=1/2 bspline active-set", dict(beta=0.5, element="bspline")),
-               ("contact β=1/4 hermite active-set", dict(beta=0.25))]
-    if not quick:
-        methods += [("contact β=1/4 bspline active-set", dict(beta=0.25, element="bspline")),
-                    ("contact β=1/2 hermite daqp", dict(beta=0.5, solver="daqp")),
-                    ("contact β=1/2 hermite osqp", dict(beta=0.5, solver="osqp"))]
-    methods += [(f"penalty {k:g} N/m β=1/4", dict(beta=0.25, stiffness=k))
-                for k in ((1e4, 1e6) if quick else (1e4, 1e5, 1e6))]
-    for label, kw in methods:
-        for J, dt in rungs:
-            pb = scenes.convex_obstacles(J=J, element=kw.get("element", "hermite"))
-            yield beam_rung("convex", label, kw, pb, dt, T, t_ref, y_ref)
-
-
-# --------------------------------------------------------------------- point stops
-def second_impact(t, force):
-    """Time of the second rising edge of contact (chatter counts: it is an impact)."""
-    on = np.abs(force) > 0
-    rises = np.flatnonzero(on[1:] & ~on[:-1]) + 1
-    return t[rises[1]] if rises.size > 1 else t[-1]
-
-
-def point_stops_ladder(quick: bool):
-    rungs = [(5, 2e-4), (10, 1e-4), (20, 5e-5), (40, 2.5e-5)]
-    T = 0.3
-    ref_pb = scenes.point_stops(J=80)
-    ref = solve(beam_system(ref_pb), 2.5e-6 if not quick else 5e-6, T, 0.5, frames=2,
-                progress=False)
-    horizon = second_impact(ref.t, ref.contact_force[:, 0])
-    t_ref, y_ref = ref.t, ref.observed["tip_displacement"]
-    methods = [("contact β=1/2 hermite", dict(beta=0.5)),
-               ("contact β=1/4 hermite", dict(beta=0.25)),
-               ("contact β=1/2 bspline", dict(beta=0.5, element="bspline"))]
-    if not quick:
-        methods += [("contact β=1/4 bspline", dict(beta=0.25, element="bspline")),
-                    ("contact β=1/2 hermite osqp", dict(beta=0.5, solver="osqp"))]
-    methods += [(f"penalty {k:g} N/m β=1/4", dict(beta=0.25, stiffness=k))
-                for k in ((1e6, 1e8) if quick else (1e6, 1e7, 1e8))]
-    for label, kw in methods:
-        for J, dt in rungs:
-            pb = scenes.point_stops(J=J, element=kw.get("element", "hermite"))
-            yield {**beam_rung("point_stops", label, kw, pb, dt, horizon, t_ref, y_ref),
-                   "horizon_s": float(horizon)}
-
-
-LADDERS = {"bar": bar_ladder, "convex": convex_ladder, "point_stops": point_stops_ladder}
-TITLES = {"bar": "impacting bar (rigid): L² error of u(L,·) vs exact",
-          "convex": "convex obstacles, T = 1: L² error of the tip vs converged reference",
-          "point_stops": "pipe between stops: L² tip error up to the second impact"}
+def rows_of(scene: str, quick: bool):
+    Ns = (10, 20, 40, 80) if quick else (20, 40, 80, 160, 320)
+    for method in METHODS:
+        for courant in COURANTS:
+            for N in Ns:
+                yield rung(scene, method, N, courant)
 
 
 def chart(path: Path, rows: list[dict]):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    scenes = [s for s in LADDERS if any(r["scene"] == s for r in rows)]
-    fig, axes = plt.subplots(1, len(scenes), figsize=(6.2 * len(scenes), 4.8), dpi=110,
+    benches = [s for s in BENCHMARKS if any(r["scene"] == s for r in rows)]
+    fig, axes = plt.subplots(len(benches), 3, figsize=(17, 4.6 * len(benches)), dpi=100,
                              squeeze=False)
-    for ax, scene in zip(axes[0], scenes):
+    for row_axes, scene in zip(axes, benches):
         sel = [r for r in rows if r["scene"] == scene]
-        for method in dict.fromkeys(r["method"] for r in sel):
-            pts = [r for r in sel if r["method"] == method]
-            style = "--" if method.startswith("penalty") else "-"
-            ax.loglog([max(r["wall_time_s"], 1e-5) for r in pts], [r["error"] for r in pts],
-                      style, marker="o", ms=3.5, lw=1.1, label=method)
-        ax.set_xlabel("wall time of the time loop (s)")
-        ax.set_ylabel("error")
-        ax.set_title(TITLES[scene], fontsize=9)
+        for ax, courant in zip(row_axes, COURANTS):
+            for label, klass, _, _ in METHODS:
+                pts = [r for r in sel if r["method"] == label and r["courant"] == courant]
+                ax.loglog([max(r["wall_time_s"], 1e-5) for r in pts],
+                          [r["error"] for r in pts], STYLE[klass], marker="o", ms=3.5,
+                          lw=1.2, label=label)
+            ax.set_xlabel("wall time of the time loop (s)")
+            ax.set_ylabel("L²(0,T) error of u(0,·)")
+            ax.set_title(f"{scene}: Δt/h = {courant:g}", fontsize=10)
+            ax.grid(alpha=0.3, which="both")
+        row_axes[0].legend(fontsize=7, loc="best")
+        ax = row_axes[2]
+        for label, klass, _, _ in METHODS:
+            for courant, marker in zip(COURANTS, "os"):
+                pts = [r for r in sel if r["method"] == label and r["courant"] == courant]
+                ax.semilogx([r["N"] for r in pts], [100 * r["energy_drift"] for r in pts],
+                            STYLE[klass], marker=marker, ms=3.5, lw=1.0,
+                            label=f"{label}, Δt/h={courant:g}")
+        ax.axhline(0.0, color="k", lw=0.6)
+        ax.set_xlabel("N (elements)")
+        ax.set_ylabel("energy drift (E(T) − E)/E (%)")
+        ax.set_title(f"{scene}: energy drift at T (○ Δt/h = 0.04, □ 0.4)", fontsize=10)
         ax.grid(alpha=0.3, which="both")
-        ax.legend(fontsize=6.5, loc="best")
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
@@ -158,24 +145,22 @@ def chart(path: Path, rows: list[dict]):
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="skfem_beam.bench.work_precision",
                                  description=__doc__.splitlines()[0])
-    ap.add_argument("--scene", default="all", choices=["all", *LADDERS])
+    ap.add_argument("--scene", default="all", choices=["all", *BENCHMARKS])
     ap.add_argument("--out", default="docs")
-    ap.add_argument("--quick", action="store_true", help="fewer methods, cheaper references")
+    ap.add_argument("--quick", action="store_true", help="coarser ladders (N = 10 to 80)")
     args = ap.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    scenes = list(LADDERS) if args.scene == "all" else [args.scene]
     rows = []
-    for scene in scenes:
-        for row in LADDERS[scene](args.quick):
+    for scene in (BENCHMARKS if args.scene == "all" else [args.scene]):
+        for row in rows_of(scene, args.quick):
             rows.append(row)
-            print(f"{row['scene']:12s} {row['method']:36s} J={row['J']:4d} dt={row['dt']:8.2e} "
-                  f"error={row['error']:9.3e} loop={row['wall_time_s']:8.4f} s "
-                  f"violation={row['violation']:.1e}", flush=True)
-    keys = sorted({k for r in rows for k in r}, key=lambda k: list(rows[0]).index(k)
-                  if k in rows[0] else 99)
+            print(f"{scene:4s} {row['method']:38s} Δt/h={row['courant']:<5g} N={row['N']:4d} "
+                  f"u(0) {row['error']:8.2e} stress {row['l2_stress']:8.2e} "
+                  f"pen {row['penetration']:8.1e} drift {100 * row['energy_drift']:+7.3f} % "
+                  f"loop {row['wall_time_s']:7.4f} s", flush=True)
     with open(out / "work_precision.csv", "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=keys)
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
     chart(out / "work_precision.png", rows)

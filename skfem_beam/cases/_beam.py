@@ -6,13 +6,13 @@ from pathlib import Path
 import numpy as np
 
 from .. import cli
-from ..contact import resolve
 from ..output.charts import energy_chart, shape_chart, trajectory_chart
 from ..output.fields import physical_tip
 from ..output.series import execute, prepare
-from ..scheme import Run, Stepping
+from ..scheme import Stepping
 from ..checks import check_positive
 from ..semidiscrete import beam_system
+from ..spaces.redistribution import redistributed
 from ..stability import kappa_h, linear_limit
 
 WORK = ("damping", "input", "contact")      # Result.work's terms, in this order
@@ -39,7 +39,9 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
     if args.method == "penalty":
         # physical N/m → the mass-normalised equation u_tt + k²u'''' = f needs N/m per kg/m
         stiffness = check_positive("stiffness", args.stiffness) / (rho_S or 1.0)
-    run = Run(system, stepping, resolve(args.solver, stiffness))
+    if args.mass == "redistributed":
+        system = redistributed(system)
+    run = cli.make_run(system, stepping, args, stiffness)
 
     view = system.view
 

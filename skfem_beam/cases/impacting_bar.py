@@ -5,7 +5,8 @@
         [--u0-csv FILE] [--v0-csv FILE] [--far-end free|clamped]
         [--obstacle-at left|right] [--N 100]
         [--dt 1e-3] [--T 3] [--beta 0.25] [--method contact|penalty]
-        [--mass average|consistent|lumped] [--save-every 1] [--frames 200] [--out DIR]
+        [--mass average|consistent|lumped|redistributed]
+        [--law position|moreau-jean|penalty] [--restitution E] [--save-every 1] [--frames 200] [--out DIR]
         [--checkpoint-every S] [--resume DIR]
 
 Example 1 of Do, Raupp & Feijoo is the default (add ``--obstacle elastic`` for the
@@ -37,13 +38,14 @@ from ..output.charts import compare_chart
 from ..output.series import Series, execute, prepare
 from ..checks import check_positive
 from ..reference import BarExact
+from ..spaces.lagrange import MASSES
 
 CASE = "impacting_bar"
 
 
 def main(argv=None) -> int:
     p = cli.parser(f"skfem_beam.cases.{CASE}", __doc__.splitlines()[0], dt=1e-3, T=3.0,
-                   beta=0.25, element=False)
+                   beta=0.25, element=False, mass=MASSES[2:3] + MASSES[:2] + MASSES[3:])
     p.add_argument("--obstacle", default="rigid", help="rigid | elastic")
     p.add_argument("--k", type=float, default=100.0, help="elastic obstacle: R = k·U⁻ (Pa/m)")
     p.add_argument("--a", "--E", dest="a", type=float, default=1.0,
@@ -65,7 +67,6 @@ def main(argv=None) -> int:
     p.add_argument("--far-end", default="free", help="free | clamped: the end without obstacle")
     p.add_argument("--obstacle-at", default="left", help="left (x = 0) | right (x = L)")
     p.add_argument("--N", type=int, default=100, help="number of P1 elements")
-    p.add_argument("--mass", default="average", help="average | consistent | lumped")
     args = cli.parse(p, argv)
 
     u0 = read_profile(args.u0_csv, "--u0-csv") if args.u0_csv else args.u0
@@ -86,8 +87,9 @@ def run_bar_case(bar: Bar, args, config: dict | None = None) -> int:
     if penalty:   # the rigid obstacle approximated by a spring of stiffness 1/ε
         bar = replace(bar, k=check_positive("stiffness", args.stiffness))
     out = prepare(args)                                  # fail before the run, not after
-    run = bar_run(bar, dt, T, beta=args.beta, method=args.method, solver=args.solver,
-                  frames=args.frames)
+    run = bar_run(bar, dt, T, beta=args.beta, method="moreau-jean" if args.law == "moreau-jean"
+                  else args.method, solver=args.solver, frames=args.frames,
+                  restitution=args.restitution)
     try:
         exact = BarExact.of(bar, T)
     except RuntimeError as e:      # very long runs with many switches

@@ -28,6 +28,13 @@ class StepOperators:
 
 def step_operators(system, dt: float, beta: float) -> StepOperators:
     M, K, B = system.M, system.K, system.B
+    massless = int((abs(M).sum(axis=1) == 0).sum())
+    if massless and beta < 0.25:
+        # a dof without inertia steps by the β-weighted K row alone, whose recursion has
+        # a root of modulus > 1 for β < 1/4 (and A = M is singular at β = 0)
+        raise InputError(f"beta={beta:g} with a mass matrix that has no inertia at {massless} "
+                         f"dof(s) (mass='redistributed'): their quasi-static step is unstable "
+                         f"for beta < 1/4; use beta=0.5")
     try:
         with np.errstate(over="raise", invalid="raise"):
             A = M + dt**2 * beta * K + (0.5 * dt * B if B is not None else 0)

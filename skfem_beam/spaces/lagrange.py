@@ -13,7 +13,10 @@ Mass matrices (the choice sets the dispersion error of a wave, docs/design.md §
 - ``consistent``: (u, v) exactly; waves travel too slowly on the mesh;
 - ``lumped``: row sums on the diagonal; waves travel too fast;
 - ``average``: ½(consistent + lumped); the two leading phase errors cancel, so the
-  dispersion error drops from O((ωh)²) to O((ωh)⁴).
+  dispersion error drops from O((ωh)²) to O((ωh)⁴);
+- ``redistributed``: the average mass here; the system built on the space empties the
+  contact node's mass row and moves its mass to the neighbours, keeping the total mass
+  and the centre of mass (:mod:`.redistribution`: only the system knows its constraints).
 """
 from __future__ import annotations
 
@@ -24,7 +27,7 @@ from skfem.helpers import dot, grad
 
 from .hermite import Sampler
 
-MASSES = ("consistent", "lumped", "average")
+MASSES = ("consistent", "lumped", "average", "redistributed")
 
 
 @BilinearForm
@@ -75,7 +78,8 @@ class LagrangeSpace:
         self.M_lumped = (P.T @ Ml @ P).tocsr()
         self.mass_kind = mass
         self.M = {"consistent": self.M_consistent, "lumped": self.M_lumped,
-                  "average": (0.5 * (self.M_consistent + self.M_lumped)).tocsr()}[mass]
+                  "average": (0.5 * (self.M_consistent + self.M_lumped)).tocsr()}[
+            "average" if mass == "redistributed" else mass]
         self.S = (P.T @ stiffness.assemble(self._basis) @ P).tocsr()
 
     def sampler(self, xi) -> Sampler:

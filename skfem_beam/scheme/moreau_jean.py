@@ -1,0 +1,304 @@
+"""Moreau–Jean: contact enforced at velocity level with a Newton impact law (the θ-scheme
+Siconos users run), as its own compiled integrator returning the same :class:`Result`.
+
+    M(v^{n+1} − vⁿ) + Δt K(θu^{n+1} + (1−θ)uⁿ) + Δt B v^θ = Δt f^{n+θ} + Cᵀp^{n+1}
+    u^{n+1} = uⁿ + Δt v^θ,      v^θ = θv^{n+1} + (1−θ)vⁿ
+
+Index set: the constrained values whose predicted gap g(uⁿ + Δt/2 vⁿ) ≤ 0; on it the
+Newton impact law 0 ≤ C v^{n+1} + e C vⁿ ⊥ p ≥ 0 (at a lower bound; at an upper bound
+the signs flip), p = 0 elsewhere.  Substituted, each step is
+
+    Â Δv = Δt (f − K uⁿ − Δtθ K vⁿ − B vⁿ) + Cᵀp,    Â = M + Δt²θ² K + Δtθ B,
+
+a box QP in p with the Delassus matrix D = C Â⁻¹ Cᵀ, solved by the compiled exact
+active set (:func:`skfem_beam.contact.active_set.box_qp`).
+
+Why a module of its own and not a contact law of the β-scheme's loop: the β-scheme is
+a two-step recursion in u alone (no velocity unknown), its law constrains u^{n+1}, and
+the loop's step matrix is M + Δt²βK.  Moreau–Jean is a one-step scheme in (u, v) whose
+law constrains v^{n+1} on an index set chosen from a predicted position, and whose
+energy is ½vᵀMv + ½uᵀKu.  With θ = 1/2 the two coincide between impacts (Newmark
+β = 1/4), but the state, the impulse and the energy differ, so hosting it in the loop
+would not be exact.  It reuses the loop's bookkeeping instead: :class:`Run`'s chunks,
+impact events and :class:`Result`.
+
+What it records, in the units of the other methods: ``energy`` ½vᵀMv + ½uᵀKu;
+velocity observers and frames use v itself; contact forces are p/Δt; penetration is
+measured on the positions as for every method (it penetrates O(Δt): the index set only
+switches the law on once the predicted gap closes); ``work``: with v^θ = (u^{n+1}−uⁿ)/Δt,
+input Δt f·v^θ, contact pᵀCv^θ, and "damping" Δt v^θᵀBv^θ plus the θ-scheme's numerical
+dissipation (θ − ½)(ΔvᵀMΔv + Δt² v^θᵀKv^θ), so energy − energy[0] + damping = input +
+contact holds to round-off.  θ = ½, e = 1 conserves the energy at impacts; e = 0 loses
+the constrained node's normal kinetic energy at each impact (O(h) on a mesh).
+Obstacles that move with a support and checkpoints are not supported (refused).
+"""
+from __future__ import annotations
+
+from collections import namedtuple
+from dataclasses import replace
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg
+from numba import njit
+
+from ..checks import check_finite
+from ..contact.active_set import box_qp
+from ..contact.base import ContactLaw
+from ..contact.restitution import Restitution
+from ..errors import InputError
+from ..linalg import Banded, band_solve, rows_dot, rows_matvec
+from .kernels import FAILED, UNSTABLE, Inputs, Series, csr_product, track_impacts
+from .operators import csr_arrays, step_operators
+from .run import Run
+from .solve import drive
+from .stepping import Result, Stepping
+
+MJOps = namedtuple("MJOps", [
+    "dt", "theta", "e", "save_every", "frame_every",
+    "Kb", "Mb", "Bb", "Achol", "loads",    # K, M, B rows; Â's factor; load vectors
+    "Cp", "Ci", "Cx", "W", "D",            # constraint rows, Â⁻¹Cᵀ, C Â⁻¹ Cᵀ
+    "Op", "Oi", "Ox", "Sp", "Si", "Sx",    # observers, penetration samples
+])
+MJState = namedtuple("MJState", [
+    "u_prev", "u_cur", "v",
+    "y_prev", "y_cur", "dy", "yv", "yp",   # C uⁿ⁻¹, C uⁿ, C(uⁿ⁺¹ − uⁿ⁻¹), C vⁿ, predicted C u
+    "lo", "hi", "slo", "shi", "lo_e", "hi_e",
+    "law_state", "active", "active_prev", "stats", "counters", "work", "impact",
+    "mu",                                  # Δt·p (so that mu/Δt² is the force p/Δt)
+    "p", "wf", "x", "dv", "Ku", "Kv",      # scratch
+])
+
+
+class MoreauJeanLaw(ContactLaw):
+    """The name a Moreau–Jean result reports as its solver."""
+    name = "moreau-jean"
+
+
+@njit(cache=True)
+def mj_record(n, ops, st, out):
+    """Penetration (every step) and the saved series of state n (v is the scheme's own)."""
+    stats = st.stats
+    for r in range(st.y_cur.size):
+        stats[0] = max(stats[0], st.lo[r] - st.y_cur[r], st.y_cur[r] - st.hi[r])
+    for r in range(st.slo.size):
+        s = 0.0
+        for q in range(ops.Sp[r], ops.Sp[r + 1]):
+            s += ops.Sx[q] * st.u_cur[ops.Si[q]]
+        stats[1] = max(stats[1], st.slo[r] - s)
+        stats[2] = max(stats[2], s - st.shi[r])
+    dt2 = ops.dt * ops.dt
+    if n % ops.save_every == 0:
+        k = n // ops.save_every
+        for r in range(ops.Op.size - 1):     # observed values and the velocity v itself
+            out.obs[k, r] = 0.0
+            out.obsv[k, r] = 0.0
+            for q in range(ops.Op[r], ops.Op[r + 1]):
+                out.obs[k, r] += ops.Ox[q] * st.u_cur[ops.Oi[q]]
+                out.obsv[k, r] += ops.Ox[q] * st.v[ops.Oi[q]]
+        out.energy[k] = 0.5 * (rows_dot(ops.Mb, st.v, st.v) + rows_dot(ops.Kb, st.u_cur,
+                                                                        st.u_cur))
+        out.work[k, :] = st.work
+        out.lam[k, :] = st.mu / dt2
+    if n % ops.frame_every == 0:
+        k = n // ops.frame_every
+        for i in range(st.u_cur.size):
+            out.frames_u[k, i] = st.u_cur[i]
+            out.frames_v[k, i] = st.v[i]
+        for j in range(st.mu.size):
+            out.frames_f[k, j] = st.mu[j] / dt2
+
+
+@njit(cache=True, inline="always")
+def mj_impulse(ops, st):
+    """p from the impact law on the index set (box QP in the velocity values); returns
+    the active set's iterations (< 0: failed).  st.x holds v_free on entry."""
+    dt, inf = ops.dt, np.inf
+    for i in range(st.x.size):
+        st.dv[i] = st.u_cur[i] + 0.5 * dt * st.v[i]
+    csr_product(ops.Cp, ops.Ci, ops.Cx, st.dv, st.yp)
+    csr_product(ops.Cp, ops.Ci, ops.Cx, st.x, st.wf)
+    for j in range(st.wf.size):
+        st.wf[j] += ops.e * st.yv[j]
+        st.lo_e[j] = 0.0 if st.yp[j] <= st.lo[j] else -inf
+        st.hi_e[j] = 0.0 if st.yp[j] >= st.hi[j] else inf
+        if (st.law_state[j] < 0 and st.lo_e[j] == -inf) or \
+                (st.law_state[j] > 0 and st.hi_e[j] == inf):
+            st.law_state[j] = 0          # warm start only from members of the index set
+    if st.wf.size == 0:
+        return 0
+    return box_qp(ops.D, st.wf, st.lo_e, st.hi_e, st.law_state, st.p)
+
+
+@njit(cache=True)
+def mj_steps(ops, st, out, n0, n1, inputs, Ebound):
+    """Steps n = n0..n1−1 of Moreau–Jean (module docstring); the codes of
+    :func:`skfem_beam.scheme.kernels.run_steps`."""
+    dt, th = ops.dt, ops.theta
+    n, m = st.x.size, st.mu.size
+    for step in range(n0, n1):
+        Gn = inputs.G[step - n0]
+        rows_matvec(ops.Kb, st.u_cur, st.Ku)
+        rows_matvec(ops.Kb, st.v, st.Kv)
+        x = st.x
+        for i in range(n):
+            s = -st.Ku[i] - dt * th * st.Kv[i]
+            for k in range(Gn.size):
+                s += Gn[k] * ops.loads[i, k]
+            x[i] = dt * s
+        if ops.Bb.shape[0]:
+            rows_matvec(ops.Bb, st.v, x, -dt, True)
+        band_solve(ops.Achol, x)
+        for i in range(n):
+            x[i] += st.v[i]                      # v_free
+        its = mj_impulse(ops, st)
+        if its < 0:
+            st.counters[3] = step + 1
+            return FAILED
+        st.counters[2] += its
+        for j in range(m):
+            if st.p[j] != 0.0:
+                for i in range(n):
+                    x[i] += ops.W[i, j] * st.p[j]
+        # x = v^{n+1}; dv = Δv; Kv ← v^θ
+        for i in range(n):
+            st.dv[i] = x[i] - st.v[i]
+            st.Kv[i] = st.v[i] + th * st.dv[i]
+        for k in range(Gn.size):
+            s = 0.0
+            for i in range(n):
+                s += ops.loads[i, k] * st.Kv[i]
+            st.work[1] += dt * Gn[k] * s
+        if ops.Bb.shape[0]:
+            st.work[0] += dt * rows_dot(ops.Bb, st.Kv, st.Kv)
+        if th != 0.5:
+            st.work[0] += (th - 0.5) * (rows_dot(ops.Mb, st.dv, st.dv)
+                                        + dt * dt * rows_dot(ops.Kb, st.Kv, st.Kv))
+        for i in range(n):
+            st.u_prev[i] = st.u_cur[i]
+            st.u_cur[i] += dt * st.Kv[i]
+            st.v[i] = x[i]
+        for j in range(m):
+            st.dy[j] = -st.y_prev[j]
+            st.y_prev[j] = st.y_cur[j]
+        csr_product(ops.Cp, ops.Ci, ops.Cx, st.u_cur, st.y_cur)
+        csr_product(ops.Cp, ops.Ci, ops.Cx, st.v, st.yv)
+        for j in range(m):
+            st.dy[j] += st.y_cur[j]
+            st.work[2] += st.p[j] * (st.y_cur[j] - st.y_prev[j]) / dt
+            st.mu[j] = st.p[j] * dt
+            st.active[j] = st.p[j] != 0.0
+        full = track_impacts(ops, st, out, step)
+        mj_record(step + 1, ops, st, out)
+        if (step + 1) % ops.save_every == 0 \
+                and not abs(out.energy[(step + 1) // ops.save_every]) <= Ebound:
+            st.counters[3] = step + 1
+            return UNSTABLE
+        if full:
+            st.counters[3] = step + 1
+            return full
+    return 0
+
+
+def check_theta(theta) -> float:
+    """θ ∈ [1/2, 1], where the θ-scheme is unconditionally stable."""
+    theta = check_finite("theta", theta)
+    if 0.5 <= theta <= 1.0:
+        return theta
+    raise InputError(f"theta={theta:g} must lie in [1/2, 1] (the θ-scheme is "
+                     f"unconditionally stable there)")
+
+
+class MoreauJean(Run):
+    """A Moreau–Jean run of ``system`` on ``stepping`` (its β is not used), with
+    ``theta`` ∈ [1/2, 1] and Newton restitution ``restitution`` ∈ [0, 1]; the interface
+    of :class:`Run` (advance, result, the saved buffers), so that :func:`drive` and the
+    output pipeline run it as they run the β-scheme."""
+
+    def __init__(self, system, stepping: Stepping, theta: float = 0.5,
+                 restitution: float = 0.0):
+        self.theta, self.e = check_theta(theta), Restitution(restitution).e
+        super().__init__(system, stepping, MoreauJeanLaw())
+
+    def _build(self, system, stepping, law) -> None:
+        if system.bound_motion is not None:
+            raise InputError("law='moreau-jean' does not handle obstacles that move with a "
+                             "support: use the position-level scheme")
+        s, m, n, th = stepping, system.C.shape[0], system.n, self.theta
+        self.system, self.stepping, self.law, self.solver = system, s, law, law.name
+        self.dt, self.beta, self.n_steps = s.dt, th, s.steps
+        self.save_every, self.frame_every, self.shift = s.save_every, s.frame_every, 0.0
+        # Â = M + Δt²θ²K + ΔtθB is step_operators' A with β = θ² and B scaled by 2θ
+        B = system.B
+        self.op = op = step_operators(replace(system, B=None if B is None else 2 * th * B),
+                                      s.dt, th * th)
+        self.pysolver = None
+        self.loads = np.ascontiguousarray(system.loads, dtype=float)
+        self.Minv_norm = np.sqrt(np.array([lv @ scipy.sparse.linalg.spsolve(system.M.tocsc(), lv)
+                                           for lv in self.loads.T])) \
+            if self.loads.shape[1] else np.zeros(0)
+        O = sp.csr_matrix(np.vstack(list(system.observe.values()))) if system.observe \
+            else sp.csr_matrix((0, n))
+        if system.sample_E is not None and system.sample_E.shape[0]:
+            samples, slo, shi = csr_arrays(system.sample_E), system.sample_lo, system.sample_hi
+        else:
+            samples, slo, shi = (np.zeros(1, np.int64), np.zeros(0, np.int64), np.zeros(0)), \
+                np.zeros(0), np.zeros(0)
+        lo, hi = (np.ascontiguousarray(b, dtype=float) for b in (system.lo, system.hi))
+        self.ops = MJOps(s.dt, th, self.e, s.save_every, s.frame_every, op.Kb.rows,
+                         Banded(system.M).rows, Banded(B).rows if B is not None
+                         else np.zeros((0, 1)), op.Ab.chol, self.loads, *csr_arrays(op.C),
+                         op.W, op.D, *csr_arrays(O), *samples)
+        z = np.zeros
+        self.st = MJState(z(n), system.u0.astype(float), system.v0.astype(float),
+                          z(m), op.C @ system.u0, z(m), op.C @ system.v0, z(m),
+                          lo, hi, np.array(slo, float), np.array(shi, float), z(m), z(m),
+                          z(m, np.int8), z(m, np.bool_), z(m, np.bool_), z(4),
+                          z(5, np.int64), z(3), np.full((m, 5), -1.0), z(m),
+                          z(m), z(m), z(n), z(n), z(n), z(n))
+        self.st.u_prev[:] = self.st.u_cur
+        self.st.y_prev[:] = self.st.y_cur
+        nsave, nframes, nobs = s.steps // s.save_every + 1, s.steps // s.frame_every + 1, O.shape[0]
+        self.out = Series(np.full((nsave, nobs), np.nan), np.full((nsave, nobs), np.nan),
+                          np.full(nsave, np.nan), z((nsave, 3)), z((nsave, m)),
+                          np.full((nframes, n), np.nan), np.full((nframes, n), np.nan),
+                          z((nframes, m)), z((max(4096, 4 * m), 7)))
+        self.events = []
+        mj_record(0, self.ops, self.st, self.out)     # state 0: the data themselves
+        self.E1 = float(self.out.energy[0])
+        self.load_bound, self.n, self.wall = 0.0, 0, 0.0
+        self.status, self.message = "running", ""
+        self._steps(0, 0, 0.0)      # load the compiled loop now, outside the timed loop
+        self.advance(1)
+
+    def load_coefficients(self, n0, n1):
+        """f^{n+θ}: the load functions at tₙ + θΔt, n = n0..n1−1."""
+        t = (np.arange(n0, n1) + self.theta) * self.dt
+        if not self.loads.shape[1]:
+            return np.zeros((n1 - n0, 0))
+        return np.ascontiguousarray(np.column_stack(
+            [np.broadcast_to(np.asarray(a(t), dtype=float), t.shape) for a in
+             self.system.load_time]))
+
+    def _steps(self, n0, n1, Ebound, inputs=None):
+        if inputs is None:
+            inputs = Inputs(np.zeros((0, self.loads.shape[1])), np.zeros(0))
+        return mj_steps(self.ops, self.st, self.out, n0, n1, inputs, Ebound)
+
+    def checkpoint(self) -> dict:
+        raise InputError("checkpoints are not implemented for law='moreau-jean'")
+
+    def restore(self, ck: dict) -> None:
+        raise InputError("law='moreau-jean' runs cannot be resumed")
+
+
+def moreau_jean(system, dt: float, T: float, theta: float = 0.5, restitution: float = 0.0,
+                save_every: int = 1, frames: int = 200, progress: bool | None = None,
+                chunk: int = 20000) -> Result:
+    """Integrate ``system`` over [0, T] with Moreau–Jean (θ-scheme, Newton impact law
+    with coefficient ``restitution``); the :class:`Result` of :func:`solve`, with
+    ``beta`` holding θ and ``solver`` "moreau-jean"."""
+    run = MoreauJean(system, Stepping(dt, T, 0.5, save_every, frames), theta, restitution)
+    drive(run, chunk, progress)
+    return run.result()
+

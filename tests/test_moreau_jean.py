@@ -1,0 +1,72 @@
+"""Moreau–Jean (velocity level, Newton impact law): a rigid mass rebounds at exactly e
+times its approach velocity, the energy identity holds to round-off, e = 1 with θ = 1/2
+conserves the energy through contact, and on the periodic rod it converges, penetrating
+O(Δt)."""
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from skfem_beam import InputError, scenes
+from skfem_beam.bar import bar_system, l2_time
+from skfem_beam.reference import exact_of
+from skfem_beam.scheme.moreau_jean import moreau_jean
+from skfem_beam.semidiscrete import SemiDiscrete
+
+
+def rigid_mass(v0=-1.0, gap=0.05):
+    one = sp.csr_matrix(np.ones((1, 1)))
+    return SemiDiscrete(M=one, K=sp.csr_matrix((1, 1)), C=one, lo=np.array([0.0]),
+                        hi=np.array([np.inf]), x_contact=np.array([0.0]),
+                        loads=np.zeros((1, 0)), load_time=[], u0=np.array([gap]),
+                        v0=np.array([v0]), observe={"x": np.ones(1)})
+
+
+@pytest.mark.parametrize("e", [0.0, 0.3, 1.0])
+def test_rigid_mass_rebounds_at_e(e):
+    r = moreau_jean(rigid_mass(), 0.01, 0.2, restitution=e)
+    v = r.velocity["x"]
+    assert v[-1] == pytest.approx(e * 1.0, abs=1e-14)
+    assert r.impacts == 1
+    # it penetrates at most one step's travel (the index set switches on once the
+    # predicted gap closes)
+    assert 0 < r.max_penetration <= 0.01 * 1.0 + 1e-15
+    assert r.energy[-1] == pytest.approx(0.5 * e * e, abs=1e-14)
+
+
+@pytest.mark.parametrize("theta,e", [(0.5, 0.0), (0.75, 0.0), (0.5, 0.5)])
+def test_energy_identity_to_round_off(theta, e):
+    bar = scenes.periodic_rod(20)
+    r = moreau_jean(bar_system(bar), 0.01, 6.0, theta=theta, restitution=e, frames=5)
+    w = r.work
+    gap = r.energy - r.energy[0] + w["damping"] - w["input"] - w["contact"]
+    assert np.abs(gap).max() < 1e-13
+    assert w["contact"][-1] < -1e-4            # impacts lose energy for e < 1
+    if theta > 0.5:
+        assert w["damping"][-1] > 1e-4         # the θ-scheme's numerical dissipation
+
+
+def test_elastic_impacts_conserve_energy():
+    bar = scenes.periodic_rod(40)
+    r = moreau_jean(bar_system(bar), 0.01, 12.0, restitution=1.0, frames=5)
+    assert np.abs(r.energy / 0.125 - 1).max() < 1e-12
+    assert r.impacts >= 4
+
+
+def test_periodic_rod_converges_and_penetrates_order_dt():
+    errs, pens = [], []
+    for N in (20, 40, 80):
+        bar = scenes.periodic_rod(N)
+        dt = 0.04 * bar.h
+        r = moreau_jean(bar_system(bar), dt, 12.0, frames=5)
+        errs.append(l2_time(r.observed["u0"] - exact_of(bar, 12.0).u(0.0, r.t), dt))
+        pens.append(r.max_penetration)
+        assert pens[-1] <= 0.5 * dt + 1e-15        # |u_t| ≤ 1/2 on this rod
+    assert errs[0] > errs[1] > errs[2] and errs[2] < 1.4e-2       # 1.30e-2 measured
+    assert pens[2] > 0
+
+
+@pytest.mark.parametrize("kw,msg", [(dict(theta=0.3), "theta=0.3"),
+                                    (dict(restitution=1.5), "restitution=1.5")])
+def test_bad_input_refused(kw, msg):
+    with pytest.raises(InputError, match=msg):
+        moreau_jean(rigid_mass(), 0.01, 0.1, **kw)

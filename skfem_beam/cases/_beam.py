@@ -57,7 +57,7 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
             cols["energy_J"] = run.energy[k0:k1] * rho_S
         # work since state 1, in the units of energy: energy − energy[0] + damping
         # = input + contact (the scheme's identity, docs/design.md §3)
-        work = run.out.work[k0:k1]
+        work = run.work[k0:k1]
         terms = {f"work_{name}": work[:, i] for i, name in enumerate(WORK)}
         cols.update(terms)
         if rho_S:

@@ -8,10 +8,12 @@ import numpy as np
 from .. import cli
 from ..contact import resolve
 from ..output.charts import energy_chart, shape_chart, trajectory_chart
+from ..output.events import beam_impacts
+from ..output.probes import probe_columns, probe_units
 from ..output.series import execute, prepare
 from ..scheme import Run, Stepping
 from ..checks import check_positive
-from ..semidiscrete import beam_system
+from ..semidiscrete import add_probes, beam_system
 from ..stability import kappa_h, linear_limit
 
 
@@ -25,6 +27,7 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
     stepping = Stepping(args.dt, args.T, args.beta, args.save_every, args.frames)
     out = prepare(args)                            # fail before the run, not after it
     system = beam_system(problem)
+    add_probes(system, getattr(args, "probe", None) or [])
     kh = kappa_h(system)
     limit = linear_limit(kh, args.beta)
     if args.dt > limit:
@@ -45,7 +48,7 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
                 "energy": run.energy[k0:k1], "contact_force": force}
         if rho_S:
             cols["contact_force_N"] = force * rho_S
-        return cols
+        return {**cols, **probe_columns(run, k0, k1)}
 
     def finish(folder: Path, data: dict, run):
         t, beta, dt = data["t"], run.beta, run.dt
@@ -66,6 +69,7 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
                     title=f"{case}: displacement ũ(x, t) at saved times ({about})")
         if extra is not None:
             extra(folder, data, run)
+        return beam_impacts(folder, run, problem, data)
 
     summary = {
         "case": case, "J": problem.J, "dt": run.dt, "T": run.n_steps * run.dt, "beta": run.beta,
@@ -73,7 +77,7 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
         "kappa_h": kh, "linear_stability_limit_dt": limit,
         "units": {"displacement": "m", "energy": "½E_β, m³/s² (per unit mass per length)",
                   "contact_force": "m²/s² (N per kg/m)",
-                  "contact_force_N": "N (contact_force × rho_S)"},
+                  "contact_force_N": "N (contact_force × rho_S)", "probes": probe_units(system)},
         "penalty_stiffness_N_per_m": args.stiffness if args.method == "penalty" else None,
         "config": {**config, **{k: v for k, v in vars(args).items() if k != "resume"}},
     }

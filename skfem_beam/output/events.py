@@ -136,6 +136,9 @@ def write_impacts(folder: Path, run, units: dict, scale: float = 1.0, sign: floa
     (:func:`forces_from_series`), else the loop's own sums over the states in contact."""
     s = run.system
     events = run.impact_events()
+    # an unstable run ends at its last good saved state: impacts after it are not kept
+    keep = np.asarray(events["t_start"]) <= (run.n + 0.5) * run.dt
+    events = {k: np.asarray(v)[keep] for k, v in events.items()}
     if force is not None:
         events = forces_from_series(events, force, run.n, run.dt)
     table = impact_table(events, np.asarray(s.lo), np.asarray(s.hi), scale, sign)

@@ -40,6 +40,10 @@ def parser(prog: str, description: str, *, J=None, dt=None, T=None, beta=None,
         p.add_argument("--mesh", default=None, metavar="FILE",
                        help="a 1-D line mesh meshio reads (non-uniform allowed; replaces --J); "
                             "the papers' meshes are in meshes/")
+        p.add_argument("--probe", type=float, action="append", default=None, metavar="X",
+                       help="repeatable: write displacement, velocity, bending moment and "
+                            "shear force at x=X (m) into timeseries.csv "
+                            "(probe_<X>_displacement, ...)")
     p.add_argument("--dt", type=float, default=dt, help="time step (s)")
     p.add_argument("--T", type=float, default=T, help="final time (s)")
     p.add_argument("--beta", type=float, default=beta,

@@ -258,3 +258,34 @@ def beam_system(problem: BeamProblem, samples_per_element: int = 20) -> SemiDisc
         view=SceneView("beam", L, k2, sup if problem.lifting == "paper" else None,
                        problem.obstacles, beam.rho_S, beam.EI, lift),
         bound_motion=motion, bound_shift=shift, sample_shift=s_shift)
+
+
+def add_probes(system: SemiDiscrete, xs) -> list[dict]:
+    """Observe a beam at each abscissa of ``xs``: three observer rows per x, in the lifted
+    variable u, ``probe_<x>_displacement`` (u(x)), ``probe_<x>_moment`` (k²·EI(x)/EI_ref·u'')
+    and ``probe_<x>_shear`` (−k²·EI(x)/EI_ref·u''', the shear σ̃ of docs/design.md §1; u'''
+    is constant on a cubic element, taken on the element to the right of a node).
+    :func:`skfem_beam.output.probes.probe_columns` adds the lifting h(x)φ(t) and the units.
+    Returns the probes (also kept in ``system.meta["probes"]``); x outside [0, L], twice,
+    or on a bar is refused in one line."""
+    problem = system.meta.get("problem")
+    if system.meta.get("kind") != "beam" or problem is None:
+        raise InputError("probes need a beam (bending moment and shear); this is a "
+                         f"{system.meta.get('kind', 'unknown')} system")
+    space, L, k2 = system.space, problem.beam.L, problem.beam.k2
+    probes = system.meta.setdefault("probes", [])
+    for x in np.atleast_1d(np.asarray(xs, dtype=float)).tolist():
+        if not 0.0 <= x <= L:
+            raise InputError(f"probe x={x:g} is outside the beam [0, L={L:g}]")
+        name = f"probe_{x:g}"
+        if any(p["name"] == name for p in probes):
+            raise InputError(f"probe x={x:g} is given twice")
+        e = min(int(np.searchsorted(space.nodes, x, side="right")) - 1, space.J - 1)
+        a, b = float(space.nodes[e]), float(space.nodes[e + 1])
+        ei = float(problem.beam.factors(0.5 * (a + b))[1])   # EI of that element
+        rows = [space.point_rows([x], k).toarray().ravel() for k in (0, 2, 3)]
+        system.observe[f"{name}_displacement"] = rows[0]
+        system.observe[f"{name}_moment"] = k2 * ei * rows[1]
+        system.observe[f"{name}_shear"] = -k2 * ei * rows[2]
+        probes.append({"name": name, "x": x, "element": (a, b), "EI_factor": ei})
+    return probes

@@ -79,7 +79,11 @@ def test_beam_run_reads_back_exactly(case, tmp_path, monkeypatch):
     assert saved.summary["case"] == case and saved.summary["config"]["T"] == float(argv[1])
     assert saved.fields.source == ("vtu" if "vtu" in argv else "xdmf")
     _assert_same_frames(saved, kept["run"])
-    assert saved.impacts is None and saved.tables == {}
+    assert saved.tables == {}
+    ev = res.impact_events          # impacts.csv: the run's own events, bit for bit
+    assert saved.impacts["t_start"].size == ev["t_start"].size == res.impacts > 0
+    for k in ("t_start", "t_end", "x", "velocity", "max_violation"):
+        assert np.array_equal(saved.impacts[k], ev[k]), k
     if case == "point_stops":        # rows every step; ũ(L) touches the stops exactly
         assert saved.t.size == 6001 and np.abs(saved["tip_displacement"]).max() == 0.1
         # the stability limit (inf for β = 1/2) comes back a float, not the string JSON had

@@ -7,11 +7,13 @@ import numpy as np
 
 from .. import cli
 from ..output.charts import energy_chart, shape_chart, trajectory_chart
+from ..output.events import beam_impacts
 from ..output.fields import physical_tip
+from ..output.probes import probe_columns, probe_units
 from ..output.series import execute, prepare
 from ..scheme import Stepping
 from ..checks import check_positive
-from ..semidiscrete import beam_system
+from ..semidiscrete import add_probes, beam_system
 from ..spaces.redistribution import redistributed
 from ..stability import kappa_h, linear_limit
 
@@ -28,6 +30,7 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
     stepping = Stepping(args.dt, args.T, args.beta, args.save_every, args.frames)
     out = prepare(args)                            # fail before the run, not after it
     system = beam_system(problem)
+    add_probes(system, getattr(args, "probe", None) or [])
     kh = kappa_h(system)
     limit = linear_limit(kh, args.beta)
     if args.dt > limit:
@@ -62,7 +65,7 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
         cols.update(terms)
         if rho_S:
             cols.update({f"{k}_J": v * rho_S for k, v in terms.items()})
-        return cols
+        return {**cols, **probe_columns(run, k0, k1)}
 
     def finish(folder: Path, data: dict, run):
         t, beta, dt = data["t"], run.beta, run.dt
@@ -86,12 +89,13 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
                     title=f"{case}: displacement ũ(x, t) at saved times ({about})")
         if extra is not None:
             extra(folder, data, run)
+        return beam_impacts(folder, run, problem, data)
 
     summary = {
         "case": case, "J": problem.J, "dt": run.dt, "T": run.n_steps * run.dt, "beta": run.beta,
         "element": problem.element, "method": args.method,
         "kappa_h": kh, "linear_stability_limit_dt": limit,
-        "units": units(rho_S, system),
+        "units": {**units(rho_S, system), "probes": probe_units(system)},
         "penalty_stiffness_N_per_m": args.stiffness if args.method == "penalty" else None,
         "config": {**config, **{k: v for k, v in vars(args).items() if k != "resume"}},
     }

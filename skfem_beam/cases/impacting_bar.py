@@ -35,6 +35,7 @@ from .. import cli
 from ..bar import (Bar, BarSeries, bar_run, contact_periods, describe, energy_report, errors,
                    read_profile, spring_step_ratio)
 from ..output.charts import compare_chart
+from ..output.events import bar_impacts
 from ..output.series import Series, execute, prepare
 from ..checks import check_positive
 from ..reference import BarExact
@@ -149,6 +150,7 @@ def run_bar_case(bar: Bar, args, config: dict | None = None) -> int:
                       {"exact total": data.get("energy_exact")}, title,
                       "energy (J/m²)" if bar.A is None else "energy (J)")
         return {
+            **bar_impacts(folder, run, bar, data),
             "T": float(b.t[-1]), "steps": min(run.n, series.n_steps),
             "max_penetration": b.penetration, "max_nodal_violation": b.penetration,
             "energy_final": float(b.energy[-1] + b.load_potential[-1]),

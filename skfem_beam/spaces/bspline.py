@@ -198,7 +198,9 @@ class BSplineSpace:
         return self._Am, self._As
 
     def point_rows(self, x, derivative: int = 0, full: bool = False) -> sp.csr_matrix:
-        """Rows evaluating d^k u/dx^k (k = 0, 1, 2) at abscissae x."""
+        """Rows evaluating d^k u/dx^k (k = 0, 1, 2, 3) at abscissae x (on the element to
+        the right of a node, the last one at x = L; the third derivative is constant on an
+        element)."""
         x = np.atleast_1d(np.asarray(x, dtype=float))
         e = np.clip(np.searchsorted(self.nodes, x, side="right") - 1, 0, self.J - 1)
         xi = (x - self.nodes[e]) / self._hu

@@ -126,8 +126,9 @@ class HermiteSpace:
             (self._Pall.T @ self._As @ self._Pall).tocsr()
 
     def point_rows(self, x, derivative: int = 0, full: bool = False) -> sp.csr_matrix:
-        """Rows evaluating d^k u/dx^k (k = 0, 1, 2) at abscissae x, from the closed-form
-        cubic Hermite shape functions on the element holding each x."""
+        """Rows evaluating d^k u/dx^k (k = 0, 1, 2, 3) at abscissae x, from the closed-form
+        cubic Hermite shape functions on the element holding each x (the one to the right
+        of a node, the last one at x = L; the third derivative is constant on an element)."""
         x = np.atleast_1d(np.asarray(x, dtype=float))
         e = np.clip(np.searchsorted(self.nodes, x, side="right") - 1, 0, self.J - 1)
         h = self.h[e]
@@ -138,7 +139,8 @@ class HermiteSpace:
              1: ((6 * s**2 - 6 * s) / h, 1 - 4 * s + 3 * s**2, (6 * s - 6 * s**2) / h,
                  3 * s**2 - 2 * s),
              2: ((12 * s - 6) / h**2, (6 * s - 4) / h, (6 - 12 * s) / h**2,
-                 (6 * s - 2) / h)}[derivative]
+                 (6 * s - 2) / h),
+             3: (12 / h**3, 6 / h**2, -12 / h**3, 6 / h**2)}[derivative]
         rows = np.tile(np.arange(x.size), 4)
         cols = np.concatenate([2 * e + k for k in range(4)])
         A = sp.csr_matrix((np.concatenate([v * one for v in N]), (rows, cols)),

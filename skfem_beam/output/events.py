@@ -1,0 +1,183 @@
+"""impacts.csv and the per-node, per-obstacle contact statistics of summary.json.
+
+One row per impact of a constrained value (``Run.impact_events``, which a checkpoint
+carries, so a resumed run writes the same table as an uninterrupted one):
+
+    t_start, t_end   s: the first state on the obstacle and the first one off it (a contact
+                     still under way at the end ends at the last state)
+    x                m: the node
+    bound            1: the lower bound (g1; the bar's obstacle at x = 0),
+                     2: the upper bound (g2; the bar's obstacle at x = L)
+    velocity         m/s: the node's approach velocity (yⁿ − yⁿ⁻¹)/Δt before contact
+    peak_force       max |force| over the contact
+    impulse          Σ force·Δt over the contact, signed like the timeseries column
+                     ``contact_force`` (beam: λ, > 0 pushed up by g1; bar: R ≥ 0)
+    max_violation    m: the largest nodal violation of the bound during the contact
+
+Forces are in N and impulses in N·s when the mass per length (beam: ``rho_S``) or the
+bar's cross-section is known, else in the system's units (beam: per unit mass per length,
+m²/s² and m²/s; bar: per unit cross-section, Pa and Pa·s); summary.json says which.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .folder import atomic_write, csv_rows
+
+IMPACTS = "impacts.csv"
+COLUMNS = ("t_start", "t_end", "x", "bound", "velocity", "peak_force", "impulse",
+           "max_violation")
+
+
+def impact_table(events: dict, lo: np.ndarray, hi: np.ndarray, scale: float = 1.0,
+                 sign: float = 1.0) -> dict[str, np.ndarray]:
+    """The impacts.csv columns of ``events`` (``Run.impact_events()``): forces and impulses
+    times ``scale`` (ρS for a beam in N), impulses times ``sign`` (the bar's R = sign·λ);
+    ``lo``, ``hi``: the bounds of the constrained values (which side each contact is on)."""
+    j = np.asarray(events["value"], dtype=int)
+    impulse = np.asarray(events["impulse"], dtype=float)
+    lower = np.isfinite(lo[j]) & (~np.isfinite(hi[j]) | (impulse > 0)
+                                  | ((impulse == 0) & (events["velocity"] < 0)))
+    return {"t_start": events["t_start"], "t_end": events["t_end"], "x": events["x"],
+            "bound": np.where(lower, 1.0, 2.0), "velocity": events["velocity"],
+            "peak_force": scale * np.asarray(events["peak_force"], dtype=float),
+            "impulse": sign * scale * impulse, "max_violation": events["max_violation"]}
+
+
+def forces_from_series(events: dict, lam: np.ndarray, n: int, dt: float) -> dict:
+    """``events`` with ``impulse`` and ``peak_force`` taken from the force of every state
+    (``lam``: states × constrained values, all of them saved): each impact owns its node's
+    force from its first state to the next impact of that node (or state ``n``).  Why: a
+    penalty spring's force is β-weighted over three states, so it goes on for up to two
+    steps after the node has left the spring, where the loop's own sums (over the states
+    in contact) stop; for exact contact the force is zero there and both agree."""
+    j = np.asarray(events["value"], dtype=int)
+    start = np.rint(np.asarray(events["t_start"]) / dt).astype(int)
+    impulse, peak = np.array(events["impulse"], dtype=float), np.array(events["peak_force"],
+                                                                        dtype=float)
+    for v in np.unique(j):
+        rows = np.flatnonzero(j == v)
+        rows = rows[np.argsort(start[rows], kind="stable")]
+        ends = np.append(start[rows[1:]], n + 1)
+        for r, a, b in zip(rows, start[rows], ends):
+            f = lam[a:b, v]
+            impulse[r] = float(np.sum(f)) * dt
+            peak[r] = float(np.abs(f).max(initial=0.0))
+    return {**events, "impulse": impulse, "peak_force": peak}
+
+
+def _union_length(start: np.ndarray, end: np.ndarray) -> float:
+    """Total length of the union of the intervals [start, end)."""
+    total, reach = 0.0, -np.inf
+    for a, b in sorted(zip(start.tolist(), end.tolist())):
+        a = max(a, reach)
+        if b > a:
+            total += b - a
+            reach = b
+    return total
+
+
+def _stats(table: dict, rows: np.ndarray, duration: float) -> dict:
+    start, end = table["t_start"][rows], table["t_end"][rows]
+    return {"impacts": int(rows.size),
+            "contact_fraction": _union_length(start, end) / duration if duration > 0 else 0.0,
+            "max_impulse": float(np.abs(table["impulse"][rows]).max()),
+            "max_peak_force": float(table["peak_force"][rows].max()),
+            "max_violation": float(table["max_violation"][rows].max())}
+
+
+def _acting(obstacles, x: float, bound: int) -> int | None:
+    """The index of the part of ``obstacles`` whose g1 (bound 1) or g2 (2) is the bound at
+    x (the highest g1, the lowest g2 of all parts), or None."""
+    parts = getattr(obstacles, "parts", ())
+    if len(parts) < 2:
+        return None
+    g = [p.bounds(np.array([x]))[bound - 1][0] for p in parts]
+    best = max(g) if bound == 1 else min(g)
+    return next((i for i, v in enumerate(g) if np.isfinite(v) and v == best), None)
+
+
+def _describe(part) -> str:
+    br = tuple(getattr(part, "breakpoints", ()))
+    if len(br) == 1:
+        return f"point stops at x={br[0]:g}"
+    if len(br) == 2:
+        return f"span [{br[0]:g}, {br[1]:g}]"
+    return "profile"
+
+
+def impact_statistics(table: dict, duration: float, obstacles=None) -> dict:
+    """Per constrained node with contact (``nodes``) and, when ``obstacles`` has several
+    parts (``Obstacles.combine``, several point stops or spans), per part (``obstacles``):
+    impacts, contact_fraction (the time in contact, intervals united, over ``duration``),
+    max_impulse (largest |impulse|), max_peak_force, max_violation."""
+    x, bound = table["x"], table["bound"].astype(int)
+    nodes = [{"x": float(xi), **_stats(table, np.flatnonzero(x == xi), duration)}
+             for xi in np.unique(x)]
+    out = {"nodes": nodes, "obstacles": None}
+    if len(getattr(obstacles, "parts", ())) > 1:
+        owner = np.array([_acting(obstacles, xi, b) for xi, b in zip(x, bound)], dtype=object)
+        out["obstacles"] = [
+            {"obstacle": i, "where": _describe(part),
+             "x": sorted({float(v) for v in x[owner == i]}),
+             **_stats(table, np.flatnonzero(owner == i), duration)}
+            for i, part in enumerate(obstacles.parts) if np.any(owner == i)]
+    return out
+
+
+def write_impacts(folder: Path, run, units: dict, scale: float = 1.0, sign: float = 1.0,
+                  obstacles=None, force: np.ndarray | None = None) -> dict:
+    """Write ``folder/impacts.csv`` from ``run`` (a :class:`~skfem_beam.scheme.Run`) and
+    return the summary entry ``{"impact_statistics": ...}``; ``units``: the force and
+    impulse units (``{"force": "N", "impulse": "N·s"}``), see :func:`impact_table`.
+    ``force``: λ of every state (states × constrained values) when the caller has it
+    (:func:`forces_from_series`), else the loop's own sums over the states in contact."""
+    s = run.system
+    events = run.impact_events()
+    # an unstable run ends at its last good saved state: impacts after it are not kept
+    keep = np.asarray(events["t_start"]) <= (run.n + 0.5) * run.dt
+    events = {k: np.asarray(v)[keep] for k, v in events.items()}
+    if force is not None:
+        events = forces_from_series(events, force, run.n, run.dt)
+    table = impact_table(events, np.asarray(s.lo), np.asarray(s.hi), scale, sign)
+    path = Path(folder) / IMPACTS
+    atomic_write(path, lambda fh: fh.write(",".join(COLUMNS) + "\n"
+                                           + (csv_rows(table, list(COLUMNS)) if table["x"].size
+                                              else "")))
+    # the share of the states 1..n, as the run's own contact_fraction counts it
+    duration = max(0, run.n - 1) * run.dt
+    stats = impact_statistics(table, duration, obstacles)
+    f, i = units["force"], units["impulse"]
+    stats["units"] = {"t_start": "s", "t_end": "s", "x": "m", "bound": "1 = g1 (lower), "
+                      "2 = g2 (upper)", "velocity": "m/s", "peak_force": f, "impulse": i,
+                      "max_violation": "m", "contact_fraction": "of the run's time"}
+    return {"impact_statistics": stats}
+
+
+def beam_impacts(folder: Path, run, problem, data: dict) -> dict:
+    """:func:`write_impacts` for a beam scene (``data``: the timeseries columns), in N and
+    N·s when ρS is known.  One constrained node and every state saved: the forces come
+    from the series (a penalty spring's trailing force counted); else from the loop."""
+    rho_S = problem.beam.rho_S
+    units = {"force": "N", "impulse": "N·s"} if rho_S else \
+        {"force": "m²/s² (N per kg/m)", "impulse": "m²/s (N·s per kg/m)"}
+    # the rows in memory, not run.lam: a resumed run has only the rows since its checkpoint
+    lam = data["contact_force"]
+    force = lam[:, None] if run.system.C.shape[0] == 1 and lam.size == run.n + 1 else None
+    return write_impacts(folder, run, units, rho_S or 1.0, 1.0, problem.obstacles, force)
+
+
+def bar_impacts(folder: Path, run, bar, data: dict) -> dict:
+    """:func:`write_impacts` for the bar: R ≥ 0 (impulse = ∫R dt), in N and N·s with a
+    cross-section A, else per unit cross-section.  ``data``: its timeseries columns; R(tₙ)
+    is the force of state n + 1 (bar.BarSeries), so with every step saved the forces of
+    states 2..N+1 come from there (the start step's state 1 opens no impact)."""
+    units = {"force": "Pa (per unit cross-section)", "impulse": "Pa·s"} if bar.A is None \
+        else {"force": "N", "impulse": "N·s"}
+    R, force = data["contact_force"], None
+    if R.size + 1 == run.n + 1:            # rows t₀..t_N, every step: states 0..N+1
+        force = np.zeros((run.n + 1, 1))
+        force[2:, 0] = bar.gap_sign * R[1:]
+    return write_impacts(folder, run, units, 1.0, bar.gap_sign, None, force)

@@ -1,0 +1,135 @@
+"""impacts.csv and the per-node / per-obstacle contact statistics of summary.json:
+against the run's own series (impulse = ∫ contact force dt), the bar's exact impact,
+several obstacles, and a SIGKILL + --resume (the same table as an uninterrupted run)."""
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from skfem_beam import BeamProblem, Obstacles, beam_system, scenes
+from skfem_beam.cases import impacting_bar, point_stops
+from skfem_beam.contact import resolve
+from skfem_beam.output.events import COLUMNS, write_impacts
+from skfem_beam.results import read_csv, read_run
+from skfem_beam.scheme import Run, Stepping, drive
+
+
+def run_case(main, tmp_path, name, argv):
+    out = tmp_path / name
+    assert main(argv + ["--format", "none", "--out", str(out)]) == 0
+    return read_run(out)
+
+
+@pytest.mark.parametrize("method", ["contact", "penalty"])
+def test_beam_impulses_are_the_integral_of_the_contact_force(tmp_path, method):
+    r = run_case(point_stops.main, tmp_path, method,
+                 ["--dt", "1e-5", "--T", "0.4", "--method", method])
+    imp, s = r.impacts, r.summary
+    assert list(imp) == list(COLUMNS)
+    n = imp["t_start"].size
+    assert n == s["impacts"] > 10
+    # N·s against the N column, every step saved; a penalty spring's β-weighted force
+    # goes on after the node has left it, and is counted
+    force = r.series["contact_force_N"]
+    assert imp["impulse"].sum() == pytest.approx(force.sum() * s["dt"], rel=1e-12)
+    assert imp["peak_force"].max() == pytest.approx(np.abs(force).max(), rel=1e-12)
+    # the upper stop pushes down, the lower up
+    assert np.all(np.sign(imp["impulse"]) == np.where(imp["bound"] == 1, 1, -1))
+    assert np.all(imp["t_end"] > imp["t_start"]) and np.all(np.diff(imp["t_start"]) > 0)
+    # one constrained node: its contact fraction is the run's own
+    (node,) = s["impact_statistics"]["nodes"]
+    assert node["x"] == 1.501 and node["impacts"] == n
+    assert node["contact_fraction"] == pytest.approx(s["contact_fraction"], rel=1e-12)
+    assert node["max_impulse"] == np.abs(imp["impulse"]).max()
+    assert node["max_violation"] == s["max_nodal_violation"]
+    assert s["impact_statistics"]["units"]["impulse"] == "N·s"
+
+
+@pytest.mark.parametrize("flags", [[], ["--obstacle-at", "right", "--v0", "1"],
+                                   ["--A", "0.01"], ["--obstacle", "elastic"],
+                                   ["--method", "penalty", "--stiffness", "1e4"]])
+def test_bar_impulse_is_the_integral_of_R(tmp_path, flags):
+    r = run_case(impacting_bar.main, tmp_path, "bar", flags)
+    imp, s, dt = r.impacts, r.summary, r.summary["dt"]
+    R = r.series["contact_force"]          # R ≥ 0 at either end, R(tₙ) from state n + 1
+    assert np.all(imp["impulse"] > 0) and np.nanmin(R) >= 0
+    assert imp["impulse"].sum() == pytest.approx(np.nansum(R) * dt, rel=1e-12)
+    # each impact: R over its states (shifted by one: R at tₙ is the force of step n → n+1)
+    start = np.rint(imp["t_start"] / dt).astype(int)
+    for i, a in enumerate(start):
+        b = start[i + 1] if i + 1 < start.size else R.size + 1
+        assert imp["impulse"][i] == pytest.approx(np.nansum(R[a - 1:b - 1]) * dt, rel=1e-12)
+    A = 0.01 if "--A" in flags else 1.0
+    if flags in ([], ["--A", "0.01"]):             # the rigid obstacle, [DRF] Example 1
+        # exact: the bar (ρL = 1, v0 = −1) rests on the obstacle for 2L/c = 2 s and
+        # leaves with +1: impulse 2ρAL|v0|
+        (t0, t1), total = (imp["t_start"][0], imp["t_end"][0]), imp["impulse"][0]
+        assert imp["t_start"].size == 1 and t0 <= 2 * dt and abs(t1 - 2.0) < 10 * dt
+        assert total == pytest.approx(2.0 * A, rel=0.01)
+        unit = "N·s" if A != 1.0 else "Pa·s"
+        assert s["impact_statistics"]["units"]["impulse"] == unit
+
+
+def test_several_obstacles_are_grouped(tmp_path):
+    # two pairs of point stops (x = 0.75 and L) and a lower span over [1.05, 1.35]
+    pipe = scenes.point_stops()
+    L = pipe.beam.L
+    obstacles = Obstacles.combine(Obstacles.stops([0.75, L], -0.02, 0.02),
+                                  Obstacles.span(1.05, 1.35, g1=-0.03))
+    nodes = np.union1d(np.linspace(0, L, 21), [0.75, 1.05, 1.35])
+    pb = BeamProblem(pipe.beam, obstacles, pipe.support, initial=pipe.initial, nodes=nodes)
+    run = Run(beam_system(pb), Stepping(1e-4, 0.4), resolve("auto", None))
+    drive(run)
+    stats = write_impacts(tmp_path, run, {"force": "N", "impulse": "N·s"},
+                          pb.beam.rho_S, 1.0, obstacles)["impact_statistics"]
+    table = read_csv(tmp_path / "impacts.csv")
+    groups = stats["obstacles"]
+    assert sum(g["impacts"] for g in groups) == table["x"].size == run.result().impacts > 0
+    assert sum(n["impacts"] for n in stats["nodes"]) == table["x"].size
+    where = {g["where"]: g for g in groups}
+    assert set(where) <= {"point stops at x=0.75", f"point stops at x={L:g}",
+                          "span [1.05, 1.35]"} and len(where) >= 2
+    for g in groups:      # each group holds exactly the rows at its nodes
+        assert g["x"] and all(x in table["x"] for x in g["x"])
+        if g["where"].startswith("span"):
+            assert all(1.05 - 1e-12 <= x <= 1.35 + 1e-12 for x in g["x"])
+        rows = np.isin(table["x"], g["x"])
+        assert g["impacts"] == rows.sum()
+        assert g["max_impulse"] == np.abs(table["impulse"][rows]).max()
+
+
+CASE = [sys.executable, "-m", "skfem_beam.cases.point_stops"]
+ARGS = ["--dt", "1e-5", "--T", "1.0", "--flush-every", "2000", "--format", "none"]
+
+
+def test_sigkill_then_resume_writes_the_same_impacts(tmp_path):
+    ref, killed = tmp_path / "ref", tmp_path / "killed"
+    assert subprocess.run(CASE + ARGS + ["--out", str(ref)], capture_output=True).returncode == 0
+    size = (ref / "timeseries.csv").stat().st_size
+    p = subprocess.Popen(CASE + ARGS + ["--out", str(killed), "--checkpoint-every", "0"],
+                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 120
+    csv = killed / "timeseries.csv"
+    while time.monotonic() < deadline and p.poll() is None:
+        if (killed / "checkpoint.npz").exists() and csv.exists() and \
+                csv.stat().st_size > size // 2:
+            break
+        time.sleep(0.002)
+    os.kill(p.pid, signal.SIGKILL)
+    p.wait()
+    if json.loads((killed / "summary.json").read_text())["status"] != "running":
+        pytest.skip("the run finished before it could be killed")
+    assert not (killed / "impacts.csv").exists()
+    res = subprocess.run(CASE + ["--resume", str(killed)], capture_output=True, text=True)
+    assert res.returncode == 0, res.stderr
+    table = (ref / "impacts.csv").read_bytes()
+    assert table.count(b"\n") > 100
+    assert (killed / "impacts.csv").read_bytes() == table
+    a, b = (json.loads((d / "summary.json").read_text())["impact_statistics"]
+            for d in (ref, killed))
+    assert a == b

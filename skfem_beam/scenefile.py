@@ -58,7 +58,8 @@ SECTION = {"I": V, "A": V, "tube": {"outer_diameter": V, "wall": V},
 MATERIAL = {"E": V, "rho": V}
 U0, V0 = {"x": V, "u": V}, {"x": V, "v": V}
 TIME_KEYS = {"dt": V, "T": V, "beta": V}
-OUTPUT = {"format": V, "save_every": V, "frames": V, "flush_every": V, "checkpoint_every": V}
+OUTPUT = {"format": V, "save_every": V, "frames": V, "flush_every": V, "checkpoint_every": V,
+          "probes": V}
 CONTACT = {"law": V, "stiffness": V, "restitution": V}
 
 BEAM_KEYS = {
@@ -577,22 +578,22 @@ def run_main(argv) -> int:
     elif args.scene is None:
         raise InputError("run needs a scene file: python -m skfem_beam run SCENE.toml")
     scene = load(args.scene or "scene.toml", args.set or (), **stored)
+    probes = scene.output.get("probes", [])
     for key, value in scene.output.items():
-        if getattr(args, key) is None:
+        if key != "probes" and getattr(args, key) is None:
             setattr(args, key, value)
     if args.T is None:
         args.T = scene.stepping.T
     if args.out is None:
         args.out = f"out/{Path(args.scene).stem}"
     penalty = scene.law == "penalty"
-    if scene.restitution:
-        raise InputError("[contact] restitution: `run` cannot pass a coefficient of "
-                         "restitution to the scenes' pipeline yet; use the Python API "
-                         "(solve(..., solver=scene.contact_law))")
     args.dt, args.beta = scene.stepping.dt, scene.stepping.beta
     args.method = "penalty" if penalty else "contact"
-    args.solver = "auto" if penalty else scene.law
-    args.stiffness = scene.stiffness
+    args.law = "penalty" if penalty else "position"
+    args.solver = "auto" if penalty or scene.restitution else scene.law
+    args.stiffness, args.restitution = scene.stiffness, scene.restitution
+    args.mass = "consistent" if scene.kind == "beam" else scene.problem.mass
+    args.probe = [float(x) for x in np.atleast_1d(probes)]
     config = {"command": "python -m skfem_beam run", "scene_text": scene.text,
               "scene_files": scene.files}
     name = f"scene {Path(args.scene).stem}" if args.scene else "scene"

@@ -265,9 +265,14 @@ def test_penalty_law_runs_as_the_case_penalty_method(tmp_path):
     assert series(a) == series(b)
 
 
-def test_restitution_is_refused_by_run_but_built_for_the_api(tmp_path, capsys):
+def test_restitution_runs_as_the_case_flag(tmp_path):
+    """[contact] restitution = 0.5 is the case command's --restitution 0.5, bit for bit."""
     f = write(tmp_path, PIPE + '[contact]\nlaw = "auto"\nrestitution = 0.5\n')
     assert load(f).contact_law.e == 0.5
-    out = tmp_path / "out"
-    out.mkdir()
-    assert_refused(run_main, [str(f), "--out", str(out / "run")], "restitution", capsys, out)
+    a, b = tmp_path / "a", tmp_path / "b"
+    assert exit_code(run_main, [str(example("point_stops")), "--out", str(a), "--T", "0.3",
+                                "--format", "none", "--set", "contact.restitution=0.5"]) == 0
+    assert exit_code(point_stops.main, ["--T", "0.3", "--out", str(b), "--format", "none",
+                                        "--restitution", "0.5"]) == 0
+    assert series(a) == series(b)
+    assert json.loads((a / "summary.json").read_text())["solver"] == "restitution"

@@ -50,7 +50,7 @@ from ..errors import InputError
 from ..linalg import Banded, band_solve, rows_dot, rows_matvec
 from .kernels import FAILED, UNSTABLE, Inputs, Series, csr_product, track_impacts
 from .operators import csr_arrays, step_operators
-from .run import Run
+from .run import FIRST_ROWS, Run
 from .solve import drive
 from .stepping import Result, Stepping
 
@@ -89,7 +89,7 @@ def mj_record(n, ops, st, out):
         stats[2] = max(stats[2], s - st.shi[r])
     dt2 = ops.dt * ops.dt
     if n % ops.save_every == 0:
-        k = n // ops.save_every
+        k = n // ops.save_every - st.counters[5]   # rows from counters[5] on (see Run)
         for r in range(ops.Op.size - 1):     # observed values and the velocity v itself
             out.obs[k, r] = 0.0
             out.obsv[k, r] = 0.0
@@ -191,7 +191,7 @@ def mj_steps(ops, st, out, n0, n1, inputs, Ebound):
         full = track_impacts(ops, st, out, step)
         mj_record(step + 1, ops, st, out)
         if (step + 1) % ops.save_every == 0 \
-                and not abs(out.energy[(step + 1) // ops.save_every]) <= Ebound:
+                and not abs(out.energy[(step + 1) // ops.save_every - st.counters[5]]) <= Ebound:
             st.counters[3] = step + 1
             return UNSTABLE
         if full:
@@ -254,11 +254,12 @@ class MoreauJean(Run):
                           z(m), op.C @ system.u0, z(m), op.C @ system.v0, z(m),
                           lo, hi, np.array(slo, float), np.array(shi, float), z(m), z(m),
                           z(m, np.int8), z(m, np.bool_), z(m, np.bool_), z(4),
-                          z(5, np.int64), z(3), np.full((m, 5), -1.0), z(m),
+                          z(6, np.int64), z(3), np.full((m, 5), -1.0), z(m),
                           z(m), z(m), z(n), z(n), z(n), z(n))
         self.st.u_prev[:] = self.st.u_cur
         self.st.y_prev[:] = self.st.y_cur
-        nsave, nframes, nobs = s.steps // s.save_every + 1, s.steps // s.frame_every + 1, O.shape[0]
+        nsave = min(s.steps // s.save_every + 1, FIRST_ROWS)    # grown as the run needs them
+        nframes, nobs = s.steps // s.frame_every + 1, O.shape[0]
         self.out = Series(np.full((nsave, nobs), np.nan), np.full((nsave, nobs), np.nan),
                           np.full(nsave, np.nan), z((nsave, 3)), z((nsave, m)),
                           np.full((nframes, n), np.nan), np.full((nframes, n), np.nan),
@@ -281,6 +282,7 @@ class MoreauJean(Run):
              self.system.load_time]))
 
     def _steps(self, n0, n1, Ebound, inputs=None):
+        self._hold_rows(n1 // self.save_every)
         if inputs is None:
             inputs = Inputs(np.zeros((0, self.loads.shape[1])), np.zeros(0))
         return mj_steps(self.ops, self.st, self.out, n0, n1, inputs, Ebound)

@@ -89,6 +89,11 @@ class Run:
     """
 
     def __init__(self, system, stepping: Stepping, law: str | ContactLaw = "auto"):
+        self._build(system, stepping, law)
+
+    def _build(self, system, stepping, law) -> None:
+        """Operators, the law, the state and buffers, the start step (a subclass with
+        another integrator, e.g. Moreau–Jean, builds its own)."""
         s, m = stepping, system.C.shape[0]
         n_steps = s.steps
         self.system, self.stepping = system, s

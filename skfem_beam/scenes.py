@@ -17,7 +17,7 @@ import math
 import numpy as np
 
 from .bar import Bar
-from .problem import (Beam, BeamProblem, InitialState, Load, Obstacles, Support,
+from .problem import (Beam, BeamProblem, Damping, InitialState, Load, Obstacles, Support,
                       check_positive, lifting)
 
 # the first paper's pipe: E = 2e11 Pa, ρ = 8000 kg/m³, outer diameter 1 cm, wall 0.5 mm
@@ -27,16 +27,18 @@ PIPE10_L = 10.0                                           # the second paper's l
 
 
 def point_stops(*, J=19, element="hermite", L=1.501, k2=PIPE_K2, gap=0.1, amplitude=0.2,
-                omega=10.0, rho_S=PIPE_RHO_S, nodes=None) -> BeamProblem:
+                omega=10.0, rho_S=PIPE_RHO_S, nodes=None, damping=None) -> BeamProblem:
     """Clamped to a support moving as A sin ωt, stops ±gap at the tip.  u0 = 0,
-    v0 = −Aω h(x): the beam is at rest in the fixed frame (ũ = ũ_t = 0) at t = 0."""
+    v0 = −Aω h(x): the beam is at rest in the fixed frame (ũ = ũ_t = 0) at t = 0.
+    ``damping``: a :class:`~skfem_beam.problem.Damping` (the papers' pipe has none)."""
     gap = check_positive("gap", gap)
     beam = Beam(L, k2, rho_S)
     return BeamProblem(
         beam=beam, obstacles=Obstacles.point_stops(beam.L, -gap, gap),
         support=Support(amplitude, omega),
         initial=InitialState(v0=lambda x: -amplitude * omega * lifting(x, beam.L)),
-        J=J, element=element, nodes=nodes)
+        J=J, element=element, nodes=nodes,
+        damping=Damping() if damping is None else damping)
 
 
 def flat_profile(L: float, gap: float = 0.01) -> Obstacles:

@@ -1,7 +1,7 @@
 """Parameter sweeps and bifurcation diagrams, on one core or a Dask cluster.
 
     python -m skfem_beam.sweep --scene point_stops --param omega --values 'linspace(5, 40, 200)' \\
-        [--transient 2 --periods 50] [--workers N | --scheduler tcp://HOST:PORT] --out DIR
+        [--transient 2 --periods 50] [--zeta 0.02] [--workers N | --scheduler tcp://HOST:PORT] --out DIR
 
 Each parameter value is one independent, deterministic run (one Dask task).  The run
 keeps a Poincaré section: the tip displacement and velocity sampled exactly at
@@ -9,6 +9,11 @@ t = k·2π/ω, once per forcing period, after the transient.  The time step is
 dt = P / round(P / dt_target) (P = 2π/ω) and the integrator saves every P/dt steps, so
 the saved states *are* the section (no interpolation).  The velocity is the
 integrator's backward difference (uⁿ − uⁿ⁻¹)/Δt.
+
+``--zeta Z`` adds Rayleigh damping B = αM + α_K K with the damping ratio Z at the beam's
+first two natural frequencies f1, f2 (:func:`skfem_beam.modes`, obstacles and support
+motion ignored; recomputed per value when L or k2 is swept); Z = 0 (the default) is the
+papers' undamped pipe, run exactly as before.  Every run records ζ, f1, f2, α, α_K.
 
 DIR receives, as runs finish, ``runs/<param>=<value>.json`` (written atomically); a
 sweep started again with the same settings skips the values whose file exists.  At
@@ -46,13 +51,14 @@ import numpy as np
 from . import cli, scenes
 from .errors import InputError, SolverError
 from .output.folder import EXIT_SOLVER, Folder, atomic_write, check_output_dir, stamp
-from .checks import check_beta, check_positive
+from .checks import check_beta, check_nonnegative, check_positive
 
 # scene name -> (problem factory, parameters that may be swept or set)
 SCENES = {
     "point_stops": (scenes.point_stops, ("omega", "amplitude", "gap", "k2", "L")),
 }
 SECTION = "tip_displacement"   # the observed value whose section is kept
+CHUNK = 20000                  # steps per call into the compiled loop
 
 
 # ---------------------------------------------------------------- inputs
@@ -104,7 +110,7 @@ def parse_values(spec: str) -> list[float]:
 
 
 def make_settings(scene="point_stops", param="omega", transient=2.0, periods=50,
-                  dt=5e-5, J=19, beta=0.5, element="hermite", solver="auto",
+                  dt=5e-5, J=19, beta=0.5, element="hermite", solver="auto", zeta=0.0,
                   **fixed) -> dict:
     """Everything a run depends on except the swept value (checked; JSON-able)."""
     defaults = scene_defaults(scene)
@@ -124,11 +130,27 @@ def make_settings(scene="point_stops", param="omega", transient=2.0, periods=50,
         raise InputError(f"J={J!r} must be a whole number ≥ 1")
     return {"scene": scene, "param": param, "fixed": fixed, "transient": transient,
             "periods": int(periods), "dt_target": check_positive("dt", dt), "J": int(J),
-            "beta": check_beta(beta), "element": str(element), "solver": str(solver)}
+            "beta": check_beta(beta), "element": str(element), "solver": str(solver),
+            "zeta": check_nonnegative("zeta", zeta)}
 
 
-def build_problem(settings: dict, value: float):
+def damping_of(settings: dict, value: float) -> dict:
+    """ζ, the first two natural frequencies f1, f2 (Hz) of the undamped scene's beam and
+    the Rayleigh pair (α, α_K) that gives ζ at both (zero when ζ = 0)."""
+    from .modes import modes
+    from .problem import Damping
+    f1, f2 = (float(f) for f in modes(build_problem(settings, value, None), 2).f)
+    zeta = settings["zeta"]
+    d = Damping.ratio(zeta, f1, f2) if zeta > 0 else Damping()
+    return {"zeta": zeta, "f1": f1, "f2": f2, "alpha": d.alpha, "alpha_K": d.alpha_K}
+
+
+def build_problem(settings: dict, value: float, damping: dict | None = None):
+    """The scene at ``value``; ``damping`` as :func:`damping_of` gives it (None: undamped)."""
+    from .problem import Damping
     kw = {**settings["fixed"], settings["param"]: float(value)}
+    if damping is not None and (damping["alpha"] or damping["alpha_K"]):
+        kw["damping"] = Damping(damping["alpha"], damping["alpha_K"])
     return SCENES[settings["scene"]][0](J=settings["J"], element=settings["element"], **kw)
 
 
@@ -147,7 +169,7 @@ def check_values(settings: dict, values: list[float]) -> None:
     for v in values:
         try:
             section_plan(settings, v)
-            build_problem(settings, v)
+            build_problem(settings, v, damping_of(settings, v))
         except InputError as e:
             raise InputError(f"--values: {e}") from None
 
@@ -158,10 +180,11 @@ def run_value(settings: dict, value: float) -> dict:
     """One parameter value → its Poincaré section and impact statistics (a plain dict).
 
     Deterministic: the same settings and value give the same numbers on any process.
-    The statistics cover the sampled window (after the transient) only; the transient
-    alone is run a second time to subtract its counts (it is a prefix of the full run).
+    The statistics cover the sampled window (after the transient) only: the counters
+    are read when the run reaches the end of the transient, and subtracted.
     """
-    from .scheme import solve
+    from .contact import resolve
+    from .scheme import Run, Stepping, drive
     from .semidiscrete import beam_system
     t_start, cpu_start = time.perf_counter(), time.process_time()
     dt, spp, ntr, omega = section_plan(settings, value)
@@ -171,38 +194,41 @@ def run_value(settings: dict, value: float) -> dict:
            "omega": omega, "dt": dt, "steps_per_period": spp, "transient_periods": ntr,
            "k": [], "t": [], "tip_displacement": [], "tip_velocity": [],
            "impacts": None, "impacts_per_period": None, "contact_fraction": None,
-           "impacts_total": None, "status": "success", "message": ""}
-    loop = 0.0
+           "impacts_total": None, "damping": None, "status": "success", "message": ""}
+    run = None
     try:
-        system = beam_system(build_problem(settings, value))
-        kw = dict(beta=settings["beta"], solver=settings["solver"], save_every=spp,
-                  frames=1, progress=False)
-        # T half a step short of n·dt: solve takes ceil(T/dt) = n steps whatever the round-off
-        full = solve(system, dt, (n_total - 0.5) * dt, **kw)
-        loop += full.wall_time_s
+        out["damping"] = damping_of(settings, value)
+        system = beam_system(build_problem(settings, value, out["damping"]))
+        # T half a step short of n·dt: the run takes ceil(T/dt) = n steps whatever the round-off
+        run = Run(system, Stepping(dt, (n_total - 0.5) * dt, settings["beta"], save_every=spp,
+                                   frames=1), resolve(settings["solver"]))
+        pre = {"impacts": 0, "contacts": 0}
+        while not run.done and run.n < n_trans:
+            run.advance(min(run.n + CHUNK, n_trans))
+        if run.n == n_trans >= 2:
+            r = run.result()
+            pre.update(impacts=r.impacts, contacts=round(r.contact_fraction * (n_trans - 1)))
+        drive(run, CHUNK, progress=False)
+        full = run.result()
         if full.status != "success":
             out.update(status=full.status, message=full.message)
         else:
-            imp_t, con_t = 0, 0
-            if n_trans >= 2:
-                pre = solve(system, dt, (n_trans - 0.5) * dt, **kw)
-                loop += pre.wall_time_s
-                imp_t, con_t = pre.impacts, round(pre.contact_fraction * (n_trans - 1))
             con = round(full.contact_fraction * (n_total - 1))
             keep = slice(ntr + 1, ntr + periods + 1)
             k = np.arange(ntr + 1, ntr + periods + 1)
             out.update(k=k.tolist(), t=(k * (spp * dt)).tolist(),
                        tip_displacement=full.observed[SECTION][keep].tolist(),
                        tip_velocity=full.velocity[SECTION][keep].tolist(),
-                       impacts=full.impacts - imp_t,
-                       impacts_per_period=(full.impacts - imp_t) / periods,
-                       contact_fraction=(con - con_t) / (n_total - n_trans),
+                       impacts=full.impacts - pre["impacts"],
+                       impacts_per_period=(full.impacts - pre["impacts"]) / periods,
+                       contact_fraction=(con - pre["contacts"]) / (n_total - n_trans),
                        impacts_total=full.impacts)
     except (InputError, SolverError) as e:
         out.update(status="failed", message=str(e))
     out["timing"] = {"task_s": time.perf_counter() - t_start,
-                     "task_cpu_s": time.process_time() - cpu_start, "time_loop_s": loop,
-                     "steps": n_total + n_trans, "pid": os.getpid()}
+                     "task_cpu_s": time.process_time() - cpu_start,
+                     "time_loop_s": 0.0 if run is None else run.wall, "steps": n_total,
+                     "pid": os.getpid()}
     return out
 
 
@@ -282,10 +308,12 @@ def assemble(out: Path, settings: dict, results: list[dict], extra: dict | None 
     atomic_write(out / "poincare.csv", lambda fh: _csv(
         fh, [param, "k", "t", "tip_displacement", "tip_velocity"], points))
     cols = ["omega", "dt", "steps_per_period", "transient_periods", "impacts",
-            "impacts_per_period", "contact_fraction", "impacts_total", "period", "status"]
+            "impacts_per_period", "contact_fraction", "impacts_total", "period"]
+    damp = ["zeta", "f1", "f2", "alpha", "alpha_K"]
     atomic_write(out / "runs.csv", lambda fh: _csv(
-        fh, [param] + [c for c in cols if c != param],
-        [[r["value"]] + [r[c] for c in cols if c != param] for r in results]))
+        fh, [param] + [c for c in cols if c != param] + damp + ["status"],
+        [[r["value"]] + [r[c] for c in cols if c != param]
+         + [(r.get("damping") or {}).get(c) for c in damp] + [r["status"]] for r in results]))
     bifurcation_chart(out / "bifurcation.png", settings, results)
     summary = {"settings": settings, "values": len(results),
                "failed": sum(r["status"] != "success" for r in results),
@@ -294,11 +322,20 @@ def assemble(out: Path, settings: dict, results: list[dict], extra: dict | None 
                          "t": "s", "contact_fraction": "fraction of time steps in contact",
                          "impacts": "contacts that start in the sampled window",
                          "period": "smallest p such that the section repeats every p forcing "
-                                   "periods (to 1e-6·gap); 0: none up to periods/2"},
+                                   "periods (to 1e-6·gap); 0: none up to periods/2",
+                         "zeta": "Rayleigh damping ratio at f1 and f2",
+                         "f1, f2": "the beam's first two natural frequencies (Hz), "
+                                   "obstacles and support motion ignored",
+                         "alpha, alpha_K": "B = alpha·M + alpha_K·K (1/s, s)"},
                **(extra or {}), **stamp()}
     atomic_write(out / "sweep.json", lambda fh: json.dump(summary, fh, indent=2,
                                                            ensure_ascii=False))
     return summary
+
+
+# periodic values, by period; no red (the stops) and no black (the irregular values)
+PERIOD_COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink",
+                 "tab:olive", "tab:cyan")
 
 
 def bifurcation_chart(path: Path, settings: dict, results: list[dict]) -> None:
@@ -308,10 +345,24 @@ def bifurcation_chart(path: Path, settings: dict, results: list[dict]) -> None:
              "gap": "gap (m)", "k2": "k² (m⁴/s²)", "L": "L (m)"}.get(param, param)
     with figure(path, figsize=(9, 6.5), dpi=120, nrows=2, sharex=True,
                 gridspec_kw={"height_ratios": [3, 1]}) as (fig, (ax, ax2)):
-        x = np.concatenate([[r["value"]] * len(r["tip_displacement"]) for r in results] or [[]])
-        y = np.concatenate([r["tip_displacement"] for r in results] or [[]])
-        ax.plot(x, y, ",", color="k", alpha=0.8)
-        ax.plot(x, y, ".", ms=1.2, color="k", alpha=0.5)
+        # periodic orbits in colour, one per period (1T, 2T, ...), the rest in black
+        periods = sorted({r.get("period") or 0 for r in results})
+        for i, p in enumerate(periods):
+            rs = [r for r in results if (r.get("period") or 0) == p]
+            x = np.concatenate([[r["value"]] * len(r["tip_displacement"]) for r in rs] or [[]])
+            y = np.concatenate([r["tip_displacement"] for r in rs] or [[]])
+            color = "k" if p == 0 else PERIOD_COLORS[(i - (0 in periods)) % len(PERIOD_COLORS)]
+            ax.plot(x, y, ",", color=color, alpha=0.8)
+            ax.plot(x, y, ".", ms=1.2 if p == 0 else 3, color=color, alpha=0.5 if p == 0 else 1,
+                    label=f"period {p}T ({len(rs)} value{'s' * (len(rs) > 1)})" if p else None)
+        f1 = {(r.get("damping") or {}).get("f1") for r in results} - {None}
+        if param == "omega" and len(f1) == 1:   # the beam's first natural frequency
+            w1 = 2 * math.pi * f1.pop()
+            for a in (ax, ax2):
+                a.axvline(w1, color="0.4", lw=0.8, ls=":")
+            ax.annotate(f"ω₁ = {w1:.3g}", (w1, 1.0), xycoords=("data", "axes fraction"),
+                        xytext=(2, -10), textcoords="offset points", fontsize=8,
+                        color="0.3")
         gap = settings["fixed"].get("gap")
         if gap is not None:
             for g in (-gap, gap):
@@ -322,8 +373,11 @@ def bifurcation_chart(path: Path, settings: dict, results: list[dict]) -> None:
         bad = [r["value"] for r in results if r["status"] != "success"]
         if bad:
             ax.plot(bad, [0.0] * len(bad), "x", color="tab:red", label="run failed / unstable")
+        if bad or any(periods):
             ax.legend(loc="upper right", fontsize=8)
         fixed = ", ".join(f"{k}={v:g}" for k, v in settings["fixed"].items())
+        zeta = settings["zeta"]
+        fixed += f"; ζ={zeta:g} at f1, f2 (Rayleigh)" if zeta else "; no damping"
         ax.set_title(f"{settings['scene']}: Poincaré section of the tip, once per forcing period\n"
                      f"({fixed}; {settings['periods']} periods after {settings['transient']:g} s, "
                      f"J={settings['J']}, β={settings['beta']:g}, Δt≈{settings['dt_target']:g} s)",
@@ -387,7 +441,7 @@ def lost(settings: dict, value: float, error: BaseException, attempts: int) -> d
             "omega": section_plan(settings, value)[3], "dt": None, "steps_per_period": None,
             "transient_periods": None, "k": [], "t": [], "tip_displacement": [],
             "tip_velocity": [], "impacts": None, "impacts_per_period": None,
-            "contact_fraction": None, "impacts_total": None, "status": "failed",
+            "contact_fraction": None, "impacts_total": None, "damping": None, "status": "failed",
             "message": f"{type(error).__name__} after {attempts} attempts: {error}",
             "timing": {"task_s": 0.0, "task_cpu_s": 0.0, "time_loop_s": 0.0, "steps": 0,
                        "pid": None}}
@@ -486,6 +540,9 @@ def parser():
     p.add_argument("--beta", type=float, default=0.5, help="Newmark β in [0, 1/2]")
     p.add_argument("--element", default="hermite", help="hermite | bspline")
     p.add_argument("--solver", default="auto", help="contact solver")
+    p.add_argument("--zeta", type=float, default=0.0,
+                   help="damping ratio (e.g. 0.02), Rayleigh, at the beam's first two natural "
+                        "frequencies; 0: undamped, as the papers")
     for name, default in scene_defaults("point_stops").items():
         p.add_argument(f"--{name}", type=float, default=argparse.SUPPRESS,
                        help=f"fixed value of {name} when not swept (default {default:g})")
@@ -503,7 +560,8 @@ def main(argv=None) -> int:
     args = parser().parse_args(argv)
     fixed = {n: getattr(args, n) for n in SCENES["point_stops"][1] if hasattr(args, n)}
     settings = make_settings(args.scene, args.param, args.transient, args.periods, args.dt,
-                             args.J, args.beta, args.element, args.solver, **fixed)
+                             args.J, args.beta, args.element, args.solver, args.zeta,
+                             **fixed)
     values = parse_values(args.values)
     check_values(settings, values)
     scheduler, workers = getattr(args, "scheduler", None), getattr(args, "workers", None)

@@ -1,23 +1,29 @@
-"""Parameter sweeps: same outputs on a Dask cluster and serially, resume, bad input."""
+"""Parameter sweeps: same outputs on a Dask cluster and serially, resume, bad input,
+the damped sweep's periodic windows."""
+import csv
 import json
 import math
 import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from conftest import assert_refused, exit_code
 from skfem_beam import beam_system, scenes, solve
-from skfem_beam.sweep import (dask_client, main, make_settings, parse_values,
-                              run_value, sweep)
+from skfem_beam.sweep import (dask_client, detect_period, main, make_settings,
+                              parse_values, run_value, sweep)
 
 SWEEP = [sys.executable, "-m", "skfem_beam.sweep"]
 # short runs: 3 forcing periods after 0.2 s, the paper's Δt
 SHORT = dict(transient=0.2, periods=3)
 OUTPUTS = ("poincare.csv", "runs.csv", "bifurcation.png")
+# the README's damped bifurcation diagram: ζ = 2 %, 60 s transient, 50 periods
+DAMPED_RUNS = Path(__file__).parents[1] / "docs" / "bifurcation_point_stops_damped_runs.csv"
+DAMPED = dict(transient=60.0, periods=50, zeta=0.02)
 
 
 def results_without_timing(out):
@@ -124,6 +130,8 @@ def test_interrupted_sweep_resumes_without_redoing(tmp_path):
     (["--workers", "-1"], "--workers -1"),
     (["--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], "not both"),
     (["--periods", "x"], "--periods"),
+    (["--zeta", "-0.01"], "zeta=-0.01 must be ≥ 0"),
+    (["--zeta", "nan"], "zeta=nan"),
 ])
 def test_bad_input_one_line_no_output(tmp_path, capsys, args, word):
     base = ["--values", "8,9", "--out", str(tmp_path / "sweep")]
@@ -197,3 +205,33 @@ def test_killed_worker_is_retried_then_marked_failed(tmp_path):
     assert runs[2].endswith(",failed") and runs[1].endswith(",success") \
         and runs[3].endswith(",success")
     assert sorted(f.name for f in (out / "runs").iterdir()) == ["omega=17.0.json", "omega=9.0.json"]
+
+
+@pytest.mark.parametrize("omega, period", [(21.0, 1), (34.2, 2)])
+def test_damped_section_collapses_to_the_charts_orbit(tmp_path, omega, period):
+    """With ζ = 2 % (Rayleigh at the first two natural frequencies) the section after the
+    chart's 60 s transient repeats every ``period`` forcing periods to 1e-6 m, as the
+    chart's CSV says; without damping the same ω never settles."""
+    chart = {float(r["omega"]): r for r in csv.DictReader(DAMPED_RUNS.open())}[omega]
+    assert chart["period"] == str(period) and chart["zeta"] == "0.02"
+    out = tmp_path / "damped"
+    sweep(make_settings("point_stops", "omega", **DAMPED), [omega], out, progress=False,
+          warm=False)
+    row = next(csv.DictReader((out / "runs.csv").open()))
+    assert row["period"] == str(period) and row["status"] == "success"
+    # the damping recorded is ζ = 0.02 at ω1, ω2, and ω1 is the cantilever's 1.8751²√k²/L²
+    w1, w2 = 2 * math.pi * float(row["f1"]), 2 * math.pi * float(row["f2"])
+    assert w1 == pytest.approx(1.875104068711961**2 * math.sqrt(scenes.PIPE_K2) / 1.501**2,
+                               rel=1e-6)
+    for w in (w1, w2):
+        zeta = float(row["alpha"]) / (2 * w) + float(row["alpha_K"]) * w / 2
+        assert zeta == pytest.approx(0.02, rel=1e-12)
+    u = np.array([float(r["tip_displacement"])
+                  for r in csv.DictReader((out / "poincare.csv").open())])
+    assert len(u) == 50 and np.abs(u[period:] - u[:-period]).max() <= 1e-6
+    if period > 1:   # a genuine subharmonic: consecutive points are centimetres apart
+        assert np.abs(u[1:] - u[:-1]).min() > 1e-2
+    bare = run_value(make_settings("point_stops", "omega", **{**DAMPED, "zeta": 0.0}), omega)
+    v = np.array(bare["tip_displacement"])
+    assert bare["damping"]["alpha"] == bare["damping"]["alpha_K"] == 0.0
+    assert detect_period(v, 1e-7) == 0 and np.abs(v[period:] - v[:-period]).max() > 1e-3

@@ -12,7 +12,7 @@ What a command writes (docs/design.md §5) comes back as plain numpy arrays:
 - ``summary``: summary.json as a dict (the strings "inf", "-inf", "nan" the writer made of
   non-finite floats are floats again);
 - ``series``: every column of timeseries.csv by its header name, whatever the command
-  wrote (probe columns included); 17 significant digits were written, so the values are
+  wrote (probe columns included); exact (shortest round-trip) digits were written, so the values are
   the run's own, bit for bit;
 - ``fields``: the field frames (:class:`SavedFields`) from ``fields.xdmf`` + ``fields.h5``,
   or from ``fields.pvd`` + ``fields_vtu/`` when there is no XDMF; None with ``--format

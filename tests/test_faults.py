@@ -192,10 +192,17 @@ SPOIL = {
                        lambda d: (d / "summary.json").write_bytes(b"\xff\xfe\x00garbage")),
     "cut series": ("fewer than the", lambda d: (d / "timeseries.csv").write_bytes(
         (d / "timeseries.csv").read_bytes()[:-500])),
-    "edited series": ("are not the ones the checkpoint was written with", lambda d: (
-        d / "timeseries.csv").write_text((d / "timeseries.csv").read_text().replace(
-            "\n0.0050000000000000001,", "\n0.0050000000000000002,", 1))),
+    "edited series": ("are not the ones the checkpoint was written with",
+                      lambda d: edit_row(d / "timeseries.csv", 100)),
 }
+
+
+def edit_row(csv, k):
+    """Change the time of row k by one unit in the last place (same length, same shape)."""
+    lines = csv.read_text().split("\n")
+    t, rest = lines[k].split(",", 1)
+    lines[k] = f"{np.nextafter(float(t), 1.0)!r},{rest}"
+    csv.write_text("\n".join(lines))
 
 
 @pytest.mark.parametrize("spoil", list(SPOIL))

@@ -44,7 +44,7 @@ def _run_case(module, main, monkeypatch, argv):
 
 def _assert_same_series(saved, data):
     assert list(saved.series) == list(data)
-    for k, v in data.items():    # 17 significant digits written: bit for bit
+    for k, v in data.items():    # exact digits written: bit for bit
         assert saved.series[k].shape == v.shape
         assert np.array_equal(saved.series[k], v, equal_nan=True), k
 

@@ -106,7 +106,7 @@ def run_bar_case(bar: Bar, args, config: dict | None = None) -> int:
     # energy split when it fits; else the run keeps --frames frames itself)
     field_every = max(1, series.n_steps // args.frames) if run.frame_every == 1 else run.frame_every
     stream = Series(series.columns, ready=series.ready, field_every=field_every,
-                    field_until=series.n_steps)
+                    field_until=series.n_steps, keep_all=True)   # errors need every row
 
     summary = {
         "case": CASE, "J": bar.N, "N": bar.N, "dt": run.dt, "T": series.n_steps * run.dt,

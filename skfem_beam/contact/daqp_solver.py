@@ -17,7 +17,6 @@ to round-off (`active_set.exact_finish`).
 """
 from __future__ import annotations
 
-import daqp
 import numpy as np
 import scipy.linalg
 
@@ -43,6 +42,7 @@ class DAQPSolver:
         self.Hs = self.H / self.s                    # f = −Ĥ y_f / s
         self.state = np.zeros(m, dtype=np.int8)
         self.repairs = 0
+        import daqp   # here, not at import: a run that does not use it does not load it
         self.model = daqp.Model()
         flag, _ = self.model.setup(self.H, np.zeros(m), np.zeros((0, m)),
                                    np.minimum(self.hi / self.s, DAQP_INF),

@@ -29,7 +29,6 @@ from __future__ import annotations
 import sys
 
 import numpy as np
-import osqp
 import scipy.sparse as sp
 
 from ..errors import SolverError
@@ -66,6 +65,8 @@ class OSQPSolver:
         self.state = np.zeros(self.lo.size, dtype=np.int8)
         self.zeros = np.zeros(self.lo.size)
         self.repairs = 0
+        import osqp   # here, not at import: a run that does not use it does not load it
+        self._solved = osqp.SolverStatus.OSQP_SOLVED
         self.prob = osqp.OSQP()
         self.prob.setup(sp.triu(A / abar, format="csc"), np.zeros(A.shape[0]), C,
                         self.lo / self.s, self.hi / self.s, verbose=False,
@@ -81,7 +82,7 @@ class OSQPSolver:
         finally:
             sys.stdout = out
         info = r.info
-        if info.status_val != osqp.SolverStatus.OSQP_SOLVED:
+        if info.status_val != self._solved:
             raise SolverError(f"OSQP returned status '{info.status}' after {info.iter} "
                               f"iterations")
         if info.status_polish not in _POLISH_OK:

@@ -8,7 +8,7 @@ and the summary; the field frames are written as they come.  With ``--checkpoint
 S`` the run's full state is written atomically (write, then rename) to
 ``checkpoint.npz``.  ``--resume DIR`` rebuilds the same run from ``summary.json``,
 restores the checkpoint, cuts the series back to it and continues: the result is
-identical, bit for bit, to an uninterrupted run (values are written with 17 significant
+identical, bit for bit, to an uninterrupted run (values are written with the exact shortest
 digits).
 
 What a command streams is a :class:`Series`: its columns, computed from the run's saved
@@ -45,7 +45,8 @@ CHECKPOINT_FORMAT = 2
 BUFFERS = ("obs", "obsv", "energy", "lam")   # the run's saved series (not in its checkpoint)
 
 
-KEEP_ROWS = 1 << 18       # rows kept whole in memory for the charts; beyond, an envelope
+PAGE = 4096              # bytes: the largest write (see SeriesFile._write)
+KEEP_ROWS = 1 << 16       # rows kept whole in memory for the charts; beyond, an envelope
 
 
 class Columns(dict):
@@ -69,11 +70,14 @@ class SeriesFile:
     rows).  One chunk at most is in flight; :meth:`sync` waits for it and re-raises its
     error.  ``nbytes`` and ``crc`` (zlib.crc32 of the file so far) go into every
     checkpoint, so that a resume can check the rows on disk are the ones it continues.
-    ``keep``: a checkpoint; the file is cut back to its rows (resume).
+    ``keep``: a checkpoint; the file is cut back to its rows (resume).  ``limit``: rows
+    held whole before the envelope (None: every row, for a command whose analysis needs
+    them all).
     """
 
-    def __init__(self, path: Path, names: list[str], keep: dict | None = None):
-        self.path, self.names = path, names
+    def __init__(self, path: Path, names: list[str], keep: dict | None = None,
+                 limit: int | None = KEEP_ROWS):
+        self.path, self.names, self.limit = path, names, limit
         self._chunks: list[dict] = []
         self._held, self.complete = 0, True
         self._writer, self._pending = ThreadPoolExecutor(max_workers=1), None
@@ -87,12 +91,12 @@ class SeriesFile:
             with open(path, "rb") as fh:
                 head = fh.read(self.nbytes)
             kept = head.split(b"\n")[1:-1]
-            # the rows a stopped process wrote come back exactly (17 digits round-trip)
+            # the rows a stopped process wrote come back exactly (written exactly)
             values = np.array([[float(v) for v in row.split(b",")] for row in kept]) \
                 .reshape(len(kept), len(names))
             self._chunks.append({k: values[:, i] for i, k in enumerate(names)})
             self._held = len(kept)
-            if self._held > KEEP_ROWS:
+            if self.limit is not None and self._held > self.limit:
                 self._reduce()
             self.fd = os.open(path, os.O_WRONLY)
             os.ftruncate(self.fd, self.nbytes)
@@ -100,10 +104,17 @@ class SeriesFile:
         self.sync()
 
     def _write(self, data: bytes) -> None:
+        """Whole rows in writes of at most a page: a process killed (SIGKILL) in the middle
+        of a large write() leaves a part of it, but not of a one-page write, so the file
+        ends on a whole row whenever the process dies."""
         try:
-            view = memoryview(data)
-            while view:
-                view = view[os.write(self.fd, view):]
+            start = 0
+            while start < len(data):
+                end = data.rfind(b"\n", start, start + PAGE) + 1 or len(data)
+                view = memoryview(data)[start:end]
+                while view:
+                    view = view[os.write(self.fd, view):]
+                start = end
         except OSError:
             self.cut()
             raise
@@ -120,7 +131,7 @@ class SeriesFile:
         cols = {k: np.array(columns[k], dtype=float) for k in self.names}
         self._chunks.append(cols)
         self._held += len(cols[self.names[0]])
-        if self._held > KEEP_ROWS:
+        if self.limit is not None and self._held > self.limit:
             self._reduce()
         self._wait()
         self._pending = self._writer.submit(self._write_rows, cols)
@@ -185,6 +196,7 @@ class Series:
     ready: Callable | None = None
     field_every: int = 0
     field_until: int | None = None
+    keep_all: bool = False      # finish needs every row (not only what a chart shows)
 
     def rows_ready(self, run: Run) -> int:
         return self.ready(run) if self.ready is not None else run.n // run.save_every + 1
@@ -489,7 +501,8 @@ def _stream(run, folder, args, series, finish, stop, used, ck, can_checkpoint) -
 
     try:
         try:
-            rows = SeriesFile(folder / "timeseries.csv", names, keep=ck)
+            rows = SeriesFile(folder / "timeseries.csv", names, keep=ck,
+                              limit=None if series.keep_all else KEEP_ROWS)
             fields = _Fields(folder.path, run, fmt, series) if fmt != "none" else None
             on_chunk(run)                      # state 1 (and, on resume, the frames so far)
             drive(run, chunk=getattr(args, "flush_every", 20000), on_chunk=on_chunk)

@@ -20,6 +20,7 @@ import argparse
 import hashlib
 import json
 import os
+import resource
 import signal
 import sys
 import threading
@@ -393,6 +394,8 @@ def outcome(result, data: dict) -> dict:
         "impacts": result.impacts, "contact_fraction": result.contact_fraction,
         "qp_iterations": result.qp_iterations, "status": result.status,
         "message": result.message,
+        # the process's peak resident memory so far (Linux: kB): flat in T, see KEEP_ROWS
+        "peak_rss_MB": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
     }
 
 

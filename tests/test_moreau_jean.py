@@ -70,3 +70,31 @@ def test_periodic_rod_converges_and_penetrates_order_dt():
 def test_bad_input_refused(kw, msg):
     with pytest.raises(InputError, match=msg):
         moreau_jean(rigid_mass(), 0.01, 0.1, **kw)
+
+
+@pytest.mark.parametrize("args, word", [
+    (["--restitution", "1.5"], "--restitution 1.5"), (["--restitution", "-0.1"], "-0.1"),
+    (["--mass", "foo"], "foo"), (["--law", "bogus"], "bogus"),
+    (["--law", "moreau-jean", "--solver", "osqp"], "osqp"),
+    (["--mass", "redistributed"], "redistributed"),      # the pipe is loaded: refused
+])
+def test_command_line_refuses_laws_and_masses_that_do_not_apply(args, word, tmp_path, capsys):
+    """One line naming the value, exit 2, nothing written (the issue's bad-input list)."""
+    from conftest import assert_refused
+    from skfem_beam.cases import point_stops
+    assert_refused(point_stops.main, args + ["--T", "0.01", "--out", str(tmp_path / "run")],
+                   word, capsys, tmp_path)
+
+
+def test_command_line_moreau_jean_and_restitution_run(tmp_path):
+    """--law moreau-jean and --restitution run the bar end to end and say so."""
+    import json
+    from conftest import exit_code
+    from skfem_beam.cases import impacting_bar
+    for args in (["--law", "moreau-jean"], ["--restitution", "0.5"]):
+        out = tmp_path / args[1]
+        assert exit_code(impacting_bar.main, args + ["--T", "0.5", "--out", str(out),
+                                                     "--format", "none"]) == 0
+        s = json.loads((out / "summary.json").read_text())
+        assert s["status"] == "success" and s["solver"] == {"moreau-jean": "moreau-jean",
+                                                              "0.5": "restitution"}[args[1]]

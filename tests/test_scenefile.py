@@ -174,7 +174,7 @@ def test_modes_command_prints_and_writes_the_cantilever_frequencies(tmp_path, ca
     assert x[0] == 0.0 and x[-1] == pytest.approx(1.501) and float(rows[1][3]) == 0.0
 
 
-def test_heat_exchanger_tube_rattles_in_both_baffles():
+def test_heat_exchanger_tube_rattles_in_both_baffles(tmp_path):
     scene = load(example("heat_exchanger_tube"))
     pb = scene.problem
     assert pb.ends == ("pinned", "pinned") and pb.damping.alpha > 0
@@ -185,6 +185,18 @@ def test_heat_exchanger_tube_rattles_in_both_baffles():
     assert r.status == "success" and r.max_nodal_violation <= 1e-10
     for x in (0.5, 1.0):
         assert (ev["x"] == x).sum() >= 5, x
+    # the command writes the statistics per baffle (N·s, N) and one impacts.csv row each
+    out = tmp_path / "hx"
+    assert exit_code(run_main, [str(example("heat_exchanger_tube")), "--out", str(out),
+                                "--format", "none"]) == 0
+    stats = json.loads((out / "summary.json").read_text())["impact_statistics"]
+    baffles = {o["where"]: o for o in stats["obstacles"]}
+    assert set(baffles) == {"point stops at x=0.5", "point stops at x=1"}
+    for o in baffles.values():
+        assert o["impacts"] == (ev["x"] == o["x"][0]).sum() and o["max_violation"] <= 1e-10
+        assert 0 < o["contact_fraction"] < 1 and o["max_impulse"] > 0
+    rows = list(csv.DictReader(open(out / "impacts.csv")))
+    assert len(rows) == len(ev["x"]) and stats["units"]["impulse"] == "N·s"
 
 
 def test_bar_with_elastic_obstacle_and_profile(tmp_path):

@@ -26,6 +26,7 @@ A killed run reads back up to its last flush (its summary says "running").
 from __future__ import annotations
 
 import csv
+import io
 import json
 import os
 import re
@@ -96,16 +97,19 @@ def _unplain(value):
 
 def read_csv(path: Path) -> dict[str, np.ndarray]:
     """A CSV with a header row as columns: floats where every value parses as one (parsed
-    exactly: 17 written digits come back bit for bit), strings otherwise."""
+    exactly: the digits written come back bit for bit), strings otherwise."""
     path = Path(path)
     with open(path, newline="") as fh:
         header = next(csv.reader([fh.readline()]), [])
         if not header:
             raise InputError(f"{path} has no header row")
-        try:    # the fast path: every value a number (numpy's parser rounds correctly)
-            values = np.loadtxt(fh, delimiter=",", ndmin=2, dtype=float)
-        except ValueError:
-            values = None
+        body = fh.read()
+    if not body.strip():          # a header alone: e.g. impacts.csv of a run without impact
+        return {name: np.zeros(0) for name in header}
+    try:    # the fast path: every value a number (numpy's parser rounds correctly)
+        values = np.loadtxt(io.StringIO(body), delimiter=",", ndmin=2, dtype=float)
+    except ValueError:
+        values = None
     if values is not None:
         if values.size == 0:
             values = np.zeros((0, len(header)))

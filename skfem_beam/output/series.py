@@ -36,7 +36,6 @@ import numpy as np
 from ..checks import check_count, check_nonnegative, check_positive
 from ..errors import InputError, SolverError
 from ..scheme import Run, drive
-from .charts import envelope
 from .fields import FieldWriter, check_format
 from .folder import (EXIT_SOLVER, SUMMARY, Folder, Interrupted, _plain, check_output_dir,
                      csv_rows, lock_folder, report)
@@ -48,13 +47,14 @@ BUFFERS = ("obs", "obsv", "energy", "lam")   # the run's saved series (not in it
 
 PAGE = 4096              # bytes: the largest write (see SeriesFile._write)
 KEEP_ROWS = 1 << 16       # rows kept whole in memory for the charts; beyond, an envelope
+BINS = 1000               # time bins of that envelope (a chart is about 1000 pixels wide)
 
 
 class Columns(dict):
     """The series a command's ``finish`` gets, name → array.  ``complete``: every row
-    written; False for a long run, whose rows are then the per-column envelope of
-    :func:`~skfem_beam.output.charts.envelope` (every extreme kept: what a chart shows),
-    so that memory stays flat however long the run."""
+    written; False for a long run, whose rows are then each column's extremes per time
+    bin (see SeriesFile._reduce: what a chart shows), so that memory stays flat however
+    long the run."""
     complete = True
 
 
@@ -80,7 +80,7 @@ class SeriesFile:
                  limit: int | None = KEEP_ROWS):
         self.path, self.names, self.limit = path, names, limit
         self._chunks: list[dict] = []
-        self._held, self.complete = 0, True
+        self._held, self.complete, self._width = 0, True, None
         self._writer, self._pending = ThreadPoolExecutor(max_workers=1), None
         if keep is None:
             self.fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
@@ -149,13 +149,26 @@ class SeriesFile:
             pending.result()          # its OSError (a full disk) goes on from here
 
     def _reduce(self) -> None:
-        """The rows held, reduced to the union of every column's envelope."""
+        """The rows held, reduced to each column's minimum and maximum in every time bin
+        (at most 2·BINS bins over the rows so far, the bin width doubling as the run
+        grows): what a chart can show, with every extreme kept, in bounded memory."""
         data = self.data()
         t = data[self.names[0]]
-        keep = np.unique(np.concatenate([np.searchsorted(t, envelope(t, data[k], 2000)[0])
-                                         for k in self.names[1:]] or [np.arange(t.size)]))
+        if self._width is None:
+            self._width = max((t[-1] - t[0]) / BINS, np.finfo(float).tiny)
+        while (t[-1] - t[0]) / self._width > 2 * BINS:
+            self._width *= 2
+        bins = np.floor((t - t[0]) / self._width).astype(np.int64)
+        starts = np.concatenate([[0], np.flatnonzero(np.diff(bins)) + 1])
+        counts = np.diff(np.concatenate([starts, [t.size]]))
+        keep = np.zeros(t.size, dtype=bool)
+        keep[starts] = keep[-1] = True
+        for k in self.names[1:]:
+            y = data[k]
+            for extreme in (np.minimum, np.maximum):
+                keep |= y == np.repeat(extreme.reduceat(y, starts), counts)
         self._chunks = [{k: v[keep] for k, v in data.items()}]
-        self._held, self.complete = keep.size, False
+        self._held, self.complete = int(keep.sum()), False
 
     def data(self) -> Columns:
         """The rows written so far, as columns (all of them, or their envelope)."""

@@ -165,8 +165,9 @@ class SeriesFile:
         keep[starts] = keep[-1] = True
         for k in self.names[1:]:
             y = data[k]
-            for extreme in (np.minimum, np.maximum):
-                keep |= y == np.repeat(extreme.reduceat(y, starts), counts)
+            for extreme in (np.minimum, np.maximum):   # its first row in each bin (ties:
+                hit = np.flatnonzero(y == np.repeat(extreme.reduceat(y, starts), counts))
+                keep[hit[np.unique(bins[hit], return_index=True)[1]]] = True   # one only)
         self._chunks = [{k: v[keep] for k, v in data.items()}]
         self._held, self.complete = int(keep.sum()), False
 

@@ -33,6 +33,19 @@ def _t(t) -> np.ndarray:
     return np.asarray(t, dtype=float)
 
 
+class _FromEval:
+    """φ(t), φ'(t), φ''(t) of a time function that evaluates any of them in ``_eval``."""
+
+    def __call__(self, t):
+        return self._eval(t, 0)
+
+    def d(self, t):
+        return self._eval(t, 1)
+
+    def dd(self, t):
+        return self._eval(t, 2)
+
+
 @dataclass(frozen=True)
 class Constant:
     """c, for every t (φ' = φ'' = 0)."""
@@ -85,7 +98,7 @@ class Sine:
 
 
 @dataclass(frozen=True)
-class SumOfSines:
+class SumOfSines(_FromEval):
     """Σ_k amplitudes[k] · sin(omegas[k]·t + phases[k])."""
     amplitudes: tuple[float, ...]
     omegas: tuple[float, ...]
@@ -103,22 +116,13 @@ class SumOfSines:
         object.__setattr__(self, "omegas", w)
         object.__setattr__(self, "phases", p)
 
-    def _sum(self, t, derivative):
+    def _eval(self, t, derivative):
         t = _t(t)
         out = np.zeros(t.shape)
         for a, w, p in zip(self.amplitudes, self.omegas, self.phases):
             arg = w * t + p
             out += a * w ** derivative * (np.sin(arg), np.cos(arg), -np.sin(arg))[derivative]
         return out
-
-    def __call__(self, t):
-        return self._sum(t, 0)
-
-    def d(self, t):
-        return self._sum(t, 1)
-
-    def dd(self, t):
-        return self._sum(t, 2)
 
 
 def band_limited(rms: float, f_low: float, f_high: float, seed: int = 0,
@@ -138,7 +142,7 @@ def band_limited(rms: float, f_low: float, f_high: float, seed: int = 0,
 
 
 @dataclass(frozen=True)
-class Table:
+class Table(_FromEval):
     """φ(t) given at times ``t`` (strictly increasing) by values ``phi``, interpolated by
     a not-a-knot cubic spline (module docstring); constant outside the table."""
     t: tuple[float, ...]
@@ -206,15 +210,6 @@ class Table:
         if derivative:
             return np.where((t < lo) | (t > hi), 0.0, inside)
         return inside
-
-    def __call__(self, t):
-        return self._eval(t, 0)
-
-    def d(self, t):
-        return self._eval(t, 1)
-
-    def dd(self, t):
-        return self._eval(t, 2)
 
 
 def derivative(f, order: int):

@@ -448,8 +448,10 @@ def lost(settings: dict, value: float, error: BaseException, attempts: int) -> d
 
 
 def _on_cluster(client, task, settings: dict, todo: list[float]):
-    """Results as they finish; a task that raises (a killed worker: KilledWorker) is
-    submitted again up to RETRIES times, then given up as :func:`lost`."""
+    """Results as they finish; a task that raises (a killed worker: KilledWorker) is tried
+    again, alone, up to RETRIES times after the others, then given up as :func:`lost`.
+    Alone: a worker that dies takes the tasks queued on it along, so a value retried
+    beside the one that kills it could be lost with it (seen once in CI)."""
     from distributed import as_completed
     attempts = {v: 1 for v in todo}
     key = {}
@@ -459,17 +461,23 @@ def _on_cluster(client, task, settings: dict, todo: list[float]):
         key[f.key] = v
         return f
 
-    queue = as_completed([submit(v) for v in todo])
-    for f in queue:
+    failed = {}
+    for f in as_completed([submit(v) for v in todo]):
         v = key[f.key]
         try:
             yield f.result()
         except Exception as e:     # the worker died (KilledWorker) or the task broke
-            if attempts[v] > RETRIES:
-                yield lost(settings, v, e, attempts[v])
-            else:
-                attempts[v] += 1
-                queue.add(submit(v))
+            failed[v] = e
+    for v, e in failed.items():
+        while attempts[v] <= RETRIES:
+            attempts[v] += 1
+            try:
+                yield submit(v).result()
+                break
+            except Exception as err:
+                e = err
+        else:
+            yield lost(settings, v, e, attempts[v])
 
 
 def sweep(settings: dict, values: list[float], out, client=None, progress: bool = True,

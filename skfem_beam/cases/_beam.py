@@ -12,12 +12,12 @@ from ..output.fields import physical_tip
 from ..output.probes import probe_columns, probe_units
 from ..output.series import execute, prepare
 from ..scheme import Stepping
+from ..scheme.kernels import WORK_TERMS
 from ..checks import check_positive
 from ..semidiscrete import add_probes, beam_system
 from ..spaces.redistribution import redistributed
 from ..stability import kappa_h, linear_limit
 
-WORK = ("damping", "input", "contact")      # Result.work's terms, in this order
 
 
 def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) -> int:
@@ -61,7 +61,7 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
         # work since state 1, in the units of energy: energy − energy[0] + damping
         # = input + contact (the scheme's identity, docs/design.md §3)
         work = run.work[k0:k1]
-        terms = {f"work_{name}": work[:, i] for i, name in enumerate(WORK)}
+        terms = {f"work_{name}": work[:, i] for i, name in enumerate(WORK_TERMS)}
         cols.update(terms)
         if rho_S:
             cols.update({f"{k}_J": v * rho_S for k, v in terms.items()})
@@ -75,7 +75,7 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
         joules = "energy_J" in data         # in J when the mass per length ρS is known
         energy_chart(folder / "energy.png", t, data["energy_J" if joules else "energy"],
                      title=f"{case}: discrete energy ½E_β ({about})",
-                     work={k: data[f"work_{k}" + ("_J" if joules else "")] for k in WORK},
+                     work={k: data[f"work_{k}" + ("_J" if joules else "")] for k in WORK_TERMS},
                      joules=joules)
         if np.any(data["contact_force"]):
             # in newtons when the mass per length ρS is known (the column is λ·ρS)
@@ -115,7 +115,7 @@ def units(rho_S, system) -> dict:
            "energy": f"½E_β, m³/s² {per_mass}; of u, relative to the lifted support motion",
            "contact_force": f"net nodal λ, m²/s² (N per kg/m), {per_mass}; positive upwards",
            **{f"work_{k}": f"m³/s² (as energy), {what}, cumulative since t = 0"
-              for k, what in zip(WORK, ("work lost in damping (≥ 0)",
+              for k, what in zip(WORK_TERMS, ("work lost in damping (≥ 0)",
                                         "work of the loads (the support's motion included)",
                                         "work of the contact forces (≤ 0 for exact contact)"))},
            "energy_balance": "energy − energy[0] + work_damping = work_input + work_contact "
@@ -123,6 +123,6 @@ def units(rho_S, system) -> dict:
     if rho_S:
         out.update({"contact_force_N": "N (contact_force × rho_S)",
                     "energy_J": "J (energy × rho_S)",
-                    **{f"work_{k}_J": f"J (work_{k} × rho_S)" for k in WORK},
+                    **{f"work_{k}_J": f"J (work_{k} × rho_S)" for k in WORK_TERMS},
                     "rho_S": f"{rho_S:g} kg/m"})
     return out

@@ -42,7 +42,7 @@ from .folder import (EXIT_SOLVER, SUMMARY, Folder, Interrupted, _plain, check_ou
 
 CHECKPOINT = "checkpoint.npz"
 CHECKPOINT_FORMAT = 2
-BUFFERS = ("obs", "obsv", "energy", "lam")   # the run's saved series (not in its checkpoint)
+BUFFERS = ("obs", "obsv", "energy", "work", "lam")   # saved series (not in the Run's checkpoint)
 
 
 PAGE = 4096              # bytes: the largest write (see SeriesFile._write)

@@ -54,6 +54,7 @@ State = namedtuple("State", [
 Series = namedtuple("Series", ["obs", "obsv", "energy", "work", "lam", "frames_u", "frames_v",
                                "frames_f", "events"])
 Inputs = namedtuple("Inputs", ["G", "phi"])
+WORK_TERMS = ("damping", "input", "contact")   # the columns of State.work and Series.work
 EVENT_COLUMNS = ("value", "start_step", "end_step", "velocity", "peak_force", "impulse",
                  "max_violation")
 FAILED, UNSTABLE, EVENTS_FULL = 1, 2, 3

@@ -16,9 +16,9 @@ from ..contact.registry import Auto
 from ..errors import InputError, SolverError
 from ..linalg import band_solve, rows_matvec
 from ..stability import kappa_h, linear_limit
-from .kernels import (EVENTS_FULL, FAILED, UNSTABLE, Inputs, Ops, PythonLaw, Series,
-                      State, call_explicit, call_law, move_bounds, csr_product,
-                      energy_beta, record, run_steps, run_steps_python)
+from .kernels import (EVENTS_FULL, FAILED, UNSTABLE, WORK_TERMS, Inputs, Ops, PythonLaw,
+                      Series, State, call_explicit, call_law, csr_product, energy_beta,
+                      move_bounds, record, run_steps, run_steps_python)
 from .operators import csr_arrays, step_operators
 from .stepping import Result, Stepping
 
@@ -445,5 +445,5 @@ class Run:
             max_penetration_below=float(st[1]), max_penetration_above=float(st[2]),
             impacts=int(c[0]), contact_fraction=float(c[1]) / max(1, self.n - 1),
             qp_iterations=int(c[2]),
-            work={k: out.work[:keep, i] for i, k in enumerate(("damping", "input", "contact"))},
+            work={k: out.work[:keep, i] for i, k in enumerate(WORK_TERMS)},
             impact_events=self.impact_events(), system=self.system)

@@ -9,17 +9,28 @@ L²(0, T; L²(0, L)) and max-in-time L²(0, L) errors of u (Gauss points inside 
 element), the largest nodal penetration max(−u(0, tₙ)), the relative energy drift
 (E(T) − E(0))/E(0) of the scheme's ½E_β, and the rates log₂(e_h/e_{h/2}).  The scene is
 :func:`skfem_beam.scenes.periodic_rod` (L = c = 1, u0 = ½ − x/2, exact energy 1/8).
+
+    python -m skfem_beam.bench.rod_study --classes [--N 80] [--out docs]
+
+Every class and option at one N (default 80), Δt/h = 0.04 and 0.4, T = 12, one row of
+:data:`SETTINGS` each (a new option is one more row): the errors, penetration, drift and
+time loop of :func:`skfem_beam.bench.work_precision.rung`, printed as a table and written
+to ``rod_study.csv`` in --out, then the best setting at each Courant number against the
+issue's targets (:func:`verdict`).  About a minute once the kernels are compiled.
 """
 from __future__ import annotations
 
 import argparse
+import csv
 import math
+from pathlib import Path
 
 import numpy as np
 
 from .. import scenes
 from ..bar import l2_time, run_bar
 from ..reference import exact_of
+from .work_precision import COURANTS, rung
 
 KEYS = ("l2_u0", "l2_u", "linf_l2_u")
 
@@ -85,15 +96,106 @@ def table(rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
+# (label, class, mass, how to run), as work_precision.METHODS: every class and option
+SETTINGS = [
+    *[(f"position, {mass}, β={b}, e={e:g}", "position", mass, dict(beta=beta, restitution=e))
+      for mass in ("average", "consistent", "lumped")
+      for b, beta in (("1/4", 0.25), ("1/2", 0.5)) for e in (0.0, 0.5, 1.0)],
+    *[(f"Moreau–Jean, average, θ={th}, e={e:g}", "moreau-jean", "average",
+       dict(theta=theta, restitution=e))
+      for th, theta in (("1/2", 0.5), ("1", 1.0)) for e in (0.0, 1.0)],
+    ("penalty k=1e3, average, β=1/4", "penalty", "average", dict(beta=0.25, stiffness=1e3)),
+    ("penalty k=1e5, average, β=1/4", "penalty", "average", dict(beta=0.25, stiffness=1e5)),
+    ("modified mass (redistributed), β=1/2", "modified mass", "redistributed", dict(beta=0.5)),
+]
+# the issue's targets: no penetration (round-off), |drift| ≤ 0.5 % over T = 12
+PENETRATION_TOL, DRIFT_TOL = 1e-12, 0.005
+COLUMNS = (("penetr.", "penetration", "8.1e"), ("drift %", "energy_drift", "+8.3f"),
+           ("L∞L² u", "linf_l2_u", "9.2e"), ("L²H¹ u", "l2_h1_u", "9.2e"),
+           ("L²L² u_t", "l2_l2_ut", "9.2e"), ("L² σ(0)", "l2_stress", "9.2e"),
+           ("L² u(0)", "error", "9.2e"), ("loop s", "wall_time_s", "7.4f"))
+
+
+def class_rows(N: int = 80, settings=SETTINGS, courants=COURANTS):
+    """One row of :func:`work_precision.rung` per setting and Courant number."""
+    for setting in settings:
+        for courant in courants:
+            yield rung("rod", setting, N, courant)
+
+
+def class_line(r: dict) -> str:
+    cells = [f"{100 * r[key] if key == 'energy_drift' else r[key]:{fmt}}"
+             for _, key, fmt in COLUMNS]
+    return f"{r['method']:40s} {r['courant']:5g} " + " ".join(cells)
+
+
+def class_header() -> str:
+    return f"{'setting':40s} {'Δt/h':>5} " + " ".join(
+        f"{name:>{int(fmt.split('.')[0].lstrip('+'))}}" for name, _, fmt in COLUMNS)
+
+
+def meets(r: dict) -> bool:
+    """Both targets: no penetration and |drift| ≤ 0.5 %."""
+    return r["penetration"] <= PENETRATION_TOL and abs(r["energy_drift"]) <= DRIFT_TOL
+
+
+def verdict(rows: list[dict], courant: float) -> dict:
+    """At one Courant number, the row with the smallest u(0) error: of all rows ("any"),
+    of those that do not penetrate ("exact"), of those that meet both targets
+    ("targets"; None when no row does)."""
+    sel = [r for r in rows if r["courant"] == courant and r["status"] == "success"]
+    best = lambda rs: min(rs, key=lambda r: r["error"]) if rs else None  # noqa: E731
+    return {"courant": courant, "any": best(sel),
+            "exact": best([r for r in sel if r["penetration"] <= PENETRATION_TOL]),
+            "targets": best([r for r in sel if meets(r)])}
+
+
+def verdict_text(v: dict) -> str:
+    lines = [f"Δt/h = {v['courant']:g}:"]
+    for key, what in (("any", "smallest u(0) error"),
+                      ("exact", "smallest u(0) error without penetration"),
+                      ("targets", "smallest u(0) error, no penetration, |drift| ≤ 0.5 %")):
+        r = v[key]
+        lines.append(f"  {what}: " + ("none" if r is None else
+                                     f"{r['method']} ({r['error']:.3g}, drift "
+                                     f"{100 * r['energy_drift']:+.2f} %, penetration "
+                                     f"{r['penetration']:.1e})"))
+    return "\n".join(lines)
+
+
+def classes(N: int, out: Path) -> list[dict]:
+    """The study of every class: print it, write ``out``/rod_study.csv, say the verdict."""
+    print(class_header(), flush=True)
+    rows = []
+    for row in class_rows(N):
+        rows.append(row)
+        print(class_line(row), flush=True)
+    out.mkdir(parents=True, exist_ok=True)
+    with open(out / "rod_study.csv", "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    for courant in COURANTS:
+        print(verdict_text(verdict(rows, courant)))
+    print(f"written {out}/rod_study.csv")
+    return rows
+
+
 def main(argv=None) -> None:
     p = argparse.ArgumentParser(prog="skfem_beam.bench.rod_study", description=__doc__)
-    p.add_argument("--N", default="20,40,80,160")
+    p.add_argument("--classes", action="store_true",
+                   help="every class and option at one N (the first of --N; default 80)")
+    p.add_argument("--out", default="docs", help="folder for rod_study.csv (--classes)")
+    p.add_argument("--N", default=None, help="default 20,40,80,160 (80 with --classes)")
     p.add_argument("--courant", default="0.4,0.04")
     p.add_argument("--T", type=float, default=12.0)
     p.add_argument("--mass", default="consistent,lumped,average")
     p.add_argument("--beta", default="0.25,0.5")
     args = p.parse_args(argv)
-    Ns = [int(n) for n in args.N.split(",")]
+    if args.classes:
+        classes(int(args.N.split(",")[0]) if args.N else 80, Path(args.out))
+        return
+    Ns = [int(n) for n in (args.N or "20,40,80,160").split(",")]
     rows = []
     for mass in args.mass.split(","):
         for beta in (float(b) for b in args.beta.split(",")):

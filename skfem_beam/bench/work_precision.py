@@ -30,6 +30,7 @@ import numpy as np
 
 from .. import scenes
 from ..bar import bar_system, l2_time
+from ..contact import resolve
 from ..reference import exact_of
 from ..scheme import solve
 from ..scheme.moreau_jean import moreau_jean
@@ -50,10 +51,14 @@ STYLE = {"position": "-", "penalty": "--", "moreau-jean": "-.", "modified mass":
 
 
 def run_method(system, dt, T, kw, frames):
+    """One run of a setting: ``kw`` holds beta, or theta (Moreau–Jean), and optionally
+    stiffness (penalty) and restitution e (e = 0: the papers' scheme, bit for bit)."""
+    e = kw.get("restitution", 0.0)
     if "theta" in kw:
-        return moreau_jean(system, dt, T, theta=kw["theta"], frames=frames, progress=False)
-    return solve(system, dt, T, kw["beta"], stiffness=kw.get("stiffness"), frames=frames,
-                 progress=False)
+        return moreau_jean(system, dt, T, theta=kw["theta"], restitution=e, frames=frames,
+                           progress=False)
+    law = resolve("auto", kw.get("stiffness"), e)
+    return solve(system, dt, T, kw["beta"], law, frames=frames, progress=False)
 
 
 def field_errors(result, exact, points: int = 4) -> dict:

@@ -16,7 +16,7 @@ Every class and option at one N (default 80), Δt/h = 0.04 and 0.4, T = 12, one 
 :data:`SETTINGS` each (a new option is one more row): the errors, penetration, drift and
 time loop of :func:`skfem_beam.bench.work_precision.rung`, printed as a table and written
 to ``rod_study.csv`` in --out, then the best setting at each Courant number against the
-issue's targets (:func:`verdict`).  About a minute once the kernels are compiled.
+issue's targets (:func:`verdict`).  About 15 s once the kernels are compiled.
 """
 from __future__ import annotations
 

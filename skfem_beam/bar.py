@@ -359,7 +359,7 @@ def steps_to(T: float, dt: float) -> int:
 
 def bar_run(bar: Bar, dt: float, T: float, beta: float = 0.25, method: str = "contact",
             solver: str = "auto", frames: int = 200, all_states_limit: int = 4_000_000,
-            restitution: float = 0.0):
+            restitution: float = 0.0, massless: str = "beta"):
     """The bar's :class:`~skfem_beam.scheme.Run` (not yet driven), to T + Δt.
 
     rigid + contact: the Signorini condition u(0) ≥ 0 (one constrained value, so the
@@ -369,6 +369,7 @@ def bar_run(bar: Bar, dt: float, T: float, beta: float = 0.25, method: str = "co
     T so that the force centred on t_N is known.  It saves every step (the reaction at
     tₙ comes from step n + 1) and keeps every state as a frame when there are at most
     ``all_states_limit`` values (the energy split needs them); else ``frames`` frames.
+    ``massless``: how a redistributed mass's contact node steps (see Stepping).
     """
     check_choice("method", method, METHODS)
     from .contact import resolve
@@ -376,7 +377,7 @@ def bar_run(bar: Bar, dt: float, T: float, beta: float = 0.25, method: str = "co
     system = bar_system(bar)
     if _spring(bar, method) and bar.k == 0:
         raise InputError("k=0 must be > 0 for a penalty spring")
-    to_T = Stepping(dt, T, beta)                  # the checks of Δt, T and β
+    to_T = Stepping(dt, T, beta, massless=massless)   # the checks of Δt, T, β, massless
     n_steps = to_T.steps
     every_state = (n_steps + 2) * system.n <= all_states_limit
     stepping = replace(to_T, T=n_steps * dt + dt, frames=n_steps + 1 if every_state else frames)
@@ -486,10 +487,12 @@ class BarSeries:
 
 
 def run_bar(bar: Bar, dt: float, T: float, beta: float = 0.25, method: str = "contact",
-            solver: str = "auto", all_states_limit: int = 4_000_000) -> BarRun:
+            solver: str = "auto", all_states_limit: int = 4_000_000,
+            massless: str = "beta") -> BarRun:
     """Integrate the bar with the shared scheme (:func:`bar_run`, driven to its end)."""
     from .scheme import drive
-    run = bar_run(bar, dt, T, beta, method, solver, all_states_limit=all_states_limit)
+    run = bar_run(bar, dt, T, beta, method, solver, all_states_limit=all_states_limit,
+                  massless=massless)
     drive(run)
     series = BarSeries(bar, run, T, method)
     return series.bar_run(series.rows(run, 0, series.ready(run)), run.result())

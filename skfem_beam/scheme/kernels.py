@@ -36,6 +36,7 @@ Ops = namedtuple("Ops", [
     "Op", "Oi", "Ox",                 # observed values (e.g. the tip)
     "Sp", "Si", "Sx", "slo", "shi",   # penetration samples between the nodes and their bounds
     "params",                         # the contact law's constants
+    "Zr", "Zp", "Zi", "Zx",           # quasi-static massless rows: their indices, K's rows
 ])
 State = namedtuple("State", [
     "u_prev", "u_cur",                # uⁿ⁻¹, uⁿ
@@ -50,10 +51,13 @@ State = namedtuple("State", [
                   #  Σ λΔt, max violation] of the contact under way (start −1: none)
     "r_e",                            # the law's explicit force (see contact.base)
     "x", "yf", "mu", "Ku", "d", "dy", # the step's free solution (then uⁿ⁺¹), C x, μ, K uⁿ,
-])                                    # scratch (n), C(uⁿ⁺¹ − uⁿ⁻¹)
+                                      # scratch (n), C(uⁿ⁺¹ − uⁿ⁻¹)
+    "ez",                             # the massless rows' explicit force of the step
+])
 Series = namedtuple("Series", ["obs", "obsv", "energy", "work", "lam", "frames_u", "frames_v",
                                "frames_f", "events"])
-Inputs = namedtuple("Inputs", ["G", "phi"])
+# H: the load at the quasi-static massless rows, (1−2β)fⁿ + βfⁿ⁻¹ there (0 rows: none)
+Inputs = namedtuple("Inputs", ["G", "phi", "H"], defaults=(np.zeros((0, 0)),))
 WORK_TERMS = ("damping", "input", "contact")   # the columns of State.work and Series.work
 EVENT_COLUMNS = ("value", "start_step", "end_step", "velocity", "peak_force", "impulse",
                  "max_violation")
@@ -71,9 +75,28 @@ def csr_product(Rp, Ri, Rx, u, y):
 
 
 @njit(cache=True, inline="always")
-def free_step(ops, st, Gn):
+def massless_force(ops, st, H, row):
+    """st.ez ← (1−2β) K_Z uⁿ + β K_Z uⁿ⁻¹ − H_Z (Z the quasi-static massless rows, needs
+    st.Ku = K uⁿ).  Added to the β-scheme's right-hand side Δt²(Gⁿ − K uⁿ) on Z it gives
+    βΔt²(f^{n+1} − K(2uⁿ − uⁿ⁻¹)): the row K u^{n+1} = f^{n+1} + Cᵀλ times β, so that A
+    stays M + βΔt²K (symmetric, banded).  It is the rows' part of the contact force that
+    the energy sees (β λ^{n+1} + st.ez), see scheme.operators."""
+    beta = ops.beta
+    for q in range(ops.Zr.size):
+        s = 0.0
+        for p in range(ops.Zp[q], ops.Zp[q + 1]):
+            s += ops.Zx[p] * st.u_prev[ops.Zi[p]]
+        s = (1.0 - 2.0 * beta) * st.Ku[ops.Zr[q]] + beta * s
+        if H.shape[0]:
+            s -= H[row, q]
+        st.ez[q] = s
+
+
+@njit(cache=True, inline="always")
+def free_step(ops, st, Gn, H, row):
     """st.x ← the step without contact, st.yf ← C x, st.Ku ← K uⁿ (reused by the energy);
-    ``Gn``: the load coefficients Gⁿ of this step; st.r_e: the law's explicit force."""
+    ``Gn``: the load coefficients Gⁿ of this step; st.r_e: the law's explicit force;
+    ``H[row]``: the load at the quasi-static massless rows (see massless_force)."""
     dt2 = ops.dt * ops.dt
     x, u_cur, u_prev = st.x, st.u_cur, st.u_prev
     rows_matvec(ops.Kb, u_cur, st.Ku)
@@ -90,6 +113,10 @@ def free_step(ops, st, Gn):
         for i in range(st.d.size):
             st.d[i] = u_cur[i] - u_prev[i]
         rows_matvec(ops.Bb, st.d, x, -ops.dt, True)
+    if ops.Zr.size:
+        massless_force(ops, st, H, row)
+        for q in range(ops.Zr.size):
+            x[ops.Zr[q]] += dt2 * st.ez[q]
     band_solve(ops.Achol, x)
     for i in range(x.size):
         x[i] += 2.0 * u_cur[i] - u_prev[i]
@@ -119,6 +146,19 @@ def finish_step(ops, st, Gn):
         for i in range(x.size):
             s += ops.loads[i, k] * d[i]
         st.work[1] += 0.5 * Gn[k] * s
+    if ops.Zr.size:
+        # quasi-static massless rows: the energy sees β λ^{n+1} + ez there, and end_step
+        # counts λ^{n+1} (the law's μ is Δt²λ^{n+1}, W and D carry the β)
+        s = 0.0
+        for q in range(ops.Zr.size):
+            s += st.ez[q] * d[ops.Zr[q]]
+        for j in range(mu.size):
+            if mu[j] != 0.0:
+                c = 0.0
+                for p in range(ops.Cp[j], ops.Cp[j + 1]):
+                    c += ops.Cx[p] * d[ops.Ci[p]]
+                s += (ops.beta - 1.0) * mu[j] / (ops.dt * ops.dt) * c
+        st.work[2] += 0.5 * s
     for i in range(x.size):
         st.u_prev[i] = st.u_cur[i]
         st.u_cur[i] = x[i]
@@ -293,7 +333,7 @@ def run_steps(law, explicit, ops, st, out, n0, n1, inputs, Ebound):
         Gn = inputs.G[step - n0]
         move_bounds(ops, st, inputs.phi[step - n0])
         explicit(st.y_cur, st.y_prev, st.lo, st.hi, ops.params, st.r_e)
-        free_step(ops, st, Gn)
+        free_step(ops, st, Gn, inputs.H, step - n0)
         its = call_law(law, ops, st)
         if its < 0:
             st.counters[3] = step + 1
@@ -331,7 +371,7 @@ def run_steps_python(ops, st, out, n0, n1, inputs, Ebound):
     e.g. OSQP or daqp, set up for bounds at rest): the compiled loop calls it for μ."""
     for step in range(n0, n1):
         Gn = inputs.G[step - n0]
-        free_step(ops, st, Gn)
+        free_step(ops, st, Gn, inputs.H, step - n0)
         with objmode(its="int64"):
             its = _solve_in_python()
         if its < 0:

@@ -39,7 +39,6 @@ from dataclasses import replace
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg
 from numba import njit
 
 from ..checks import check_finite
@@ -49,7 +48,7 @@ from ..contact.restitution import Restitution
 from ..errors import InputError
 from ..linalg import Banded, band_solve, rows_dot, rows_matvec
 from .kernels import FAILED, UNSTABLE, Inputs, Series, csr_product, track_impacts
-from .operators import csr_arrays, step_operators
+from .operators import csr_arrays, load_norms, step_operators
 from .run import FIRST_ROWS, Run
 from .solve import drive
 from .stepping import Result, Stepping
@@ -234,9 +233,7 @@ class MoreauJean(Run):
                                       s.dt, th * th)
         self.pysolver = None
         self.loads = np.ascontiguousarray(system.loads, dtype=float)
-        self.Minv_norm = np.sqrt(np.array([lv @ scipy.sparse.linalg.spsolve(system.M.tocsc(), lv)
-                                           for lv in self.loads.T])) \
-            if self.loads.shape[1] else np.zeros(0)
+        self.load_norm = load_norms(system, s.dt, th * th)
         O = sp.csr_matrix(np.vstack(list(system.observe.values()))) if system.observe \
             else sp.csr_matrix((0, n))
         if system.sample_E is not None and system.sample_E.shape[0]:

@@ -2,6 +2,18 @@
 
     A = M + Δt/2 B + Δt²βK  (factored, banded),   M/Δt² + βK  (the energy's),
     W = A⁻¹Cᵀ,   D = C A⁻¹ Cᵀ  (the Delassus matrix the contact laws see).
+
+Massless rows (a redistributed mass) step in one of two ways (``massless``):
+
+- "beta": like every row, by the β-weighted K row β u^{n+1} + (1−2β)uⁿ + βu^{n−1}
+  (= Gⁿ + Cᵀλ there).  At β = 1/4 its recursion has the double root −1: the node
+  oscillates step to step.
+- "quasi-static": equilibrium at the new time, K u^{n+1} = f^{n+1} + Cᵀλ^{n+1} on those
+  rows (no recursion, nothing to oscillate).  Written times β, the row's matrix is A's
+  own row (M is zero there), so A stays M + βΔt²K, symmetric and banded; the rest of the
+  row goes to the right-hand side as the explicit force of kernels.massless_force.  The
+  constraint acts on massless dofs only, so the contact term is βΔt²Cᵀλ: W and D carry
+  the β and the law's μ is Δt²λ^{n+1}, the nodal reaction at t_{n+1}.
 """
 from __future__ import annotations
 
@@ -9,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
 from ..errors import InputError
 from ..linalg import Banded, band_solve
@@ -23,12 +36,36 @@ class StepOperators:
     Bb: np.ndarray      # damping rows, (0, 1) when there is none
     C: sp.csr_matrix
     W: np.ndarray       # A⁻¹Cᵀ (n × m)
-    D: np.ndarray       # C A⁻¹ Cᵀ (m × m)
+    D: np.ndarray       # C A⁻¹ Cᵀ (m × m), both times β with quasi-static massless rows
+    Z: np.ndarray       # the quasi-static massless rows (empty with massless="beta")
 
 
-def step_operators(system, dt: float, beta: float) -> StepOperators:
+def massless_rows(M) -> np.ndarray:
+    """The dofs without inertia (their rows of M are zero: a redistributed mass)."""
+    return np.flatnonzero(np.asarray(abs(sp.csr_matrix(M)).sum(axis=1)).ravel() == 0)
+
+
+def load_norms(system, dt: float, beta: float) -> np.ndarray:
+    """‖b_k‖_{N⁻¹} for each load vector b_k: a step's load g = Σ_k Gⁿ_k b_k raises
+    √(½E_β) by at most Δt‖g‖_{N⁻¹} ≤ Δt Σ_k |Gⁿ_k| ‖b_k‖_{N⁻¹} (Run's a-priori bound).
+
+    Why: the work of a step is ½gᵀδ, δ = u^{n+1} − u^{n−1}, and
+    E_β = |δu|²_{M/Δt² + (β−¼)K} + |ū|²_K (δu = uⁿ − uⁿ⁻¹, ū = (uⁿ + uⁿ⁻¹)/2).  With
+    S = √E_β^{n+1} + √E_βⁿ, δ = δu^{n+1} + δuⁿ = 2(ū^{n+1} − ūⁿ) gives
+    |δ|²_{M/Δt² + (β−¼)K} ≤ S² and |δ|²_K ≤ 4S², so |δ|²_{M/Δt² + βK} ≤ 2S² for β ≥ 1/4:
+    N = M + βΔt²K, positive definite even where M has no inertia.  A regular M keeps
+    N = M (today's bound, looser: N ≥ M), so that those runs do not change."""
+    if not system.loads.shape[1]:
+        return np.zeros(0)
+    N = system.M if massless_rows(system.M).size == 0 else system.M + beta * dt**2 * system.K
+    N = N.tocsc()
+    return np.sqrt(np.array([lv @ spla.spsolve(N, lv) for lv in system.loads.T]))
+
+
+def step_operators(system, dt: float, beta: float, massless: str = "beta") -> StepOperators:
     M, K, B = system.M, system.K, system.B
-    massless = int((abs(M).sum(axis=1) == 0).sum())
+    Z = massless_rows(M)
+    quasi_static, massless = massless == "quasi-static", Z.size
     if massless and beta < 0.25:
         # a dof without inertia steps by the β-weighted K row alone, whose recursion has
         # a root of modulus > 1 for β < 1/4 (and A = M is singular at β = 0)
@@ -53,10 +90,21 @@ def step_operators(system, dt: float, beta: float) -> StepOperators:
         col = C[j].toarray().ravel()
         band_solve(Ab.chol, col)
         W[:, j] = col
+    if quasi_static and Z.size:
+        if B is not None:
+            raise InputError("massless='quasi-static' with damping is not supported (the "
+                             "massless rows' equilibrium would need the damping force); use "
+                             "massless='beta'")
+        if np.setdiff1d(C.indices, Z).size:
+            raise InputError("massless='quasi-static' needs constraints that act on massless "
+                             "dofs only (mass='redistributed')")
+        W *= beta       # the contact term of the rows times β (see the module docstring)
+    else:
+        Z = np.zeros(0, dtype=np.int64)
     D = np.ascontiguousarray((C @ W).reshape(m, m))
     return StepOperators(A=sp.csr_matrix(A), Ab=Ab, Eb=Banded(E), Kb=Banded(K),
                          Bb=Banded(B).rows if B is not None else np.zeros((0, 1)),
-                         C=C, W=W, D=D)
+                         C=C, W=W, D=D, Z=Z.astype(np.int64))
 
 
 def csr_arrays(a):

@@ -7,7 +7,6 @@ import time
 
 import numpy as np
 import scipy.sparse
-import scipy.sparse.linalg
 from numba.core import event
 
 from ..contact import ContactLaw, StepData, resolve
@@ -19,7 +18,7 @@ from ..stability import kappa_h, linear_limit
 from .kernels import (EVENTS_FULL, FAILED, UNSTABLE, WORK_TERMS, Inputs, Ops, PythonLaw,
                       Series, State, call_explicit, call_law, csr_product, energy_beta,
                       move_bounds, record, run_steps, run_steps_python)
-from .operators import csr_arrays, step_operators
+from .operators import csr_arrays, load_norms, step_operators
 from .stepping import Result, Stepping
 
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(4)
@@ -100,7 +99,7 @@ class Run:
         self.dt, self.beta, self.n_steps = s.dt, s.beta, n_steps
         self.save_every, self.frame_every = s.save_every, s.frame_every
         self.shift = 0.5 * s.dt if s.load_window == "centered" else 0.0
-        self.op = op = step_operators(system, s.dt, s.beta)
+        self.op = op = step_operators(system, s.dt, s.beta, s.massless)
         step = StepData(op.A, op.C, op.D, np.ascontiguousarray(system.lo, dtype=float),
                         np.ascontiguousarray(system.hi, dtype=float), s.dt, s.beta)
         law = resolve(law) if not isinstance(law, ContactLaw) else law
@@ -111,11 +110,12 @@ class Run:
         self.law, self.solver = law, law.name
         params = law.setup(step)
         self.pysolver = law.solver(step) if law.kernel is None else None
+        if op.Z.size and (law.kernel is None or law.explicit is not None):
+            raise InputError(f"massless='quasi-static' needs an exact compiled contact law "
+                             f"(projection, active-set, restitution), not {law.name!r}")
 
         self.loads = np.ascontiguousarray(system.loads, dtype=float)
-        self.Minv_norm = np.sqrt(np.array([lv @ scipy.sparse.linalg.spsolve(system.M.tocsc(), lv)
-                                           for lv in self.loads.T])) if self.loads.shape[1] \
-            else np.zeros(0)
+        self.load_norm = load_norms(system, s.dt, s.beta)
         Orows = scipy.sparse.csr_matrix(np.vstack(list(system.observe.values()))) \
             if system.observe else scipy.sparse.csr_matrix((0, system.n))
         if system.sample_E is not None and system.sample_E.shape[0]:
@@ -134,7 +134,8 @@ class Run:
             if moving and slo.size else np.zeros(0)
         self.ops = Ops(s.dt, s.beta, s.save_every, s.frame_every, op.Kb.rows, op.Bb,
                        op.Ab.chol, op.Eb.rows, self.loads, *csr_arrays(op.C), step.lo, step.hi,
-                       shift, sshift, op.W, op.D, *csr_arrays(Orows), *samples, slo, shi, params)
+                       shift, sshift, op.W, op.D, *csr_arrays(Orows), *samples, slo, shi, params,
+                       op.Z, *csr_arrays(system.K.tocsr()[op.Z]))
         n = system.n
         self.st = State(np.empty(n), np.empty(n), np.empty(m), np.empty(m),
                         step.lo.copy(), step.hi.copy(), slo.copy(), shi.copy(),
@@ -142,7 +143,7 @@ class Run:
                         np.zeros(4), np.zeros(6, np.int64), np.zeros(3),
                         np.full((m, 5), -1.0), np.zeros(m),
                         np.empty(n), np.empty(m), np.zeros(m), np.empty(n), np.empty(n),
-                        np.zeros(m))
+                        np.zeros(m), np.zeros(op.Z.size))
         nframes, nobs = n_steps // s.frame_every + 1, Orows.shape[0]
         rows = min(n_steps // s.save_every + 1, FIRST_ROWS)   # grown as the run needs them
         self.out = Series(np.full((rows, nobs), np.nan), np.full((rows, nobs), np.nan),
@@ -151,7 +152,7 @@ class Run:
                           np.zeros((nframes, m)), np.zeros((max(4096, 4 * m), 7)))
         self.events = []       # impact event rows taken from the compiled loop's buffer
         self._start(Orows, law.setup(step, first=True))
-        self.load_bound = 0.0  # Σ‖Gⁿ‖_{M⁻¹}Δt so far: the a-priori energy bound grows with it
+        self.load_bound = 0.0  # Σ‖Gⁿ‖_{N⁻¹}Δt so far: the a-priori energy bound grows with it
         self.n = 1             # the last computed state
         self.wall = 0.0
         self.status, self.message = "running", ""
@@ -184,6 +185,8 @@ class Run:
             + beta * dt**3 * (K @ v0) + 0.5 * dt**2 * f0
         if B is not None:
             F0 -= 0.5 * dt**2 * (B @ v0)
+        if op.Z.size:   # quasi-static massless rows: K u¹ = f¹ + Cᵀλ¹ there, times β
+            F0[op.Z] = beta * dt**2 * (self.loads[op.Z] @ self.load_averages(1, 1)[1])
         csr_product(self.ops.Cp, self.ops.Ci, self.ops.Cx, u0, st.y_prev)
         move_bounds(self.ops, st, self.motion(np.array([dt]))[0])   # the bounds at t₁
         kernel, explicit = self._kernels
@@ -230,10 +233,24 @@ class Run:
 
     def load_coefficients(self, n0, n1):
         """Gⁿ = βf^{n+1} + (1−2β)fⁿ + βf^{n−1} for n = n0..n1−1 (per chunk: flat memory)."""
-        nk = self.loads.shape[1]
-        if not nk:
+        if not self.loads.shape[1]:
             return np.zeros((n1 - n0, 0))
-        dt, beta = self.dt, self.beta
+        f, beta = self.load_averages(n0, n1), self.beta
+        return np.ascontiguousarray(beta * f[2:] + (1 - 2 * beta) * f[1:-1] + beta * f[:-2])
+
+    def massless_load(self, n0, n1):
+        """The load at the quasi-static massless rows, (1−2β)fⁿ + βf^{n−1} there, for
+        n = n0..n1−1 (kernels.massless_force); none without such rows or loads."""
+        Z = self.op.Z
+        if not (Z.size and self.loads.shape[1]):
+            return np.zeros((0, Z.size))
+        f, beta = self.load_averages(n0, n1), self.beta
+        return np.ascontiguousarray(((1 - 2 * beta) * f[1:-1] + beta * f[:-2]) @ self.loads[Z].T)
+
+    def load_averages(self, n0, n1):
+        """fᵐ_k, m = n0−1..n1: the load functions averaged over each step's window."""
+        nk = self.loads.shape[1]
+        dt = self.dt
         t = np.arange(n0 - 1, n1 + 1) * dt - self.shift
         f = np.empty((t.size, nk))
         for b in range(0, t.size, 4096):   # blocks that stay in cache: 1.7× faster (measured)
@@ -244,7 +261,7 @@ class Run:
                 v = np.asarray(a(s), dtype=float)
                 f[b:b + 4096, k] = (_GAUSS_W[0] * v[0] + _GAUSS_W[1] * v[1]
                                     + _GAUSS_W[2] * v[2] + _GAUSS_W[3] * v[3]) / 2.0
-        return np.ascontiguousarray(beta * f[2:] + (1 - 2 * beta) * f[1:-1] + beta * f[:-2])
+        return f
 
     @property
     def row0(self) -> int:
@@ -280,7 +297,8 @@ class Run:
         """The compiled loop over steps n0..n1−1 (see kernels.run_steps)."""
         self._hold_rows(n1 // self.save_every)
         if inputs is None:
-            inputs = Inputs(np.zeros((0, self.loads.shape[1])), np.zeros(0))
+            inputs = Inputs(np.zeros((0, self.loads.shape[1])), np.zeros(0),
+                            np.zeros((0, self.op.Z.size)))
         if self.pysolver is None:
             try:
                 return run_steps(*self._kernels, self.ops, self.st, self.out, n0, n1, inputs,
@@ -336,7 +354,7 @@ class Run:
             return
         t0 = time.perf_counter()
         G = self.load_coefficients(n0, n1)
-        self.load_bound += float((np.abs(G) @ self.Minv_norm).sum()) * self.dt \
+        self.load_bound += float((np.abs(G) @ self.load_norm).sum()) * self.dt \
             if G.shape[1] else 0.0
         # the bound grows with n: its chunk-end value is the loosest for the chunk
         Ebound = self.stepping.growth_limit * (math.sqrt(abs(self.E1)) + self.load_bound) ** 2 \
@@ -344,12 +362,15 @@ class Run:
         if not math.isfinite(Ebound):
             raise InputError(f"the load is too large for floating point: its work by step {n1} "
                              f"is {self.load_bound:g}")
-        inputs = Inputs(G, self.motion(np.arange(n0 + 1, n1 + 1) * self.dt))
+        inputs = Inputs(G, self.motion(np.arange(n0 + 1, n1 + 1) * self.dt),
+                        self.massless_load(n0, n1))
         code, at = self._steps(n0, n1, Ebound, inputs), n0
         while code == EVENTS_FULL:       # take the impact events, go on from where it stopped
             self._take_events()
             at, k = int(self.st.counters[3]), int(self.st.counters[3]) - n0
-            code = self._steps(at, n1, Ebound, Inputs(G[k:], inputs.phi[k:]))
+            code = self._steps(at, n1, Ebound, Inputs(G[k:], inputs.phi[k:],
+                                                      inputs.H[k:] if inputs.H.shape[0]
+                                                      else inputs.H))
         self._take_events()
         self.wall += time.perf_counter() - t0
         k = int(self.st.counters[3])

@@ -11,6 +11,7 @@ from ..checks import check_beta, check_choice, check_count, check_positive
 
 MAX_STEPS = 10**10        # beyond this a run is a hang, not a computation
 LOAD_WINDOWS = ("forward", "centered")
+MASSLESS = ("beta", "quasi-static")
 
 
 @dataclass(frozen=True)
@@ -21,7 +22,10 @@ class Stepping:
     (about); ``load_window``: fⁿ averages f over [tₙ, tₙ+Δt] ("forward", the papers'
     choice, first order) or [tₙ−Δt/2, tₙ+Δt/2] ("centered", second order);
     ``growth_limit``: the run is unstable when its energy exceeds this many times the
-    a-priori bound (√E¹ + Σ‖Gⁿ‖_{M⁻¹}Δt)².
+    a-priori bound (√E¹ + Σ‖Gⁿ‖_{N⁻¹}Δt)² (N = M, or M + βΔt²K when M has massless
+    rows: see operators.load_norms); ``massless``: how dofs without inertia (a
+    redistributed mass) step, "beta" (the β-weighted K row) or "quasi-static"
+    (equilibrium at t_{n+1}), see scheme.operators.
     """
     dt: float
     T: float
@@ -30,6 +34,7 @@ class Stepping:
     frames: int = 200
     load_window: str = "forward"
     growth_limit: float = 10.0
+    massless: str = "beta"
 
     def __post_init__(self):
         dt, T = check_positive("dt", self.dt), check_positive("T", self.T)
@@ -41,6 +46,7 @@ class Stepping:
         object.__setattr__(self, "growth_limit", check_positive("growth_limit",
                                                                  self.growth_limit))
         check_choice("load_window", self.load_window, LOAD_WINDOWS)
+        check_choice("massless", self.massless, MASSLESS)
         if self.steps < 2:
             raise InputError(f"dt={dt:g} must be at most T/2={T / 2:g}")
         if self.steps > MAX_STEPS:

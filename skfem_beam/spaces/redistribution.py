@@ -21,11 +21,13 @@ the space's interpolants of 1 and x.  It is refused when the constraints touch m
 than a quarter of the dofs (obstacles along the span: nothing would be left to carry
 the mass) or when M₀ + Δ is not positive definite on the dofs that keep mass.
 
-The step of a massless dof is quasi-static: its row of the scheme is the β-weighted
-K row, β u^{n+1} + (1−2β) uⁿ + β u^{n−1}.  At β = 1/4 that recursion has the double
-root −1 and the discrete energy does not control it (its M/Δt² + (β−1/4)K part is
-zero there): the massless node oscillates step to step.  At β = 1/2 the energy holds
-it (roots ±i, E_β ⊇ ¼δᵀKδ), and β = 0 makes the step matrix A = M singular (refused).
+The step of a massless dof is quasi-static.  By default (``Stepping(massless="beta")``)
+its row of the scheme is the β-weighted K row, β u^{n+1} + (1−2β) uⁿ + β u^{n−1}.  At
+β = 1/4 that recursion has the double root −1 and the discrete energy does not control
+it (its M/Δt² + (β−1/4)K part is zero there): the massless node oscillates step to
+step.  At β = 1/2 the energy holds it (roots ±i, E_β ⊇ ¼δᵀKδ), and β = 0 makes the
+step matrix A = M singular (refused).  ``massless="quasi-static"`` writes the row as
+equilibrium at the new time, K u^{n+1} = f^{n+1} + Cᵀλ^{n+1} (scheme.operators).
 """
 from __future__ import annotations
 
@@ -123,10 +125,7 @@ def rigid_modes(space) -> np.ndarray:
 
 def redistributed(system):
     """``system`` (a SemiDiscrete) with its mass redistributed away from the dofs its
-    constraints act on.  Refused with loads: the run's a-priori energy bound needs M⁻¹."""
-    if system.loads.shape[1]:
-        raise InputError("mass='redistributed' with a load (or a moving support) is not "
-                         "supported: the run's energy bound needs M⁻¹, which a massless "
-                         "dof does not have")
+    constraints act on.  Loads and moving supports are kept as they are (the run bounds
+    their work in the norm of (M + βΔt²K)⁻¹, see scheme.operators.load_norms)."""
     M = redistribute(system.M, system.K, massless_dofs(system.C), rigid_modes(system.space))
     return replace(system, M=M)

@@ -41,7 +41,7 @@ from .folder import (EXIT_SOLVER, SUMMARY, Folder, Interrupted, _plain, check_ou
                      csv_rows, lock_folder, report)
 
 CHECKPOINT = "checkpoint.npz"
-CHECKPOINT_FORMAT = 2
+CHECKPOINT_FORMAT = 3       # 3: impact events hold their first step off (State.impact)
 BUFFERS = ("obs", "obsv", "energy", "work", "lam")   # saved series (not in the Run's checkpoint)
 
 
@@ -205,13 +205,16 @@ class Series:
     of them) for the run's saved rows k0..k1−1; ``ready(run)``: how many saved rows are final
     (default: all computed so far); ``field_every``: steps between field frames, a multiple
     of ``run.frame_every`` (0: every frame the run keeps); ``field_until``: the last step
-    with a frame (None: the run's end).
+    with a frame (None: the run's end); ``events(folder, run, last)``: writes impacts.csv
+    and returns its summary entries (``last``: the last state the loop computed), on every
+    way a run ends: finished, unstable, interrupted, failed.
     """
     columns: Callable
     ready: Callable | None = None
     field_every: int = 0
     field_until: int | None = None
     keep_all: bool = False      # finish needs every row (not only what a chart shows)
+    events: Callable | None = None
 
     def rows_ready(self, run: Run) -> int:
         return self.ready(run) if self.ready is not None else run.n // run.save_every + 1
@@ -284,10 +287,12 @@ def read_checkpoint(folder: Path) -> dict:
     if missing:
         raise InputError(f"{path} has no {missing[0]!r} (not a checkpoint of this version); "
                          "cannot resume, nothing was changed")
-    if int(ck["format"]) != CHECKPOINT_FORMAT or \
-            _digest({k: v for k, v in ck.items() if k != "sha256"}) != str(ck["sha256"]):
+    if _digest({k: v for k, v in ck.items() if k != "sha256"}) != str(ck["sha256"]):
         raise InputError(f"{path} does not match its sha256 checksum (changed or cut); "
                          "cannot resume, nothing was changed")
+    if int(ck["format"]) != CHECKPOINT_FORMAT:
+        raise InputError(f"{path} is of checkpoint format {int(ck['format'])}, this version "
+                         f"reads format {CHECKPOINT_FORMAT}; cannot resume, nothing was changed")
     ck["config"] = json.loads(str(ck["config"]))
     return ck
 
@@ -508,6 +513,19 @@ def _stream(run, folder, args, series, finish, stop, used, ck, can_checkpoint) -
             save_checkpoint()
             last_ck = time.monotonic()
 
+    def write_events(last: int, quiet: bool = True) -> dict:
+        """impacts.csv of the events up to state ``last`` (its summary entries); nothing
+        when the command has none, or (``quiet``, a run already stopping on an error) when
+        the disk refuses it: that run's own error is the one to report."""
+        if series.events is None:
+            return {}
+        try:
+            return series.events(folder.path, run, last)
+        except OSError:
+            if not quiet:
+                raise
+            return {}
+
     def what_is_kept() -> str:
         t = (rows.rows - 1) * run.save_every * run.dt if rows is not None and rows.rows else 0.0
         ck_line = (f"the checkpoint at step {kept['step']} (t={kept['step'] * run.dt:.6g} s)"
@@ -533,6 +551,7 @@ def _stream(run, folder, args, series, finish, stop, used, ck, can_checkpoint) -
         data = rows.data()
         entries = outcome(run.result(), data)
         entries.update(finish(folder.path, data, run) or {})
+        entries.update(write_events(run.n, quiet=False))
     except Interrupted as e:
         name = signal.Signals(e.signum).name
         why = ""
@@ -542,6 +561,7 @@ def _stream(run, folder, args, series, finish, stop, used, ck, can_checkpoint) -
             except OSError as err:
                 why = f" (no new checkpoint: {err.strerror})"
         entries = outcome(run.result(), rows.data())
+        entries.update(write_events(run.n))
         folder.close(**{**entries, "status": "interrupted", "steps": run.n,
                         "message": f"interrupted by {name} at step {run.n} "
                                    f"(t={run.n * run.dt:.6g} s)"})
@@ -550,10 +570,11 @@ def _stream(run, folder, args, series, finish, stop, used, ck, can_checkpoint) -
         print(f"interrupted by {name}: {what_is_kept()}{why}; {resume}", file=sys.stderr)
         return e.code
     except SolverError as e:
-        folder.fail(e, steps=run.n)
+        # the loop stopped inside a chunk: its events reach the state before the failed step
+        folder.fail(e, steps=run.n, **write_events(int(run.st.counters[3]) - 1))
         raise
     except OSError as e:
-        folder.fail(e, steps=run.n, kept=what_is_kept())
+        folder.fail(e, steps=run.n, kept=what_is_kept(), **write_events(run.n))
         resume = (f"once there is room, continue with: {_command(folder.summary)} --resume "
                   f"{folder.path}" if kept["step"] is not None else
                   "without a checkpoint (--checkpoint-every) it cannot be resumed")

@@ -21,6 +21,7 @@ from skfem_beam import cli
 from skfem_beam.cases import impacting_bar, point_stops
 from skfem_beam.contact import ContactLaw
 from skfem_beam.errors import SolverError
+from skfem_beam.output import series
 from skfem_beam.results import read_run
 from skfem_beam.scheme import Run
 
@@ -359,3 +360,27 @@ def test_output_flags_are_checked(tmp_path, capsys, main, flag, value):
     assert err.count("\n") == 1 and value in err and \
         flag.lstrip("-") in err.replace("_", "-"), err
     assert not list(tmp_path.iterdir())
+
+
+def test_resume_of_a_long_run_reads_no_row(tmp_path, monkeypatch):
+    """A run longer than the rows kept whole (KEEP_ROWS, made 1,000 here) checkpoints its
+    chart envelope: --resume checks the rows on disk (CRC, block by block) and parses
+    none of them, and ends with the same files, charts included, as one run to the end."""
+    monkeypatch.setattr(series, "KEEP_ROWS", 1000)
+    argv = ["--dt", "1e-4", "--flush-every", "500", "--format", "none"]
+    whole, part = tmp_path / "whole", tmp_path / "part"
+    assert exit_code(point_stops.main, argv + ["--T", "1", "--out", str(whole)]) == 0
+    assert exit_code(point_stops.main, argv + ["--T", "0.5", "--out", str(part)]) == 0
+    with np.load(part / "checkpoint.npz", allow_pickle=False) as z:
+        envelope = z["envelope"]
+    header = (part / "timeseries.csv").read_text().splitlines()[0].split(",")
+    # 5,001 rows reduced to each column's first extremes per time bin (at most 2,000 bins)
+    assert envelope.shape[1] == len(header) and 1000 < envelope.shape[0] < 5001
+
+    def parse(*a):
+        raise AssertionError("a resume parsed the rows on disk")
+    monkeypatch.setattr(series, "read_rows", parse)
+    assert exit_code(point_stops.main, ["--resume", str(part), "--T", "1"]) == 0
+    for name in ("timeseries.csv", "impacts.csv", "tip_displacement.png", "energy.png",
+                 "contact_force.png"):
+        assert (part / name).read_bytes() == (whole / name).read_bytes(), name

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import hashlib
+import io
 import json
 import os
 import resource
@@ -46,6 +47,7 @@ BUFFERS = ("obs", "obsv", "energy", "work", "lam")   # saved series (not in the 
 
 
 PAGE = 4096              # bytes: the largest write (see SeriesFile._write)
+BLOCK = 1 << 23          # bytes read at a time on resume (CRC, rows): flat memory
 KEEP_ROWS = 1 << 16       # rows kept whole in memory for the charts; beyond, an envelope
 BINS = 1000               # time bins of that envelope (a chart is about 1000 pixels wide)
 
@@ -56,6 +58,42 @@ class Columns(dict):
     bin (see SeriesFile._reduce: what a chart shows), so that memory stays flat however
     long the run."""
     complete = True
+
+
+def read_blocks(path: Path, nbytes: int, start: int = 0):
+    """The bytes start..nbytes of ``path`` in blocks of at most BLOCK bytes."""
+    with open(path, "rb") as fh:
+        fh.seek(start)
+        left = nbytes - start
+        while left > 0:
+            block = fh.read(min(BLOCK, left))
+            if not block:
+                return
+            left -= len(block)
+            yield block
+
+
+def file_crc(path: Path, nbytes: int) -> int:
+    """zlib.crc32 of the first ``nbytes`` of ``path``, read block by block."""
+    crc = 0
+    for block in read_blocks(path, nbytes):
+        crc = zlib.crc32(block, crc)
+    return crc
+
+
+def read_rows(path: Path, nbytes: int, width: int):
+    """The CSV rows in the first ``nbytes`` of ``path`` after its header, as arrays of
+    ``width`` columns, block by block (np.loadtxt rounds correctly: the 17 written digits
+    come back bit for bit)."""
+    with open(path, "rb") as fh:
+        start = len(fh.readline())
+    rest = b""
+    for block in read_blocks(path, nbytes, start):
+        block = rest + block
+        cut = block.rfind(b"\n") + 1
+        rest = block[cut:]
+        if cut:
+            yield np.loadtxt(io.BytesIO(block[:cut]), delimiter=",", ndmin=2).reshape(-1, width)
 
 
 class SeriesFile:
@@ -89,16 +127,16 @@ class SeriesFile:
         else:   # resume: keep the header and the checkpoint's rows (checked), drop the rest
             self.rows, self.nbytes = int(keep["rows"]), int(keep["nbytes"])
             self.crc = int(keep["crc"])
-            with open(path, "rb") as fh:
-                head = fh.read(self.nbytes)
-            kept = head.split(b"\n")[1:-1]
-            # the rows a stopped process wrote come back exactly (written exactly)
-            values = np.array([[float(v) for v in row.split(b",")] for row in kept]) \
-                .reshape(len(kept), len(names))
-            self._chunks.append({k: values[:, i] for i, k in enumerate(names)})
-            self._held = len(kept)
-            if self.limit is not None and self._held > self.limit:
-                self._reduce()
+            if "envelope" in keep:   # a long run: its chart rows came with the checkpoint
+                self._chunks = [dict(zip(names, np.asarray(keep["envelope"], dtype=float).T))]
+                self._held, self.complete = len(keep["envelope"]), False
+                self._width = float(keep["envelope_width"])
+            else:                    # at most `limit` rows (or every row: limit None)
+                for values in read_rows(path, self.nbytes, len(names)):
+                    self._chunks.append({k: values[:, i] for i, k in enumerate(names)})
+                    self._held += len(values)
+                    if self.limit is not None and self._held > self.limit:
+                        self._reduce()
             self.fd = os.open(path, os.O_WRONLY)
             os.ftruncate(self.fd, self.nbytes)
             os.lseek(self.fd, self.nbytes, os.SEEK_SET)
@@ -170,6 +208,17 @@ class SeriesFile:
                 keep[hit[np.unique(bins[hit], return_index=True)[1]]] = True   # one only)
         self._chunks = [{k: v[keep] for k, v in data.items()}]
         self._held, self.complete = int(keep.sum()), False
+
+    def envelope(self) -> dict:
+        """What a checkpoint keeps of the rows in memory: nothing while they are complete
+        (a resume reads them back from the file, at most ``limit`` rows), else the
+        reduced rows and the bin width, so that a resume of a long run reads no row and
+        goes on reducing exactly as the run it continues."""
+        if self.complete:
+            return {}
+        data = self.data()
+        return {"envelope": np.column_stack([data[k] for k in self.names]),
+                "envelope_width": self._width}
 
     def data(self) -> Columns:
         """The rows written so far, as columns (all of them, or their envelope)."""
@@ -336,10 +385,9 @@ def check_resumable(folder: Path, summary: dict, ck: dict, extend: bool) -> None
     if size < nbytes:
         raise InputError(f"{csv} has {max(size, 0)} bytes, fewer than the {nbytes} of the "
                          f"checkpoint's {int(ck['rows'])} rows; cannot resume")
-    with open(csv, "rb") as fh:
-        if zlib.crc32(fh.read(nbytes)) != int(ck["crc"]):
-            raise InputError(f"{csv}: its first {int(ck['rows'])} rows are not the ones the "
-                             "checkpoint was written with; cannot resume, nothing was changed")
+    if file_crc(csv, nbytes) != int(ck["crc"]):
+        raise InputError(f"{csv}: its first {int(ck['rows'])} rows are not the ones the "
+                         "checkpoint was written with; cannot resume, nothing was changed")
 
 
 def _longer(a, b) -> bool:
@@ -353,7 +401,7 @@ def _checkpoint(run: Run, rows: SeriesFile, used: int) -> dict:
     keep = run.n // run.save_every + 1
     pending = {f"pending_{k}": getattr(run, k)[first:keep] for k in BUFFERS}
     return {**run.checkpoint(), "rows": rows.rows, "nbytes": rows.nbytes, "crc": rows.crc,
-            "used": used, "pending_from": first, **pending}
+            "used": used, "pending_from": first, **pending, **rows.envelope()}
 
 
 def _restore(run: Run, ck: dict) -> int:

@@ -17,7 +17,13 @@ import numpy as np
 import pytest
 
 from conftest import exit_code
+from skfem_beam import cli
 from skfem_beam.cases import impacting_bar, point_stops
+from skfem_beam.contact import ContactLaw
+from skfem_beam.errors import SolverError
+from skfem_beam.output import series
+from skfem_beam.results import read_run
+from skfem_beam.scheme import Run
 
 CASE = [sys.executable, "-m", "skfem_beam.cases.point_stops"]
 LONG = ["--dt", "1e-5", "--T", "2", "--flush-every", "2000", "--frames", "10"]
@@ -42,6 +48,24 @@ def whole_rows(folder):
 def checkpoint(folder):
     with np.load(folder / "checkpoint.npz", allow_pickle=False) as z:
         return {k: z[k] for k in ("n", "rows")}
+
+
+def impacts_so_far(folder, reference, last_t):
+    """impacts.csv of a stopped run: read back by read_run; its finished rows are the
+    reference's first rows, byte for byte; after them only open rows (contacts under way
+    at the last state ``last_t``, one per node at most) starting where the reference's
+    next ones do.  Returns the number of finished rows."""
+    imp, s = read_run(folder).impacts, summary(folder)
+    ref = (reference / "impacts.csv").read_text().splitlines()
+    lines = (folder / "impacts.csv").read_text().splitlines()
+    closed, n = int((imp["open"] == 0).sum()), imp["x"].size
+    assert lines[0] == ref[0] and lines[1:closed + 1] == ref[1:closed + 1]
+    assert np.all(imp["open"][closed:] == 1) and np.unique(imp["x"][closed:]).size == n - closed
+    assert np.array_equal(imp["t_start"][closed:],
+                          read_run(reference).impacts["t_start"][closed:n])
+    assert imp["t_end"].max() <= last_t + 1e-12
+    assert sum(node["impacts"] for node in s["impact_statistics"]["nodes"]) == n
+    return closed
 
 
 def snapshot(folder):
@@ -97,14 +121,59 @@ def test_kill_interrupt_terminate_then_resume_is_identical(reference, tmp_path):
         assert s["steps"] == s["checkpoint_step"] == int(ck["n"]) > 0
         assert int(ck["rows"]) == len(kept) - 1 and f"kept {len(kept) - 1} whole rows" in err[0]
         assert kept == ref[:len(kept)]
+        assert impacts_so_far(out, reference, s["steps"] * s["dt"]) > 20 * frac   # ~400 in T
 
     p = subprocess.run(CASE + ["--resume", str(out)], capture_output=True, text=True, timeout=60)
     assert p.returncode == 0, p.stderr
     assert csv.read_bytes() == (reference / "timeseries.csv").read_bytes()
+    assert (out / "impacts.csv").read_bytes() == (reference / "impacts.csv").read_bytes()
     a, b = summary(reference), summary(out)
-    for key in ("status", "steps", "impacts", "max_nodal_violation", "energy_final"):
+    for key in ("status", "steps", "impacts", "max_nodal_violation", "energy_final",
+                "impact_statistics"):
         assert a[key] == b[key]
     assert (out / "fields.h5").stat().st_size == (reference / "fields.h5").stat().st_size
+
+
+class GivesUp(ContactLaw):
+    """Lemma 4.1's projection solved in Python, failing at its ``calls``-th step."""
+    name = "gives-up"
+
+    def __init__(self, calls):
+        self.calls = calls
+
+    def solver(self, step):
+        d, lo, hi, calls = np.diag(step.D), step.lo, step.hi, [0]
+
+        class Solver:
+            def solve(self, x, yf):
+                calls[0] += 1
+                if calls[0] == self.calls:
+                    raise SolverError("gave up on purpose")
+                return (np.clip(yf, lo, hi) - yf) / d, 0
+        Solver.calls = self.calls
+        return Solver()
+
+
+def test_failed_solver_keeps_the_impacts_so_far(tmp_path, monkeypatch, capsys):
+    """A solver failing at step 6000 of 10,000: exit 3, status "failed", and impacts.csv
+    holds the events up to the state before the failed step, their rows those of the same
+    run with the compiled projection."""
+    argv = ["--dt", "1e-4", "--T", "1", "--flush-every", "200", "--format", "none"]
+    ref = tmp_path / "ref"
+    assert exit_code(point_stops.main, argv + ["--out", str(ref)]) == 0
+    monkeypatch.setattr(cli, "make_run", lambda system, stepping, args, stiffness=None:
+                        Run(system, stepping, GivesUp(6001)))   # call 1: the start step
+    out = tmp_path / "run"
+    capsys.readouterr()
+    assert exit_code(point_stops.main, argv + ["--out", str(out)]) == 3
+    err = [e for e in capsys.readouterr().err.splitlines() if not e.startswith("compiling")]
+    assert len(err) == 1 and "gave up on purpose" in err[0], err
+    s = summary(out)
+    assert s["status"] == "failed" and s["steps"] < 6000
+    imp = read_run(out).impacts
+    assert imp["t_start"].size > 10 and imp["t_end"].max() == pytest.approx(0.6) \
+        or imp["open"].sum() == 0
+    assert impacts_so_far(out, ref, 0.6) >= imp["t_start"].size - 1
 
 
 HOLD = ("import fcntl, os, sys, time; fd = os.open(sys.argv[1], os.O_RDWR | os.O_CREAT); "
@@ -291,3 +360,27 @@ def test_output_flags_are_checked(tmp_path, capsys, main, flag, value):
     assert err.count("\n") == 1 and value in err and \
         flag.lstrip("-") in err.replace("_", "-"), err
     assert not list(tmp_path.iterdir())
+
+
+def test_resume_of_a_long_run_reads_no_row(tmp_path, monkeypatch):
+    """A run longer than the rows kept whole (KEEP_ROWS, made 1,000 here) checkpoints its
+    chart envelope: --resume checks the rows on disk (CRC, block by block) and parses
+    none of them, and ends with the same files, charts included, as one run to the end."""
+    monkeypatch.setattr(series, "KEEP_ROWS", 1000)
+    argv = ["--dt", "1e-4", "--flush-every", "500", "--format", "none"]
+    whole, part = tmp_path / "whole", tmp_path / "part"
+    assert exit_code(point_stops.main, argv + ["--T", "1", "--out", str(whole)]) == 0
+    assert exit_code(point_stops.main, argv + ["--T", "0.5", "--out", str(part)]) == 0
+    with np.load(part / "checkpoint.npz", allow_pickle=False) as z:
+        envelope = z["envelope"]
+    header = (part / "timeseries.csv").read_text().splitlines()[0].split(",")
+    # 5,001 rows reduced to each column's first extremes per time bin (at most 2,000 bins)
+    assert envelope.shape[1] == len(header) and 1000 < envelope.shape[0] < 5001
+
+    def parse(*a):
+        raise AssertionError("a resume parsed the rows on disk")
+    monkeypatch.setattr(series, "read_rows", parse)
+    assert exit_code(point_stops.main, ["--resume", str(part), "--T", "1"]) == 0
+    for name in ("timeseries.csv", "impacts.csv", "tip_displacement.png", "energy.png",
+                 "contact_force.png"):
+        assert (part / name).read_bytes() == (whole / name).read_bytes(), name

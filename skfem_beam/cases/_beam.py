@@ -10,7 +10,7 @@ from ..output.charts import energy_chart, shape_chart, trajectory_chart
 from ..output.events import beam_impacts
 from ..output.fields import physical_tip
 from ..output.probes import probe_columns, probe_units
-from ..output.series import execute, prepare
+from ..output.series import Series, execute, prepare
 from ..scheme import Stepping
 from ..scheme.kernels import WORK_TERMS
 from ..checks import check_positive
@@ -89,7 +89,6 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
                     title=f"{case}: displacement ũ(x, t) at saved times ({about})")
         if extra is not None:
             extra(folder, data, run)
-        return beam_impacts(folder, run, problem, data)
 
     summary = {
         "case": case, "J": problem.J, "dt": run.dt, "T": run.n_steps * run.dt, "beta": run.beta,
@@ -99,7 +98,10 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
         "penalty_stiffness_N_per_m": args.stiffness if args.method == "penalty" else None,
         "config": {**config, **{k: v for k, v in vars(args).items() if k != "resume"}},
     }
-    return execute(run, out, args, summary, columns, finish)
+    def events(folder: Path, run, last: int) -> dict:
+        return beam_impacts(folder, run, problem, last)
+
+    return execute(run, out, args, summary, Series(columns, events=events), finish)
 
 
 def units(rho_S, system) -> dict:

@@ -106,7 +106,8 @@ def run_bar_case(bar: Bar, args, config: dict | None = None) -> int:
     # energy split when it fits; else the run keeps --frames frames itself)
     field_every = max(1, series.n_steps // args.frames) if run.frame_every == 1 else run.frame_every
     stream = Series(series.columns, ready=series.ready, field_every=field_every,
-                    field_until=series.n_steps, keep_all=True)   # errors need every row
+                    field_until=series.n_steps, keep_all=True,   # errors need every row
+                    events=lambda folder, run, last: bar_impacts(folder, run, bar, last))
 
     summary = {
         "case": CASE, "J": bar.N, "N": bar.N, "dt": run.dt, "T": series.n_steps * run.dt,
@@ -150,7 +151,6 @@ def run_bar_case(bar: Bar, args, config: dict | None = None) -> int:
                       {"exact total": data.get("energy_exact")}, title,
                       "energy (J/m²)" if bar.A is None else "energy (J)")
         return {
-            **bar_impacts(folder, run, bar, data),
             "T": float(b.t[-1]), "steps": min(run.n, series.n_steps),
             "max_penetration": b.penetration, "max_nodal_violation": b.penetration,
             "energy_final": float(b.energy[-1] + b.load_potential[-1]),

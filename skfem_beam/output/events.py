@@ -4,15 +4,24 @@ One row per impact of a constrained value (``Run.impact_events``, which a checkp
 carries, so a resumed run writes the same table as an uninterrupted one):
 
     t_start, t_end   s: the first state on the obstacle and the first one off it (a contact
-                     still under way at the end ends at the last state)
+                     still under way at the last state ends there)
     x                m: the node
     bound            1: the lower bound (g1; the bar's obstacle at x = 0),
                      2: the upper bound (g2; the bar's obstacle at x = L)
     velocity         m/s: the node's approach velocity (yⁿ − yⁿ⁻¹)/Δt before contact
     peak_force       max |force| over the contact
-    impulse          Σ force·Δt over the contact, signed like the timeseries column
+    impulse          Σ force·Δt over the event, signed like the timeseries column
                      ``contact_force`` (beam: λ, > 0 pushed up by g1; bar: R ≥ 0)
     max_violation    m: the largest nodal violation of the bound during the contact
+    open             1: the event was not over at the run's last state (in contact, or
+                     within the two states after t_end that a penalty spring's trailing
+                     force reaches); its peak_force and impulse are those so far.  Only
+                     the last rows of a run can be open: an interrupted or failed run's,
+                     and a finished run's contacts under way at T.  0 otherwise.
+
+An event owns the whole contact force of its value (a law's explicit part included) from
+its first state to the second state after t_end, or to the value's next impact (see
+scheme.kernels.track_impacts), so the impulses add up to Σ λΔt of the run to round-off.
 
 Forces are in N and impulses in N·s when the mass per length (beam: ``rho_S``) or the
 bar's cross-section is known, else in the system's units (beam: per unit mass per length,
@@ -28,7 +37,7 @@ from .folder import atomic_write, csv_rows
 
 IMPACTS = "impacts.csv"
 COLUMNS = ("t_start", "t_end", "x", "bound", "velocity", "peak_force", "impulse",
-           "max_violation")
+           "max_violation", "open")
 
 
 def impact_table(events: dict, lo: np.ndarray, hi: np.ndarray, scale: float = 1.0,
@@ -43,29 +52,8 @@ def impact_table(events: dict, lo: np.ndarray, hi: np.ndarray, scale: float = 1.
     return {"t_start": events["t_start"], "t_end": events["t_end"], "x": events["x"],
             "bound": np.where(lower, 1.0, 2.0), "velocity": events["velocity"],
             "peak_force": scale * np.asarray(events["peak_force"], dtype=float),
-            "impulse": sign * scale * impulse, "max_violation": events["max_violation"]}
-
-
-def forces_from_series(events: dict, lam: np.ndarray, n: int, dt: float) -> dict:
-    """``events`` with ``impulse`` and ``peak_force`` taken from the force of every state
-    (``lam``: states × constrained values, all of them saved): each impact owns its node's
-    force from its first state to the next impact of that node (or state ``n``).  Why: a
-    penalty spring's force is β-weighted over three states, so it goes on for up to two
-    steps after the node has left the spring, where the loop's own sums (over the states
-    in contact) stop; for exact contact the force is zero there and both agree."""
-    j = np.asarray(events["value"], dtype=int)
-    start = np.rint(np.asarray(events["t_start"]) / dt).astype(int)
-    impulse, peak = np.array(events["impulse"], dtype=float), np.array(events["peak_force"],
-                                                                        dtype=float)
-    for v in np.unique(j):
-        rows = np.flatnonzero(j == v)
-        rows = rows[np.argsort(start[rows], kind="stable")]
-        ends = np.append(start[rows[1:]], n + 1)
-        for r, a, b in zip(rows, start[rows], ends):
-            f = lam[a:b, v]
-            impulse[r] = float(np.sum(f)) * dt
-            peak[r] = float(np.abs(f).max(initial=0.0))
-    return {**events, "impulse": impulse, "peak_force": peak}
+            "impulse": sign * scale * impulse, "max_violation": events["max_violation"],
+            "open": np.asarray(events["open"], dtype=float)}
 
 
 def _union_length(start: np.ndarray, end: np.ndarray) -> float:
@@ -128,56 +116,46 @@ def impact_statistics(table: dict, duration: float, obstacles=None) -> dict:
 
 
 def write_impacts(folder: Path, run, units: dict, scale: float = 1.0, sign: float = 1.0,
-                  obstacles=None, force: np.ndarray | None = None) -> dict:
+                  obstacles=None, last: int | None = None) -> dict:
     """Write ``folder/impacts.csv`` from ``run`` (a :class:`~skfem_beam.scheme.Run`) and
     return the summary entry ``{"impact_statistics": ...}``; ``units``: the force and
     impulse units (``{"force": "N", "impulse": "N·s"}``), see :func:`impact_table`.
-    ``force``: λ of every state (states × constrained values) when the caller has it
-    (:func:`forces_from_series`), else the loop's own sums over the states in contact."""
+    ``last``: the last state the loop computed when it is not ``run.n`` (a failed step
+    stops the loop inside a chunk)."""
     s = run.system
-    events = run.impact_events()
+    last = run.n if last is None else int(last)
+    events = run.impact_events(last)
     # an unstable run ends at its last good saved state: impacts after it are not kept
-    keep = np.asarray(events["t_start"]) <= (run.n + 0.5) * run.dt
+    keep = np.asarray(events["t_start"]) <= (last + 0.5) * run.dt
     events = {k: np.asarray(v)[keep] for k, v in events.items()}
-    if force is not None:
-        events = forces_from_series(events, force, run.n, run.dt)
     table = impact_table(events, np.asarray(s.lo), np.asarray(s.hi), scale, sign)
     path = Path(folder) / IMPACTS
     atomic_write(path, lambda fh: fh.write(",".join(COLUMNS) + "\n"
                                            + (csv_rows(table, list(COLUMNS)) if table["x"].size
                                               else "")))
     # the share of the states 1..n, as the run's own contact_fraction counts it
-    duration = max(0, run.n - 1) * run.dt
+    duration = max(0, last - 1) * run.dt
     stats = impact_statistics(table, duration, obstacles)
     f, i = units["force"], units["impulse"]
     stats["units"] = {"t_start": "s", "t_end": "s", "x": "m", "bound": "1 = g1 (lower), "
                       "2 = g2 (upper)", "velocity": "m/s", "peak_force": f, "impulse": i,
-                      "max_violation": "m", "contact_fraction": "of the run's time"}
+                      "max_violation": "m", "open": "1 = not over at the last state",
+                      "contact_fraction": "of the run's time"}
     return {"impact_statistics": stats}
 
 
-def beam_impacts(folder: Path, run, problem, data: dict) -> dict:
-    """:func:`write_impacts` for a beam scene (``data``: the timeseries columns), in N and
-    N·s when ρS is known.  One constrained node and every state saved: the forces come
-    from the series (a penalty spring's trailing force counted); else from the loop."""
+def beam_impacts(folder: Path, run, problem, last: int | None = None) -> dict:
+    """:func:`write_impacts` for a beam scene, in N and N·s when ρS is known."""
     rho_S = problem.beam.rho_S
     units = {"force": "N", "impulse": "N·s"} if rho_S else \
         {"force": "m²/s² (N per kg/m)", "impulse": "m²/s (N·s per kg/m)"}
-    # the rows in memory, not run.lam: a resumed run has only the rows since its checkpoint
-    lam = data["contact_force"]
-    force = lam[:, None] if run.system.C.shape[0] == 1 and lam.size == run.n + 1 else None
-    return write_impacts(folder, run, units, rho_S or 1.0, 1.0, problem.obstacles, force)
+    return write_impacts(folder, run, units, rho_S or 1.0, 1.0, problem.obstacles, last)
 
 
-def bar_impacts(folder: Path, run, bar, data: dict) -> dict:
-    """:func:`write_impacts` for the bar: R ≥ 0 (impulse = ∫R dt), in N and N·s with a
-    cross-section A, else per unit cross-section.  ``data``: its timeseries columns; R(tₙ)
-    is the force of state n + 1 (bar.BarSeries), so with every step saved the forces of
-    states 2..N+1 come from there (the start step's state 1 opens no impact)."""
+def bar_impacts(folder: Path, run, bar, last: int | None = None) -> dict:
+    """:func:`write_impacts` for the bar: R ≥ 0 (impulse = ∫R dt; R(tₙ) is the force of
+    state n + 1, bar.BarSeries), in N and N·s with a cross-section A, else per unit
+    cross-section."""
     units = {"force": "Pa (per unit cross-section)", "impulse": "Pa·s"} if bar.A is None \
         else {"force": "N", "impulse": "N·s"}
-    R, force = data["contact_force"], None
-    if R.size + 1 == run.n + 1:            # rows t₀..t_N, every step: states 0..N+1
-        force = np.zeros((run.n + 1, 1))
-        force[2:, 0] = bar.gap_sign * R[1:]
-    return write_impacts(folder, run, units, 1.0, bar.gap_sign, None, force)
+    return write_impacts(folder, run, units, 1.0, bar.gap_sign, None, last)

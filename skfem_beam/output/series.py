@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import hashlib
+import io
 import json
 import os
 import resource
@@ -41,11 +42,12 @@ from .folder import (EXIT_SOLVER, SUMMARY, Folder, Interrupted, _plain, check_ou
                      csv_rows, lock_folder, report)
 
 CHECKPOINT = "checkpoint.npz"
-CHECKPOINT_FORMAT = 2
+CHECKPOINT_FORMAT = 3       # 3: impact events hold their first step off (State.impact)
 BUFFERS = ("obs", "obsv", "energy", "work", "lam")   # saved series (not in the Run's checkpoint)
 
 
 PAGE = 4096              # bytes: the largest write (see SeriesFile._write)
+BLOCK = 1 << 23          # bytes read at a time on resume (CRC, rows): flat memory
 KEEP_ROWS = 1 << 16       # rows kept whole in memory for the charts; beyond, an envelope
 BINS = 1000               # time bins of that envelope (a chart is about 1000 pixels wide)
 
@@ -56,6 +58,42 @@ class Columns(dict):
     bin (see SeriesFile._reduce: what a chart shows), so that memory stays flat however
     long the run."""
     complete = True
+
+
+def read_blocks(path: Path, nbytes: int, start: int = 0):
+    """The bytes start..nbytes of ``path`` in blocks of at most BLOCK bytes."""
+    with open(path, "rb") as fh:
+        fh.seek(start)
+        left = nbytes - start
+        while left > 0:
+            block = fh.read(min(BLOCK, left))
+            if not block:
+                return
+            left -= len(block)
+            yield block
+
+
+def file_crc(path: Path, nbytes: int) -> int:
+    """zlib.crc32 of the first ``nbytes`` of ``path``, read block by block."""
+    crc = 0
+    for block in read_blocks(path, nbytes):
+        crc = zlib.crc32(block, crc)
+    return crc
+
+
+def read_rows(path: Path, nbytes: int, width: int):
+    """The CSV rows in the first ``nbytes`` of ``path`` after its header, as arrays of
+    ``width`` columns, block by block (np.loadtxt rounds correctly: the 17 written digits
+    come back bit for bit)."""
+    with open(path, "rb") as fh:
+        start = len(fh.readline())
+    rest = b""
+    for block in read_blocks(path, nbytes, start):
+        block = rest + block
+        cut = block.rfind(b"\n") + 1
+        rest = block[cut:]
+        if cut:
+            yield np.loadtxt(io.BytesIO(block[:cut]), delimiter=",", ndmin=2).reshape(-1, width)
 
 
 class SeriesFile:
@@ -89,16 +127,16 @@ class SeriesFile:
         else:   # resume: keep the header and the checkpoint's rows (checked), drop the rest
             self.rows, self.nbytes = int(keep["rows"]), int(keep["nbytes"])
             self.crc = int(keep["crc"])
-            with open(path, "rb") as fh:
-                head = fh.read(self.nbytes)
-            kept = head.split(b"\n")[1:-1]
-            # the rows a stopped process wrote come back exactly (written exactly)
-            values = np.array([[float(v) for v in row.split(b",")] for row in kept]) \
-                .reshape(len(kept), len(names))
-            self._chunks.append({k: values[:, i] for i, k in enumerate(names)})
-            self._held = len(kept)
-            if self.limit is not None and self._held > self.limit:
-                self._reduce()
+            if "envelope" in keep:   # a long run: its chart rows came with the checkpoint
+                self._chunks = [dict(zip(names, np.asarray(keep["envelope"], dtype=float).T))]
+                self._held, self.complete = len(keep["envelope"]), False
+                self._width = float(keep["envelope_width"])
+            else:                    # at most `limit` rows (or every row: limit None)
+                for values in read_rows(path, self.nbytes, len(names)):
+                    self._chunks.append({k: values[:, i] for i, k in enumerate(names)})
+                    self._held += len(values)
+                    if self.limit is not None and self._held > self.limit:
+                        self._reduce()
             self.fd = os.open(path, os.O_WRONLY)
             os.ftruncate(self.fd, self.nbytes)
             os.lseek(self.fd, self.nbytes, os.SEEK_SET)
@@ -171,6 +209,17 @@ class SeriesFile:
         self._chunks = [{k: v[keep] for k, v in data.items()}]
         self._held, self.complete = int(keep.sum()), False
 
+    def envelope(self) -> dict:
+        """What a checkpoint keeps of the rows in memory: nothing while they are complete
+        (a resume reads them back from the file, at most ``limit`` rows), else the
+        reduced rows and the bin width, so that a resume of a long run reads no row and
+        goes on reducing exactly as the run it continues."""
+        if self.complete:
+            return {}
+        data = self.data()
+        return {"envelope": np.column_stack([data[k] for k in self.names]),
+                "envelope_width": self._width}
+
     def data(self) -> Columns:
         """The rows written so far, as columns (all of them, or their envelope)."""
         out = Columns({k: np.concatenate([c[k] for c in self._chunks] or [np.zeros(0)])
@@ -205,13 +254,16 @@ class Series:
     of them) for the run's saved rows k0..k1−1; ``ready(run)``: how many saved rows are final
     (default: all computed so far); ``field_every``: steps between field frames, a multiple
     of ``run.frame_every`` (0: every frame the run keeps); ``field_until``: the last step
-    with a frame (None: the run's end).
+    with a frame (None: the run's end); ``events(folder, run, last)``: writes impacts.csv
+    and returns its summary entries (``last``: the last state the loop computed), on every
+    way a run ends: finished, unstable, interrupted, failed.
     """
     columns: Callable
     ready: Callable | None = None
     field_every: int = 0
     field_until: int | None = None
     keep_all: bool = False      # finish needs every row (not only what a chart shows)
+    events: Callable | None = None
 
     def rows_ready(self, run: Run) -> int:
         return self.ready(run) if self.ready is not None else run.n // run.save_every + 1
@@ -284,10 +336,12 @@ def read_checkpoint(folder: Path) -> dict:
     if missing:
         raise InputError(f"{path} has no {missing[0]!r} (not a checkpoint of this version); "
                          "cannot resume, nothing was changed")
-    if int(ck["format"]) != CHECKPOINT_FORMAT or \
-            _digest({k: v for k, v in ck.items() if k != "sha256"}) != str(ck["sha256"]):
+    if _digest({k: v for k, v in ck.items() if k != "sha256"}) != str(ck["sha256"]):
         raise InputError(f"{path} does not match its sha256 checksum (changed or cut); "
                          "cannot resume, nothing was changed")
+    if int(ck["format"]) != CHECKPOINT_FORMAT:
+        raise InputError(f"{path} is of checkpoint format {int(ck['format'])}, this version "
+                         f"reads format {CHECKPOINT_FORMAT}; cannot resume, nothing was changed")
     ck["config"] = json.loads(str(ck["config"]))
     return ck
 
@@ -331,10 +385,9 @@ def check_resumable(folder: Path, summary: dict, ck: dict, extend: bool) -> None
     if size < nbytes:
         raise InputError(f"{csv} has {max(size, 0)} bytes, fewer than the {nbytes} of the "
                          f"checkpoint's {int(ck['rows'])} rows; cannot resume")
-    with open(csv, "rb") as fh:
-        if zlib.crc32(fh.read(nbytes)) != int(ck["crc"]):
-            raise InputError(f"{csv}: its first {int(ck['rows'])} rows are not the ones the "
-                             "checkpoint was written with; cannot resume, nothing was changed")
+    if file_crc(csv, nbytes) != int(ck["crc"]):
+        raise InputError(f"{csv}: its first {int(ck['rows'])} rows are not the ones the "
+                         "checkpoint was written with; cannot resume, nothing was changed")
 
 
 def _longer(a, b) -> bool:
@@ -348,7 +401,7 @@ def _checkpoint(run: Run, rows: SeriesFile, used: int) -> dict:
     keep = run.n // run.save_every + 1
     pending = {f"pending_{k}": getattr(run, k)[first:keep] for k in BUFFERS}
     return {**run.checkpoint(), "rows": rows.rows, "nbytes": rows.nbytes, "crc": rows.crc,
-            "used": used, "pending_from": first, **pending}
+            "used": used, "pending_from": first, **pending, **rows.envelope()}
 
 
 def _restore(run: Run, ck: dict) -> int:
@@ -508,6 +561,19 @@ def _stream(run, folder, args, series, finish, stop, used, ck, can_checkpoint) -
             save_checkpoint()
             last_ck = time.monotonic()
 
+    def write_events(last: int, quiet: bool = True) -> dict:
+        """impacts.csv of the events up to state ``last`` (its summary entries); nothing
+        when the command has none, or (``quiet``, a run already stopping on an error) when
+        the disk refuses it: that run's own error is the one to report."""
+        if series.events is None:
+            return {}
+        try:
+            return series.events(folder.path, run, last)
+        except OSError:
+            if not quiet:
+                raise
+            return {}
+
     def what_is_kept() -> str:
         t = (rows.rows - 1) * run.save_every * run.dt if rows is not None and rows.rows else 0.0
         ck_line = (f"the checkpoint at step {kept['step']} (t={kept['step'] * run.dt:.6g} s)"
@@ -533,6 +599,7 @@ def _stream(run, folder, args, series, finish, stop, used, ck, can_checkpoint) -
         data = rows.data()
         entries = outcome(run.result(), data)
         entries.update(finish(folder.path, data, run) or {})
+        entries.update(write_events(run.n, quiet=False))
     except Interrupted as e:
         name = signal.Signals(e.signum).name
         why = ""
@@ -542,6 +609,7 @@ def _stream(run, folder, args, series, finish, stop, used, ck, can_checkpoint) -
             except OSError as err:
                 why = f" (no new checkpoint: {err.strerror})"
         entries = outcome(run.result(), rows.data())
+        entries.update(write_events(run.n))
         folder.close(**{**entries, "status": "interrupted", "steps": run.n,
                         "message": f"interrupted by {name} at step {run.n} "
                                    f"(t={run.n * run.dt:.6g} s)"})
@@ -550,10 +618,11 @@ def _stream(run, folder, args, series, finish, stop, used, ck, can_checkpoint) -
         print(f"interrupted by {name}: {what_is_kept()}{why}; {resume}", file=sys.stderr)
         return e.code
     except SolverError as e:
-        folder.fail(e, steps=run.n)
+        # the loop stopped inside a chunk: its events reach the state before the failed step
+        folder.fail(e, steps=run.n, **write_events(int(run.st.counters[3]) - 1))
         raise
     except OSError as e:
-        folder.fail(e, steps=run.n, kept=what_is_kept())
+        folder.fail(e, steps=run.n, kept=what_is_kept(), **write_events(run.n))
         resume = (f"once there is room, continue with: {_command(folder.summary)} --resume "
                   f"{folder.path}" if kept["step"] is not None else
                   "without a checkpoint (--checkpoint-every) it cannot be resumed")

@@ -48,7 +48,8 @@ State = namedtuple("State", [
                   #  impact events written, first saved row held in the Series buffers]
     "work",       # Σ over the steps of [damping, load input, contact] work (energy units)
     "impact",     # per constrained value: [start step, approach velocity, peak |λ|,
-                  #  Σ λΔt, max violation] of the contact under way (start −1: none)
+                  #  Σ λΔt, max violation, first step off (−1: in contact)] of the
+                  #  event under way (start −1: none)
     "r_e",                            # the law's explicit force (see contact.base)
     "x", "yf", "mu", "Ku", "d", "dy", # the step's free solution (then uⁿ⁺¹), C x, μ, K uⁿ,
                                       # scratch (n), C(uⁿ⁺¹ − uⁿ⁻¹)
@@ -252,27 +253,39 @@ def move_bounds(ops, st, phi):
 @njit(cache=True, inline="always")
 def track_impacts(ops, st, out, step):
     """Contact bookkeeping after state step+1: impacts counted when a value enters
-    contact, and one event row (see EVENT_COLUMNS) when it leaves.  Returns
-    EVENTS_FULL when the event buffer has no room left for another row."""
+    contact; an event (State.impact) owns its value's contact force λ (the total: a
+    law's explicit part included) from its first state to the second state off the
+    obstacle, or to the value's next impact, then it becomes one row (EVENT_COLUMNS).
+    Why two states: a law's explicit force reads yⁿ and yⁿ⁻¹, so a spring's β-weighted
+    force trails the contact by up to two states; Σ impulse is then Σ λΔt of the run
+    (exact laws: λ = 0 off contact, the same rows).  Returns EVENTS_FULL when the event
+    buffer has no room left for another row."""
     counters, ev, dt = st.counters, st.impact, ops.dt
     any_active = False
     for j in range(st.active.size):
         a = st.active[j]
         if a and not st.active_prev[j]:
             counters[0] += 1
+            if ev[j, 0] >= 0.0:          # the last contact's trailing force ends here
+                write_event(out, counters, j, ev[j])
             ev[j, 0] = step + 1
             # approach velocity (yⁿ − yⁿ⁻¹)/Δt, with yⁿ⁻¹ = yⁿ⁺¹ − dy
             ev[j, 1] = (st.y_prev[j] - st.y_cur[j] + st.dy[j]) / dt
             ev[j, 2] = 0.0
             ev[j, 3] = 0.0
             ev[j, 4] = 0.0
-        if a:
-            lam = st.mu[j] / (dt * dt)
-            ev[j, 2] = max(ev[j, 2], abs(lam))
-            ev[j, 3] += lam * dt
-            ev[j, 4] = max(ev[j, 4], st.lo[j] - st.y_cur[j], st.y_cur[j] - st.hi[j])
-        elif st.active_prev[j]:
-            write_event(out, counters, j, ev[j], step + 1)
+            ev[j, 5] = -1.0
+        elif st.active_prev[j] and not a:
+            ev[j, 5] = step + 1          # the first state off the obstacle
+        if ev[j, 0] >= 0.0:
+            if st.mu[j] != 0.0:
+                lam = st.mu[j] / (dt * dt)
+                ev[j, 2] = max(ev[j, 2], abs(lam))
+                ev[j, 3] += lam * dt
+            if a:
+                ev[j, 4] = max(ev[j, 4], st.lo[j] - st.y_cur[j], st.y_cur[j] - st.hi[j])
+            elif step + 1 > ev[j, 5]:    # the second state off: no force can trail further
+                write_event(out, counters, j, ev[j])
         st.active_prev[j] = a
         any_active = any_active or a
     if any_active:
@@ -281,11 +294,12 @@ def track_impacts(ops, st, out, step):
 
 
 @njit(cache=True, inline="always")
-def write_event(out, counters, j, e, end_step):
+def write_event(out, counters, j, e):
+    """Event row k of the buffer from the value j's State.impact row ``e`` (then free)."""
     k = counters[4]
     out.events[k, 0] = j
     out.events[k, 1] = e[0]
-    out.events[k, 2] = end_step
+    out.events[k, 2] = e[5]
     for c in range(1, 5):
         out.events[k, c + 2] = e[c]
     counters[4] = k + 1

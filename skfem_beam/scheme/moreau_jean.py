@@ -251,7 +251,7 @@ class MoreauJean(Run):
                           z(m), op.C @ system.u0, z(m), op.C @ system.v0, z(m),
                           lo, hi, np.array(slo, float), np.array(shi, float), z(m), z(m),
                           z(m, np.int8), z(m, np.bool_), z(m, np.bool_), z(4),
-                          z(6, np.int64), z(3), np.full((m, 5), -1.0), z(m),
+                          z(6, np.int64), z(3), np.full((m, 6), -1.0), z(m),
                           z(m), z(m), z(n), z(n), z(n), z(n))
         self.st.u_prev[:] = self.st.u_cur
         self.st.y_prev[:] = self.st.y_cur

@@ -141,7 +141,7 @@ class Run:
                         step.lo.copy(), step.hi.copy(), slo.copy(), shi.copy(),
                         np.zeros(m, np.int8), np.zeros(m, np.bool_), np.zeros(m, np.bool_),
                         np.zeros(4), np.zeros(6, np.int64), np.zeros(3),
-                        np.full((m, 5), -1.0), np.zeros(m),
+                        np.full((m, 6), -1.0), np.zeros(m),
                         np.empty(n), np.empty(m), np.zeros(m), np.empty(n), np.empty(n),
                         np.zeros(m), np.zeros(op.Z.size))
         nframes, nobs = n_steps // s.frame_every + 1, Orows.shape[0]
@@ -324,24 +324,31 @@ class Run:
     def _all_events(self) -> np.ndarray:
         return np.concatenate(self.events) if self.events else np.zeros((0, 7))
 
-    def impact_events(self) -> dict:
-        """One row per impact of a constrained value so far (contacts still under way end
-        at the last state): ``value`` (its index), ``x``, ``t_start``, ``t_end``,
-        ``velocity`` (approach velocity (yⁿ − yⁿ⁻¹)/Δt before contact), ``peak_force``
-        (max |λ|), ``impulse`` (Σ λΔt), ``max_violation`` (m), in the system's units."""
-        rows = [self._all_events()]
+    def impact_events(self, last: int | None = None) -> dict:
+        """One row per impact of a constrained value so far: ``value`` (its index), ``x``,
+        ``t_start``, ``t_end`` (the first state off the obstacle), ``velocity`` (approach
+        velocity (yⁿ − yⁿ⁻¹)/Δt before contact), ``peak_force`` (max |λ|), ``impulse``
+        (Σ λΔt), ``max_violation`` (m), in the system's units, and ``open``: 1 for an
+        event the loop still holds at the last state (``last``, default ``n``): in contact
+        (t_end is then that state) or within the two states after t_end that a spring's
+        trailing force reaches; its peak and impulse are those so far."""
+        last = self.n if last is None else int(last)
+        done = self._all_events()
+        rows = [np.column_stack([done, np.zeros(len(done))])]
         open_ = self.st.impact[:, 0] >= 0
         if open_.any():
             j = np.flatnonzero(open_)
             e = self.st.impact[j]
-            rows.append(np.column_stack([j, e[:, 0], np.full(j.size, self.n), e[:, 1:]]))
+            end = np.where(e[:, 5] >= 0, e[:, 5], last)
+            rows.append(np.column_stack([j, e[:, 0], end, e[:, 1:5], np.ones(j.size)]))
         table = np.concatenate(rows)
         table = table[np.lexsort((table[:, 0], table[:, 1]))]
         x = np.asarray(self.system.x_contact, dtype=float)
         value = table[:, 0].astype(int)
         return {"value": value, "x": x[value], "t_start": table[:, 1] * self.dt,
                 "t_end": table[:, 2] * self.dt, "velocity": table[:, 3],
-                "peak_force": table[:, 4], "impulse": table[:, 5], "max_violation": table[:, 6]}
+                "peak_force": table[:, 4], "impulse": table[:, 5], "max_violation": table[:, 6],
+                "open": table[:, 7].astype(int)}
 
     @property
     def done(self) -> bool:

@@ -126,3 +126,40 @@ def test_quasi_static_refusals(solver, massless, word):
     s = bar_system(scenes.periodic_rod(20, mass="redistributed"))
     with pytest.raises(InputError, match=word):
         Run(s, Stepping(0.01, 1.0, 0.25, massless=massless), solver)
+
+
+def test_command_line_massless_reaches_the_run(tmp_path):
+    """--mass redistributed --massless quasi-static runs the bar (exit 0) with the run the
+    API gives for massless="quasi-static", which is not the default rows' run."""
+    import json
+    from conftest import exit_code
+    from skfem_beam.cases import impacting_bar
+    base = ["--mass", "redistributed", "--T", "0.5", "--format", "none"]
+    qs, beta = tmp_path / "qs", tmp_path / "beta"
+    assert exit_code(impacting_bar.main, base + ["--massless", "quasi-static",
+                                                 "--out", str(qs)]) == 0
+    assert exit_code(impacting_bar.main, base + ["--out", str(beta)]) == 0
+    s = json.loads((qs / "summary.json").read_text())
+    assert s["status"] == "success" and s["config"]["massless"] == "quasi-static"
+    assert s["max_penetration"] < 1e-15
+    force = {k: np.genfromtxt(d / "timeseries.csv", delimiter=",", skip_header=1, usecols=3)
+             for k, d in (("qs", qs), ("beta", beta))}      # the reaction R(0, t)
+    api = run_bar(scenes.impacting_bar(mass="redistributed"), 1e-3, 0.5, beta=0.25,
+                  massless="quasi-static")
+    np.testing.assert_array_equal(force["qs"], api.force)
+    assert np.nanmax(np.abs(force["qs"] - force["beta"])) > 0.05      # 0.099 measured
+
+
+@pytest.mark.parametrize("args, word", [
+    (["--mass", "redistributed", "--massless", "foo"], "--massless='foo' is not one of"),
+    (["--massless", "quasi-static"], "applies to --mass redistributed only"),
+    (["--mass", "redistributed", "--massless", "beta", "--law", "moreau-jean"],
+     "--law moreau-jean"),
+])
+def test_command_line_massless_refusals(args, word, tmp_path, capsys):
+    """A bad value, or --massless without a redistributed mass (or with Moreau–Jean): one
+    stderr line naming it, exit 2, nothing written."""
+    from conftest import assert_refused
+    from skfem_beam.cases import impacting_bar
+    assert_refused(impacting_bar.main, args + ["--T", "0.1", "--out", str(tmp_path / "run")],
+                   word, capsys, tmp_path)

@@ -17,6 +17,7 @@ from .errors import InputError, SolverError
 from .output.folder import (EXIT_INPUT, EXIT_SOLVER, EXIT_UNSTABLE, OPENED,  # noqa: F401
                             Interrupted, release, report, stamp)
 from .output.series import stored_args
+from .scheme.stepping import MASSLESS
 
 
 class Parser(argparse.ArgumentParser):
@@ -61,6 +62,10 @@ def parser(prog: str, description: str, *, J=None, dt=None, T=None, beta=None,
     p.add_argument("--restitution", type=float, default=0.0, metavar="E",
                    help="Newton coefficient of restitution e in [0, 1] (position, moreau-jean)")
     p.add_argument("--mass", default=mass[0], help=" | ".join(mass))
+    if "redistributed" in mass:
+        p.add_argument("--massless", default=None, help=" | ".join(MASSLESS) + ": how the "
+                       "massless rows of --mass redistributed step: β-weighted (default) or "
+                       "in equilibrium at the new time (use it at β = 1/4)")
     p.add_argument("--stiffness", type=float, default=1e8,
                    help="penalty stiffness 1/ε (N/m) for --method penalty")
     p.add_argument("--save-every", type=int, default=1,
@@ -112,6 +117,27 @@ def check_law(args, p: Parser) -> None:
         raise InputError(f"--restitution {e:g} must lie in [0, 1]")
     allowed = next(a.help.split(" | ") for a in p._actions if a.dest == "mass")
     check_choice("--mass", args.mass, allowed)
+    check_massless(args)
+
+
+def check_massless(args) -> None:
+    """--massless: one of MASSLESS, and only with --mass redistributed and the β-scheme
+    (left None when not given: the run then steps its massless rows the default way)."""
+    rows = getattr(args, "massless", None)
+    if rows is None:
+        return
+    check_choice("--massless", rows, MASSLESS)
+    if args.mass != "redistributed":
+        raise InputError(f"--massless {rows} applies to --mass redistributed only "
+                         f"(--mass is {args.mass}: it has no massless rows)")
+    if args.law == "moreau-jean":
+        raise InputError(f"--massless {rows} applies to the β-scheme (--law position); "
+                         "--law moreau-jean does not take it")
+
+
+def massless(args) -> str:
+    """The Stepping's ``massless``: the flag's value, or the default "beta"."""
+    return getattr(args, "massless", None) or "beta"
 
 
 def make_run(system, stepping, args, stiffness=None):

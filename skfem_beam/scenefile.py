@@ -41,7 +41,9 @@ from .bar import Bar
 from .errors import InputError
 from .problem import (Beam, BeamProblem, Damping, InitialState, Load, Material, Obstacles,
                       Section, Support)
+from .checks import check_choice
 from .scheme import Stepping
+from .scheme.stepping import MASSLESS
 from .timefunctions import Constant, Sine, SumOfSines, Table, band_limited
 
 V = None          # a value (checked by the object it builds)
@@ -84,7 +86,7 @@ BAR_KEYS = {
     "damping": {"viscosity": V},
     "loads": [{"value": V}],
     "initial": {"u0": Either(U0), "v0": Either(V0)},
-    "mesh": {"J": V, "mass": V},
+    "mesh": {"J": V, "mass": V, "massless": V},
     "time": TIME_KEYS, "contact": CONTACT, "output": OUTPUT,
 }
 KINDS = {"beam": BEAM_KEYS, "bar": BAR_KEYS}
@@ -243,11 +245,25 @@ def _scene(kind, problem, data, text, files) -> Scene:
         raise InputError("[time] needs dt and T (s)")
     beta = t.get("beta", 0.25 if kind == "bar" or law == "penalty" else 0.5)
     out = {**OUTPUT_DEFAULTS, **data.get("output", {})}
-    stepping = Stepping(t["dt"], t["T"], beta, out["save_every"], out["frames"])
+    stepping = Stepping(t["dt"], t["T"], beta, out["save_every"], out["frames"],
+                        massless=_massless(data.get("mesh", {})))
     scene = Scene(kind, problem, stepping, law, k, contact.get("restitution", 0.0), out,
                   text, files, data)
     scene.contact_law        # the law's own checks (name, stiffness, restitution)
     return scene
+
+
+def _massless(mesh: dict) -> str:
+    """[mesh] massless: how the massless rows of mass = "redistributed" step (Stepping);
+    refused with any other mass, which has no massless rows."""
+    rows = mesh.get("massless")
+    if rows is None:
+        return "beta"
+    check_choice("[mesh] massless", rows, MASSLESS)
+    if mesh.get("mass") != "redistributed":
+        raise InputError(f"[mesh] massless = {rows!r} needs mass = \"redistributed\" "
+                         f"(mass is {mesh.get('mass', 'average')!r}: it has no massless rows)")
+    return rows
 
 
 class _Reader:
@@ -593,6 +609,7 @@ def run_main(argv) -> int:
     args.solver = "auto" if penalty or scene.restitution else scene.law
     args.stiffness, args.restitution = scene.stiffness, scene.restitution
     args.mass = "consistent" if scene.kind == "beam" else scene.problem.mass
+    args.massless = scene.stepping.massless
     args.probe = [float(x) for x in np.atleast_1d(probes)]
     config = {"command": "python -m skfem_beam run", "scene_text": scene.text,
               "scene_files": scene.files}

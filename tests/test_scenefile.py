@@ -288,3 +288,25 @@ def test_restitution_runs_as_the_case_flag(tmp_path):
                                         "--restitution", "0.5"]) == 0
     assert series(a) == series(b)
     assert json.loads((a / "summary.json").read_text())["solver"] == "restitution"
+
+
+def test_massless_key_is_the_case_flag(tmp_path, capsys):
+    """[mesh] massless = "quasi-static" with mass = "redistributed" is the bar command's
+    --mass redistributed --massless quasi-static, bit for bit; an unknown value, or the
+    key without mass = "redistributed", is refused in one line naming it."""
+    a, b = tmp_path / "scene", tmp_path / "case"
+    mesh = ["--set", "mesh.mass=redistributed", "--set", "mesh.massless=quasi-static"]
+    assert load(example("impacting_bar"), mesh[1::2]).stepping.massless == "quasi-static"
+    assert exit_code(run_main, [str(example("impacting_bar")), "--set", "time.T=0.5", *mesh,
+                                "--out", str(a), "--format", "none"]) == 0
+    assert exit_code(impacting_bar.main, ["--T", "0.5", "--mass", "redistributed",
+                                          "--massless", "quasi-static", "--out", str(b),
+                                          "--format", "none"]) == 0
+    assert series(a) == series(b)
+    bad = tmp_path / "bad"
+    bad.mkdir()
+    for sets, word in ((["mesh.mass=redistributed", "mesh.massless=midpoint"],
+                        "[mesh] massless='midpoint' is not one of: beta, quasi-static"),
+                       (["mesh.massless=quasi-static"], 'needs mass = "redistributed"')):
+        assert_refused(run_main, [str(example("impacting_bar")), "--out", str(bad / "run"),
+                                  *[x for s in sets for x in ("--set", s)]], word, capsys, bad)

@@ -18,12 +18,14 @@ def test_quick_work_precision(tmp_path):
     col = lambda key, *k: np.array([float(r[key]) for r in by[k]])  # noqa: E731
     pos, mj, mm = "position, average, β=1/4", "Moreau–Jean θ=1/2 e=0, average", \
         "modified mass (redistributed), β=1/2"
+    qs = "modified mass (redistributed), β=1/4, quasi-static"
     for scene in ("rod", "bar"):
         for c in (0.04, 0.4):
             e = col("error", scene, pos, c)
             assert np.all(np.diff(e) < 0)                        # converges
             assert col("penetration", scene, pos, c).max() < 1e-15
             assert col("penetration", scene, mm, c).max() < 1e-15
+            assert col("penetration", scene, qs, c).max() < 1e-15
             assert np.all(col("penetration", scene, mj, c) > 1e-6)   # O(Δt)
             assert np.all(col("energy_drift", scene, pos, c) < 0)   # E_β only falls
     # a soft penalty spring penetrates; a stiff one at Δt/h = 0.4 gains energy

@@ -27,7 +27,8 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
     the timeseries columns, from memory).
     """
     cli.check_method(args)
-    stepping = Stepping(args.dt, args.T, args.beta, args.save_every, args.frames)
+    stepping = Stepping(args.dt, args.T, args.beta, args.save_every, args.frames,
+                        massless=cli.massless(args))
     out = prepare(args)                            # fail before the run, not after it
     system = beam_system(problem)
     add_probes(system, getattr(args, "probe", None) or [])

@@ -5,7 +5,7 @@
         [--u0-csv FILE] [--v0-csv FILE] [--far-end free|clamped]
         [--obstacle-at left|right] [--N 100]
         [--dt 1e-3] [--T 3] [--beta 0.25] [--method contact|penalty]
-        [--mass average|consistent|lumped|redistributed]
+        [--mass average|consistent|lumped|redistributed] [--massless beta|quasi-static]
         [--law position|moreau-jean|penalty] [--restitution E] [--save-every 1] [--frames 200] [--out DIR]
         [--checkpoint-every S] [--resume DIR]
 
@@ -90,7 +90,7 @@ def run_bar_case(bar: Bar, args, config: dict | None = None) -> int:
     out = prepare(args)                                  # fail before the run, not after
     run = bar_run(bar, dt, T, beta=args.beta, method="moreau-jean" if args.law == "moreau-jean"
                   else args.method, solver=args.solver, frames=args.frames,
-                  restitution=args.restitution)
+                  restitution=args.restitution, massless=cli.massless(args))
     try:
         exact = BarExact.of(bar, T)
     except RuntimeError as e:      # very long runs with many switches

@@ -42,9 +42,13 @@ from .errors import InputError
 from .problem import (Beam, BeamProblem, Damping, InitialState, Load, Material, Obstacles,
                       Section, Support)
 from .checks import check_choice
+from .cli import LAWS
+from .contact import SOLVERS
 from .scheme import Stepping
 from .scheme.stepping import MASSLESS
 from .timefunctions import Constant, Sine, SumOfSines, Table, band_limited
+
+BEAM_MASSES = ("consistent", "redistributed")        # [mesh] mass of a beam
 
 V = None          # a value (checked by the object it builds)
 
@@ -76,7 +80,7 @@ BEAM_KEYS = {
     "damping": {"zeta": V, "f1": V, "f2": V, "alpha": V, "alpha_K": V},
     "loads": [{"x": V, "distributed": V, "per_mass": V, "gravity": V, **TIME}],
     "initial": {"mode": V, "amplitude": V, "u0": U0, "v0": V0, "fixed_frame": V},
-    "mesh": {"J": V, "element": V, "nodes": V},
+    "mesh": {"J": V, "element": V, "nodes": V, "mass": V, "massless": V},
     "time": TIME_KEYS, "contact": CONTACT, "output": OUTPUT,
 }
 BAR_KEYS = {
@@ -116,14 +120,23 @@ class Scene:
     data: dict = field(default_factory=dict)
 
     @property
+    def scheme(self) -> str:
+        """The class of time-stepping: position (the β-scheme), moreau-jean or penalty;
+        ``law`` is one of these or a position-level solver (auto, projection, ...)."""
+        return self.law if self.law in LAWS else "position"
+
+    @property
     def contact_law(self):
-        """The contact law object (a beam's penalty stiffness is divided by ρA: the
-        equation is mass-normalised, docs/design.md §1)."""
+        """The β-scheme's contact law object, None for moreau-jean (its run is a
+        ``MoreauJean``, which solves its own impulse problem).  A beam's penalty stiffness
+        is divided by ρA: the equation is mass-normalised, docs/design.md §1."""
         from .contact import resolve
         k = self.stiffness
         if k is not None and self.kind == "beam":
             k = k / (self.problem.beam.rho_S or 1.0)
-        return resolve(self.law, k, self.restitution or 0.0)
+        law = resolve("auto" if self.law in LAWS[:2] else self.law, k,
+                      self.restitution or 0.0)
+        return None if self.law == "moreau-jean" else law
 
 
 # ---------------------------------------------------------------- the file's shape
@@ -240,6 +253,10 @@ def _scene(kind, problem, data, text, files) -> Scene:
     law, k = contact.get("law", "auto"), contact.get("stiffness")
     if k is not None and law == "auto":
         law = "penalty"
+    check_choice("[contact] law", law, (*LAWS, *SOLVERS))
+    if k is not None and law in LAWS[:2]:
+        raise InputError(f"[contact] stiffness is the penalty spring: law = {law!r} does not "
+                         "take it")
     t = data.get("time", {})
     if "dt" not in t or "T" not in t:
         raise InputError("[time] needs dt and T (s)")
@@ -250,6 +267,12 @@ def _scene(kind, problem, data, text, files) -> Scene:
     scene = Scene(kind, problem, stepping, law, k, contact.get("restitution", 0.0), out,
                   text, files, data)
     scene.contact_law        # the law's own checks (name, stiffness, restitution)
+    mesh = data.get("mesh", {})
+    if kind == "beam":
+        check_choice("[mesh] mass", mesh.get("mass", "consistent"), BEAM_MASSES)
+    if scene.law == "moreau-jean" and "massless" in mesh:
+        raise InputError("[mesh] massless applies to the β-scheme: [contact] law = "
+                         "\"moreau-jean\" does not take it")
     return scene
 
 
@@ -262,7 +285,7 @@ def _massless(mesh: dict) -> str:
     check_choice("[mesh] massless", rows, MASSLESS)
     if mesh.get("mass") != "redistributed":
         raise InputError(f"[mesh] massless = {rows!r} needs mass = \"redistributed\" "
-                         f"(mass is {mesh.get('mass', 'average')!r}: it has no massless rows)")
+                         "(the other masses have no massless rows)")
     return rows
 
 
@@ -605,10 +628,12 @@ def run_main(argv) -> int:
     penalty = scene.law == "penalty"
     args.dt, args.beta = scene.stepping.dt, scene.stepping.beta
     args.method = "penalty" if penalty else "contact"
-    args.law = "penalty" if penalty else "position"
-    args.solver = "auto" if penalty or scene.restitution else scene.law
+    args.law = scene.scheme
+    args.solver = "auto" if args.law != "position" or scene.restitution \
+        or scene.law == "position" else scene.law
     args.stiffness, args.restitution = scene.stiffness, scene.restitution
-    args.mass = "consistent" if scene.kind == "beam" else scene.problem.mass
+    args.mass = scene.data.get("mesh", {}).get("mass", "consistent") \
+        if scene.kind == "beam" else scene.problem.mass
     args.massless = scene.stepping.massless
     args.probe = [float(x) for x in np.atleast_1d(probes)]
     config = {"command": "python -m skfem_beam run", "scene_text": scene.text,

@@ -310,3 +310,36 @@ def test_massless_key_is_the_case_flag(tmp_path, capsys):
                        (["mesh.massless=quasi-static"], 'needs mass = "redistributed"')):
         assert_refused(run_main, [str(example("impacting_bar")), "--out", str(bad / "run"),
                                   *[x for s in sets for x in ("--set", s)]], word, capsys, bad)
+
+
+@pytest.mark.parametrize("scene, sets, flags", [
+    ("impacting_bar", ["contact.law=moreau-jean", "time.T=0.5"],
+     (impacting_bar.main, ["--T", "0.5", "--law", "moreau-jean"])),
+    ("point_stops", ["contact.law=moreau-jean", "time.T=0.3"],
+     (point_stops.main, ["--T", "0.3", "--law", "moreau-jean"])),
+    ("point_stops", ["mesh.mass=redistributed", "mesh.massless=quasi-static", "time.T=0.3"],
+     (point_stops.main, ["--T", "0.3", "--mass", "redistributed", "--massless",
+                         "quasi-static"])),
+])
+def test_law_and_mass_keys_are_the_case_flags(tmp_path, scene, sets, flags):
+    """[contact] law = "moreau-jean" and a beam's [mesh] mass / massless run as the case
+    command's --law, --mass, --massless, bit for bit (issue: scene files name every class)."""
+    a, b = tmp_path / "scene", tmp_path / "case"
+    assert exit_code(run_main, [str(example(scene)), *[x for s in sets for x in ("--set", s)],
+                                "--out", str(a), "--format", "none"]) == 0
+    main, argv = flags
+    assert exit_code(main, [*argv, "--out", str(b), "--format", "none"]) == 0
+    assert series(a) == series(b)
+    assert json.loads((a / "summary.json").read_text())["status"] == "success"
+
+
+@pytest.mark.parametrize("sets, word", [
+    (["mesh.mass=lumped"], "[mesh] mass='lumped' is not one of: consistent, redistributed"),
+    (["contact.law=bogus"], "[contact] law='bogus' is not one of: position, moreau-jean"),
+    (["contact.law=position", "contact.stiffness=1e6"], "law = 'position' does not take it"),
+    (["contact.law=moreau-jean", "mesh.mass=redistributed", "mesh.massless=beta"],
+     '[mesh] massless applies to the β-scheme'),
+])
+def test_bad_law_and_mass_keys_are_refused(tmp_path, capsys, sets, word):
+    assert_refused(run_main, [str(example("point_stops")), "--out", str(tmp_path / "run"),
+                              *[x for s in sets for x in ("--set", s)]], word, capsys, tmp_path)

@@ -148,7 +148,9 @@ def _gi(D, yf, lo, hi, state, mu, maxit):
     z = np.empty(m)
     v = np.empty(m)
     y = np.empty(m)
-    k = 0
+    # np.int64(·), not a bare literal, for the values passed to the helpers below: a
+    # literal start gives each helper a second compile for Literal[int] (1.3 s cold)
+    k = np.int64(0)
     for i in range(m):                   # warm start: factor D_WW by appending
         b = lo[i] if state[i] < 0 else hi[i]
         if state[i] == 0 or not np.isfinite(b):
@@ -172,7 +174,7 @@ def _gi(D, yf, lo, hi, state, mu, maxit):
         _multipliers(L, k, W, yf, lo, hi, state, w, z, mu)
         # dual feasibility (a warm start, or round-off at a grazing bound, can violate
         # it): drop the worst; any wrong sign counts, so returned signs are exact
-        worst, wv = -1, 0.0
+        worst, wv = np.int64(-1), 0.0
         for a in range(k):
             i = W[a]
             t = state[i] * mu[i] * D[i, i]   # > 0: wrong sign, in units of y
@@ -187,7 +189,7 @@ def _gi(D, yf, lo, hi, state, mu, maxit):
             changes += 1
             continue
         _values(D, W, k, yf, mu, y)
-        p, pv = -1, tol                  # most violated bound
+        p, pv = np.int64(-1), tol       # most violated bound
         for i in range(m):
             if state[i] == 0:
                 t = max(lo[i] - y[i], y[i] - hi[i])
@@ -206,7 +208,7 @@ def _gi(D, yf, lo, hi, state, mu, maxit):
                 return -1
             _backward(L, k, w, z)        # z = D_WW⁻¹ D_Wp: dμ_W/dμ_p = −z
             full = (bp - yp) / schur
-            tau, block = 1.0, -1
+            tau, block = 1.0, np.int64(-1)
             for a in range(k):
                 i = W[a]
                 d = -z[a] * full * state[i]   # growth of the wrong-sign part

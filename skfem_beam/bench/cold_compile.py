@@ -4,16 +4,18 @@
 
 Each repeat copies the package (sources only) to a fresh temporary folder, so that no
 ``__pycache__`` and no numba cache exist, runs the job there twice in child processes
-(cold, then warm), and reports both wall times and their difference: the compile a
+(cold, then warm), and reports both times (CPU and wall) and their difference: the compile a
 first run pays.  The cold child registers a ``numba:compile`` listener and times the
 law's C callbacks (``CFunc.compile``), so the compile time is attributed per function:
 ``self`` excludes the functions compiled inside it (callees that are not inlined),
-``total`` includes them.
+``total`` includes them.  The per-function times are CPU seconds, which a busy shared
+machine disturbs less than wall time.
 """
 from __future__ import annotations
 
 import argparse
 import json
+import resource
 import shutil
 import subprocess
 import sys
@@ -32,26 +34,26 @@ def _listen() -> list:
 
     class Timer(event.Listener):
         def on_start(self, ev):
-            stack.append(time.perf_counter())
+            stack.append(time.process_time())
 
         def on_end(self, ev):
             t0 = stack.pop()
             d = ev.data or {}
             disp = d.get("dispatcher")
             name = getattr(getattr(disp, "py_func", None), "__qualname__", str(disp))
-            records.append((name, t0, time.perf_counter(), len(stack),
+            records.append((name, t0, time.process_time(), len(stack),
                             str(d.get("args", ""))))
 
     event.register("numba:compile", Timer())
     original = ccallback.CFunc.compile
 
     def timed(self):      # C callbacks (the laws) do not send a numba:compile event
-        stack.append(time.perf_counter())
+        stack.append(time.process_time())
         try:
             original(self)
         finally:
             t0 = stack.pop()
-            records.append((f"cfunc {self.__name__}", t0, time.perf_counter(), len(stack), ""))
+            records.append((f"cfunc {self.__name__}", t0, time.process_time(), len(stack), ""))
 
     ccallback.CFunc.compile = timed
     return records
@@ -61,29 +63,31 @@ def _child(job: str, out: str) -> None:
     """Runs ``python -m job --out out`` in this process with the compile listener."""
     import importlib
     records = _listen()
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     code = importlib.import_module(job).main(["--out", out, "--overwrite"])
-    wall = time.perf_counter() - t0
+    cpu = time.process_time() - t0
     rows = []
     for i, (name, a, b, depth, args) in enumerate(records):
         inner = sum(b2 - a2 for (_, a2, b2, d2, _) in records
                     if d2 == depth + 1 and a <= a2 and b2 <= b)
         rows.append({"name": name, "total_s": b - a, "self_s": b - a - inner, "depth": depth,
                      "args": args})
-    print(json.dumps({"code": code, "wall_s": wall, "compiles": rows}))
+    print(json.dumps({"code": code, "cpu_s": cpu, "compiles": rows}))
 
 
-def _run(folder: Path, job: str, listen: bool) -> tuple[float, dict]:
+def _run(folder: Path, job: str, listen: bool) -> tuple[float, float, dict]:
     out = folder / "out"
-    argv = ([sys.executable, "-m", "skfem_beam.bench.cold_compile", "--child", job, str(out)]
+    # the listener runs from this file, so that an older checkout can be measured too
+    argv = ([sys.executable, str(Path(__file__).resolve()), "--child", job, str(out)]
             if listen else [sys.executable, "-m", job, "--out", str(out), "--overwrite"])
-    t0 = time.perf_counter()
+    before, t0 = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
     p = subprocess.run(argv, cwd=folder, env={**_env(), "PYTHONPATH": str(folder)},
                        capture_output=True, text=True, check=True)
-    wall = time.perf_counter() - t0
+    wall, after = time.perf_counter() - t0, resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
     info = json.loads(p.stdout.strip().splitlines()[-1]) if listen else {}
     info["stderr"] = p.stderr
-    return wall, info
+    return cpu, wall, info
 
 
 def _env() -> dict:
@@ -96,6 +100,8 @@ def main(argv=None) -> int:
                                  description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--job", default="skfem_beam.cases.flat_obstacles")
+    ap.add_argument("--package", default=str(PACKAGE),
+                    help="the skfem_beam folder to copy (another checkout, to compare)")
     ap.add_argument("--child", nargs=2, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.child:
@@ -104,13 +110,14 @@ def main(argv=None) -> int:
     for r in range(args.repeat):
         with tempfile.TemporaryDirectory() as tmp:
             folder = Path(tmp)
-            shutil.copytree(PACKAGE, folder / "skfem_beam",
+            shutil.copytree(args.package, folder / "skfem_beam",
                             ignore=shutil.ignore_patterns("__pycache__"))
-            cold, info = _run(folder, args.job, listen=True)
-            warm, again = _run(folder, args.job, listen=False)
+            cold, cold_wall, info = _run(folder, args.job, listen=True)
+            warm, warm_wall, again = _run(folder, args.job, listen=False)
         notice = "compiling numerical kernels"
-        print(f"run {r + 1}: cold {cold:.2f} s, warm {warm:.2f} s, compile {cold - warm:.2f} s "
-              f"(notice: cold {info['stderr'].count(notice)}, warm "
+        print(f"run {r + 1}: CPU cold {cold:.2f} s, warm {warm:.2f} s, compile {cold - warm:.2f} s;"
+              f" wall cold {cold_wall:.2f} s, warm {warm_wall:.2f} s, compile "
+              f"{cold_wall - warm_wall:.2f} s (notice: cold {info['stderr'].count(notice)}, warm "
               f"{again['stderr'].count(notice)})")
         by = {}
         for c in info["compiles"]:

@@ -187,14 +187,9 @@ def record(n, ops, st, out):
 
 @njit(cache=True, inline="always")
 def call_law(law, ops, st):
-    """One call of a compiled law on the state's free step (the start step uses it)."""
+    """One call of a compiled law on the state's free step."""
     return law(ops.D, st.yf, st.y_cur, st.y_prev, st.lo, st.hi, ops.params, st.law_state,
                st.mu, st.active)
-
-
-@njit(cache=True)
-def call_explicit(explicit, ops, st, y_cur, y_prev, r):
-    return explicit(y_cur, y_prev, st.lo, st.hi, ops.params, r)
 
 
 @njit(cache=True, inline="always")

@@ -17,8 +17,8 @@ from ..errors import InputError, SolverError
 from ..linalg import band_solve, rows_matvec
 from ..stability import kappa_h, linear_limit
 from .kernels import (EVENTS_FULL, FAILED, UNSTABLE, WORK_TERMS, Inputs, Ops, PythonLaw,
-                      Series, State, call_explicit, call_law, csr_product, energy_beta,
-                      move_bounds, record, run_steps, run_steps_python)
+                      Series, State, csr_product, energy_beta, move_bounds, record, run_steps,
+                      run_steps_python)
 from .operators import csr_arrays, step_operators
 from .stepping import Result, Stepping
 
@@ -173,6 +173,12 @@ class Run:
         energy into the top modes (an explicit Taylor start gave ½E_β¹ = 855 instead of
         166.8 for the energy-decay scene at J = 80, Δt = 1e-3).  Its contact is the
         chosen law's (a spring's force at u⁰ weighted ½(1−2β), see contact.penalty).
+
+        It runs the loop's helpers and the law as the Python functions they are compiled
+        from (``py_func``, the law's ``func``), on the same arrays: one step, the same
+        floating-point operations in the same order, so the same numbers; compiling them
+        apart from the loop, which inlines them, cost 3–4 s on a fresh install.  What they
+        call that is compiled (energy_beta, box_qp, ...) is shared with the loop.
         """
         system, op, st, out = self.system, self.op, self.st, self.out
         dt, beta, M, K, B = self.dt, self.beta, system.M, system.K, system.B
@@ -185,11 +191,9 @@ class Run:
         if B is not None:
             F0 -= 0.5 * dt**2 * (B @ v0)
         csr_product(self.ops.Cp, self.ops.Ci, self.ops.Cx, u0, st.y_prev)
-        move_bounds(self.ops, st, self.motion(np.array([dt]))[0])   # the bounds at t₁
-        kernel, explicit = self._kernels
-        first = self.ops._replace(params=first_params)
+        move_bounds.py_func(self.ops, st, self.motion(np.array([dt]))[0])   # bounds at t₁
         if self.law.explicit is not None:   # its force at u⁰ as load, implicit at u¹ (as K)
-            call_explicit(explicit, first, st, st.y_prev, st.y_prev, st.r_e)
+            self.law.explicit.func(st.y_prev, st.y_prev, st.lo, st.hi, first_params, st.r_e)
             F0 += dt**2 * (op.C.T @ st.r_e)
             st.r_e[:] = 0.0
         u1 = F0.copy()
@@ -202,7 +206,8 @@ class Run:
                 st.mu[:] = mu
             else:
                 st.y_cur[:] = st.y_prev
-                if call_law(kernel, first, st) < 0:
+                if self.law.kernel.func(self.ops.D, st.yf, st.y_cur, st.y_prev, st.lo, st.hi,
+                                        first_params, st.law_state, st.mu, st.active) < 0:
                     raise SolverError("the first step's contact problem could not be solved")
                 st.law_state[:] = 0
                 st.active[:] = False
@@ -215,7 +220,7 @@ class Run:
         out.obs[0] = Orows @ st.u_prev
         out.obsv[0] = Orows @ system.v0
         rows_matvec(op.Kb.rows, st.u_prev, st.Ku)   # K uⁿ⁻¹ for the energy
-        record(1, self.ops, st, out)
+        record.py_func(1, self.ops, st, out)
         out.frames_u[0], out.frames_v[0] = st.u_prev, system.v0
         self.E1 = 0.5 * energy_beta(op.Eb.rows, st.u_prev, st.u_cur, st.Ku, st.d)
         if not (np.isfinite(st.u_cur).all() and math.isfinite(self.E1)):

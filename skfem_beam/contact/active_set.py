@@ -35,8 +35,12 @@ REL_TOL = 1e-13
 # bounds' scale, beyond which the engine's active set is wrong, not merely grazing
 REPAIR_TOL = 1e-6
 
+# The helpers below are called from compiled code only: no Python or C entry wrappers
+# to build (a cold start compiles them once each, with the law)
+internal = njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 
-@njit(cache=True)
+
+@internal
 def _scale(yf, lo, hi):
     s = 0.0
     for i in range(yf.size):
@@ -48,7 +52,7 @@ def _scale(yf, lo, hi):
     return s if s > 0.0 else 1.0
 
 
-@njit(cache=True)
+@internal
 def _forward(L, k, D, W, p, w):
     """w ← L⁻¹ D[W, p]; returns the Schur complement D_pp − wᵀw."""
     s2 = 0.0
@@ -61,7 +65,7 @@ def _forward(L, k, D, W, p, w):
     return D[p, p] - s2
 
 
-@njit(cache=True)
+@internal
 def _backward(L, k, w, z):
     """z ← L⁻ᵀ w."""
     for a in range(k - 1, -1, -1):
@@ -71,7 +75,7 @@ def _backward(L, k, w, z):
         z[a] = s / L[a, a]
 
 
-@njit(cache=True)
+@internal
 def _drop(L, k, j, W, v):
     """Remove position j from W and its row/column from L (rank-one update of the
     trailing block: L₃₃'L₃₃'ᵀ = L₃₃L₃₃ᵀ + l₃₂l₃₂ᵀ)."""
@@ -96,7 +100,7 @@ def _drop(L, k, j, W, v):
             v[e] = cs * v[e] - sn * L[b, a]
 
 
-@njit(cache=True)
+@internal
 def _grow(L, k, m):
     c = min(m, 2 * k + 8)
     L2 = np.empty((c, c))
@@ -106,7 +110,7 @@ def _grow(L, k, m):
     return L2
 
 
-@njit(cache=True)
+@internal
 def _multipliers(L, k, W, yf, lo, hi, state, w, z, mu):
     """μ_W = D_WW⁻¹ (b_W − y_f,W) by the two triangular solves."""
     for a in range(k):
@@ -122,7 +126,7 @@ def _multipliers(L, k, W, yf, lo, hi, state, w, z, mu):
         mu[W[a]] = z[a]
 
 
-@njit(cache=True)
+@internal
 def _values(D, W, k, yf, mu, y):
     """y = y_f + D[:, W] μ_W (D symmetric: read contiguous rows)."""
     for i in range(y.size):              # loops, not slice assignment: compiles in 1/10 the time
@@ -134,7 +138,7 @@ def _values(D, W, k, yf, mu, y):
             y[i] += D[j, i] * c
 
 
-@njit(cache=True)
+@internal
 def _gi(D, yf, lo, hi, state, mu, maxit):
     m = yf.size
     tol = REL_TOL * _scale(yf, lo, hi)

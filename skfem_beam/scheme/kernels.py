@@ -274,7 +274,8 @@ def end_step(ops, st, out, step, Gn, Ebound):
 # Compiled without numba's reference counting: the loop allocates nothing, and the
 # refcount operations on the named tuples' arrays cost 0.6 µs of a 1.3 µs step (measured).
 # nogil: the output pipeline writes the last chunk's rows while this computes the next.
-@njit(cache=True, _nrt=False, nogil=True)
+# No C entry wrapper: it is never passed as a first-class function.
+@njit(cache=True, _nrt=False, nogil=True, no_cfunc_wrapper=True)
 def run_steps(law, explicit, ops, st, out, n0, n1, inputs, Ebound):
     """Steps n = n0..n1−1 (computing uⁿ⁺¹) with a compiled law: the bounds at t_{n+1},
     the law's explicit force, the free step, the law, then `end_step`.  ``inputs``

@@ -8,6 +8,7 @@ import time
 import numpy as np
 import scipy.sparse
 import scipy.sparse.linalg
+from numba import typeof, types
 from numba.core import event
 
 from ..contact import ContactLaw, StepData, resolve
@@ -150,6 +151,7 @@ class Run:
                           np.full((nframes, n), np.nan), np.full((nframes, n), np.nan),
                           np.zeros((nframes, m)), np.zeros((max(4096, 4 * m), 7)))
         self.events = []       # impact event rows taken from the compiled loop's buffer
+        self._compile_side_by_side()
         self._start(Orows, law.setup(step, first=True))
         self.load_bound = 0.0  # Σ‖Gⁿ‖_{M⁻¹}Δt so far: the a-priori energy bound grows with it
         self.n = 1             # the last computed state
@@ -162,6 +164,26 @@ class Run:
         """The compiled law and its explicit part (no-ops for a law solved in Python)."""
         return ((self.law.kernel or NoContact.kernel).cfunc,
                 (self.law.explicit or no_explicit).cfunc)
+
+    def _compile_side_by_side(self) -> None:
+        """A fresh install (this process has compiled a kernel already, so numba's cache is
+        cold) compiles the law in a child process while this one compiles the loop for
+        these arrays' types; then it waits for the law (see contact.base.Compiled)."""
+        if self.law.kernel is None or not _CompileNotice.said:
+            return
+        kernel, explicit = self.law.kernel, self.law.explicit or no_explicit
+        # the types of the arguments exactly as _steps passes them: the same compiled loop
+        loop = (types.FunctionType(kernel.signature), types.FunctionType(explicit.signature))
+        args = (self.ops, self.st, self.out, 1, 1,
+                Inputs(np.zeros((0, self.loads.shape[1])), np.zeros(0)), 0.0)
+        loop += tuple(typeof(a) for a in args)
+        if loop in run_steps.overloads:
+            return
+        for k in (self.law.kernel, self.law.explicit):
+            if k is not None:
+                k.compile_aside()
+        run_steps.compile(loop)
+        _ = self._kernels     # wait for the law: the start step calls what it compiled
 
     def _start(self, Orows, first_params) -> None:
         """u¹: one step of the scheme itself, from u⁰ and the fictitious u⁻¹ = u¹ − 2Δt v⁰

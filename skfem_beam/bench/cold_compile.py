@@ -8,13 +8,16 @@ Each repeat copies the package (sources only) to a fresh temporary folder, so th
 first run pays.  The cold child registers a ``numba:compile`` listener and times the
 law's C callbacks (``CFunc.compile``), so the compile time is attributed per function:
 ``self`` excludes the functions compiled inside it (callees that are not inlined),
-``total`` includes them.  The per-function times are CPU seconds, which a busy shared
+``total`` includes them; a law compiled aside in a child process (a fresh install on
+two cores or more, see contact.base.Compiled) is not listed: ``--one-core`` lists it.  The
+CPU times include that child's.  The per-function times are CPU seconds, which a busy shared
 machine disturbs less than wall time.
 """
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import resource
 import shutil
 import subprocess
@@ -75,14 +78,16 @@ def _child(job: str, out: str) -> None:
     print(json.dumps({"code": code, "cpu_s": cpu, "compiles": rows}))
 
 
-def _run(folder: Path, job: str, listen: bool) -> tuple[float, float, dict]:
+def _run(folder: Path, job: str, listen: bool, one_core: bool) -> tuple[float, float, dict]:
     out = folder / "out"
     # the listener runs from this file, so that an older checkout can be measured too
     argv = ([sys.executable, str(Path(__file__).resolve()), "--child", job, str(out)]
             if listen else [sys.executable, "-m", job, "--out", str(out), "--overwrite"])
     before, t0 = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
+    # one core: the run compiles its law itself (not aside), so every compile is listed
+    pin = (lambda: os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})) if one_core else None
     p = subprocess.run(argv, cwd=folder, env={**_env(), "PYTHONPATH": str(folder)},
-                       capture_output=True, text=True, check=True)
+                       capture_output=True, text=True, check=True, preexec_fn=pin)
     wall, after = time.perf_counter() - t0, resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
     info = json.loads(p.stdout.strip().splitlines()[-1]) if listen else {}
@@ -91,7 +96,6 @@ def _run(folder: Path, job: str, listen: bool) -> tuple[float, float, dict]:
 
 
 def _env() -> dict:
-    import os
     return {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_CACHE_DIR")}
 
 
@@ -102,6 +106,9 @@ def main(argv=None) -> int:
     ap.add_argument("--job", default="skfem_beam.cases.flat_obstacles")
     ap.add_argument("--package", default=str(PACKAGE),
                     help="the skfem_beam folder to copy (another checkout, to compare)")
+    ap.add_argument("--one-core", action="store_true",
+                    help="pin the runs to one core: the law compiles in the run itself, so the "
+                         "table lists it (by default it compiles in a child process, unlisted)")
     ap.add_argument("--child", nargs=2, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.child:
@@ -112,8 +119,8 @@ def main(argv=None) -> int:
             folder = Path(tmp)
             shutil.copytree(args.package, folder / "skfem_beam",
                             ignore=shutil.ignore_patterns("__pycache__"))
-            cold, cold_wall, info = _run(folder, args.job, listen=True)
-            warm, warm_wall, again = _run(folder, args.job, listen=False)
+            cold, cold_wall, info = _run(folder, args.job, True, args.one_core)
+            warm, warm_wall, again = _run(folder, args.job, False, args.one_core)
         notice = "compiling numerical kernels"
         print(f"run {r + 1}: CPU cold {cold:.2f} s, warm {warm:.2f} s, compile {cold - warm:.2f} s;"
               f" wall cold {cold_wall:.2f} s, warm {warm_wall:.2f} s, compile "

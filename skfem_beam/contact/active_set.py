@@ -35,8 +35,12 @@ REL_TOL = 1e-13
 # bounds' scale, beyond which the engine's active set is wrong, not merely grazing
 REPAIR_TOL = 1e-6
 
+# The helpers below are called from compiled code only: no Python or C entry wrappers
+# to build (a cold start compiles them once each, with the law)
+internal = njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 
-@njit(cache=True)
+
+@internal
 def _scale(yf, lo, hi):
     s = 0.0
     for i in range(yf.size):
@@ -48,7 +52,7 @@ def _scale(yf, lo, hi):
     return s if s > 0.0 else 1.0
 
 
-@njit(cache=True)
+@internal
 def _forward(L, k, D, W, p, w):
     """w ← L⁻¹ D[W, p]; returns the Schur complement D_pp − wᵀw."""
     s2 = 0.0
@@ -61,7 +65,7 @@ def _forward(L, k, D, W, p, w):
     return D[p, p] - s2
 
 
-@njit(cache=True)
+@internal
 def _backward(L, k, w, z):
     """z ← L⁻ᵀ w."""
     for a in range(k - 1, -1, -1):
@@ -71,7 +75,7 @@ def _backward(L, k, w, z):
         z[a] = s / L[a, a]
 
 
-@njit(cache=True)
+@internal
 def _drop(L, k, j, W, v):
     """Remove position j from W and its row/column from L (rank-one update of the
     trailing block: L₃₃'L₃₃'ᵀ = L₃₃L₃₃ᵀ + l₃₂l₃₂ᵀ)."""
@@ -96,7 +100,7 @@ def _drop(L, k, j, W, v):
             v[e] = cs * v[e] - sn * L[b, a]
 
 
-@njit(cache=True)
+@internal
 def _grow(L, k, m):
     c = min(m, 2 * k + 8)
     L2 = np.empty((c, c))
@@ -106,7 +110,7 @@ def _grow(L, k, m):
     return L2
 
 
-@njit(cache=True)
+@internal
 def _multipliers(L, k, W, yf, lo, hi, state, w, z, mu):
     """μ_W = D_WW⁻¹ (b_W − y_f,W) by the two triangular solves."""
     for a in range(k):
@@ -122,7 +126,7 @@ def _multipliers(L, k, W, yf, lo, hi, state, w, z, mu):
         mu[W[a]] = z[a]
 
 
-@njit(cache=True)
+@internal
 def _values(D, W, k, yf, mu, y):
     """y = y_f + D[:, W] μ_W (D symmetric: read contiguous rows)."""
     for i in range(y.size):              # loops, not slice assignment: compiles in 1/10 the time
@@ -134,7 +138,7 @@ def _values(D, W, k, yf, mu, y):
             y[i] += D[j, i] * c
 
 
-@njit(cache=True)
+@internal
 def _gi(D, yf, lo, hi, state, mu, maxit):
     m = yf.size
     tol = REL_TOL * _scale(yf, lo, hi)
@@ -148,7 +152,9 @@ def _gi(D, yf, lo, hi, state, mu, maxit):
     z = np.empty(m)
     v = np.empty(m)
     y = np.empty(m)
-    k = 0
+    # np.int64(·), not a bare literal, for the values passed to the helpers below: a
+    # literal start gives each helper a second compile for Literal[int] (1.3 s cold)
+    k = np.int64(0)
     for i in range(m):                   # warm start: factor D_WW by appending
         b = lo[i] if state[i] < 0 else hi[i]
         if state[i] == 0 or not np.isfinite(b):
@@ -172,7 +178,7 @@ def _gi(D, yf, lo, hi, state, mu, maxit):
         _multipliers(L, k, W, yf, lo, hi, state, w, z, mu)
         # dual feasibility (a warm start, or round-off at a grazing bound, can violate
         # it): drop the worst; any wrong sign counts, so returned signs are exact
-        worst, wv = -1, 0.0
+        worst, wv = np.int64(-1), 0.0
         for a in range(k):
             i = W[a]
             t = state[i] * mu[i] * D[i, i]   # > 0: wrong sign, in units of y
@@ -187,7 +193,7 @@ def _gi(D, yf, lo, hi, state, mu, maxit):
             changes += 1
             continue
         _values(D, W, k, yf, mu, y)
-        p, pv = -1, tol                  # most violated bound
+        p, pv = np.int64(-1), tol       # most violated bound
         for i in range(m):
             if state[i] == 0:
                 t = max(lo[i] - y[i], y[i] - hi[i])
@@ -206,7 +212,7 @@ def _gi(D, yf, lo, hi, state, mu, maxit):
                 return -1
             _backward(L, k, w, z)        # z = D_WW⁻¹ D_Wp: dμ_W/dμ_p = −z
             full = (bp - yp) / schur
-            tau, block = 1.0, -1
+            tau, block = 1.0, np.int64(-1)
             for a in range(k):
                 i = W[a]
                 d = -z[a] * full * state[i]   # growth of the wrong-sign part

@@ -31,6 +31,10 @@ and cached once for all of them and calls the law through a pointer.
 """
 from __future__ import annotations
 
+import atexit
+import os
+import subprocess
+import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -45,18 +49,66 @@ LAW_SIGNATURE = types.int64(types.float64[:, ::1], _vec, _vec, _vec, _vec, _vec,
 EXPLICIT_SIGNATURE = types.int64(_vec, _vec, _vec, _vec, _vec, _vec)
 
 
+# the child that compiles a kernel aside: import its module, compile it into numba's cache
+_CHILD = "import importlib, sys; getattr(importlib.import_module(sys.argv[1]), sys.argv[2]).cfunc"
+
+
 class Compiled:
     """A law's kernel, compiled (and cached on disk) the first time a run uses it, so that
     a run compiles its own law only: a cold start compiled every law at import (16 s)."""
 
     def __init__(self, func, signature):
-        self.func, self.signature, self._cfunc = func, signature, None
+        self.func, self.signature, self._cfunc, self._child = func, signature, None, None
 
     @property
     def cfunc(self):
         if self._cfunc is None:
+            if self._child is not None:     # compiled aside: then this loads it from the cache
+                try:
+                    self._child.wait(timeout=600)
+                except subprocess.TimeoutExpired:
+                    self._child.kill()
+                self._child = None
             self._cfunc = cfunc(self.signature, cache=True)(self.func)
         return self._cfunc
+
+    def compile_aside(self) -> None:
+        """Start compiling this kernel into numba's on-disk cache in a child process, while
+        this process compiles the time loop (a fresh install: two independent compiles of
+        ~4 s each, run side by side on two cores); `cfunc` then waits for the child and
+        loads the result.  Nothing happens when it is compiled already, when it is not a
+        module-level kernel another process can import, or with one core.  Should the
+        child fail, `cfunc` compiles it here as before."""
+        mod, name = self.func.__module__, self.func.__name__
+        if self._cfunc is not None or self._child is not None or mod == "__main__" \
+                or getattr(sys.modules.get(mod), name, None) is not self or _cores() < 2:
+            return
+        # the child imports the same package: this process's sys.path, '' as the cwd
+        path = os.pathsep.join(os.path.abspath(p or os.curdir) for p in sys.path)
+        try:
+            self._child = subprocess.Popen(
+                [sys.executable, "-c", _CHILD, mod, name], env={**os.environ, "PYTHONPATH": path},
+                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        except OSError:
+            return
+        _CHILDREN.append(self._child)
+
+
+_CHILDREN = []
+
+
+def _cores() -> int:
+    affinity = getattr(os, "sched_getaffinity", None)
+    return len(affinity(0)) if affinity else (os.cpu_count() or 1)
+
+
+@atexit.register
+def _stop_children() -> None:
+    """A process that ends before it needed its law leaves no compiler running."""
+    for child in _CHILDREN:
+        if child.poll() is None:
+            child.kill()
+            child.wait()
 
 
 def compiled_law(func) -> Compiled:

@@ -228,14 +228,9 @@ def record(n, ops, st, out):
 
 @njit(cache=True, inline="always")
 def call_law(law, ops, st):
-    """One call of a compiled law on the state's free step (the start step uses it)."""
+    """One call of a compiled law on the state's free step."""
     return law(ops.D, st.yf, st.y_cur, st.y_prev, st.lo, st.hi, ops.params, st.law_state,
                st.mu, st.active)
-
-
-@njit(cache=True)
-def call_explicit(explicit, ops, st, y_cur, y_prev, r):
-    return explicit(y_cur, y_prev, st.lo, st.hi, ops.params, r)
 
 
 @njit(cache=True, inline="always")
@@ -333,7 +328,8 @@ def end_step(ops, st, out, step, Gn, Ebound):
 # Compiled without numba's reference counting: the loop allocates nothing, and the
 # refcount operations on the named tuples' arrays cost 0.6 µs of a 1.3 µs step (measured).
 # nogil: the output pipeline writes the last chunk's rows while this computes the next.
-@njit(cache=True, _nrt=False, nogil=True)
+# No C entry wrapper: it is never passed as a first-class function.
+@njit(cache=True, _nrt=False, nogil=True, no_cfunc_wrapper=True)
 def run_steps(law, explicit, ops, st, out, n0, n1, inputs, Ebound):
     """Steps n = n0..n1−1 (computing uⁿ⁺¹) with a compiled law: the bounds at t_{n+1},
     the law's explicit force, the free step, the law, then `end_step`.  ``inputs``

@@ -7,6 +7,7 @@ import time
 
 import numpy as np
 import scipy.sparse
+from numba import typeof, types
 from numba.core import event
 
 from ..contact import ContactLaw, StepData, resolve
@@ -16,8 +17,8 @@ from ..errors import InputError, SolverError
 from ..linalg import band_solve, rows_matvec
 from ..stability import kappa_h, linear_limit
 from .kernels import (EVENTS_FULL, FAILED, UNSTABLE, WORK_TERMS, Inputs, Ops, PythonLaw,
-                      Series, State, call_explicit, call_law, csr_product, energy_beta,
-                      move_bounds, record, run_steps, run_steps_python)
+                      Series, State, csr_product, energy_beta, move_bounds, record, run_steps,
+                      run_steps_python)
 from .operators import csr_arrays, load_norms, step_operators
 from .stepping import Result, Stepping
 
@@ -151,6 +152,7 @@ class Run:
                           np.full((nframes, n), np.nan), np.full((nframes, n), np.nan),
                           np.zeros((nframes, m)), np.zeros((max(4096, 4 * m), 7)))
         self.events = []       # impact event rows taken from the compiled loop's buffer
+        self._compile_side_by_side()
         self._start(Orows, law.setup(step, first=True))
         self.load_bound = 0.0  # Σ‖Gⁿ‖_{N⁻¹}Δt so far: the a-priori energy bound grows with it
         self.n = 1             # the last computed state
@@ -164,6 +166,26 @@ class Run:
         return ((self.law.kernel or NoContact.kernel).cfunc,
                 (self.law.explicit or no_explicit).cfunc)
 
+    def _compile_side_by_side(self) -> None:
+        """A fresh install (this process has compiled a kernel already, so numba's cache is
+        cold) compiles the law in a child process while this one compiles the loop for
+        these arrays' types; then it waits for the law (see contact.base.Compiled)."""
+        if self.law.kernel is None or not _CompileNotice.said:
+            return
+        kernel, explicit = self.law.kernel, self.law.explicit or no_explicit
+        # the types of the arguments exactly as _steps passes them: the same compiled loop
+        loop = (types.FunctionType(kernel.signature), types.FunctionType(explicit.signature))
+        args = (self.ops, self.st, self.out, 1, 1,
+                Inputs(np.zeros((0, self.loads.shape[1])), np.zeros(0)), 0.0)
+        loop += tuple(typeof(a) for a in args)
+        if loop in run_steps.overloads:
+            return
+        for k in (self.law.kernel, self.law.explicit):
+            if k is not None:
+                k.compile_aside()
+        run_steps.compile(loop)
+        _ = self._kernels     # wait for the law: the start step calls what it compiled
+
     def _start(self, Orows, first_params) -> None:
         """u¹: one step of the scheme itself, from u⁰ and the fictitious u⁻¹ = u¹ − 2Δt v⁰
         (central difference at t = 0).  Substituted, it reads
@@ -174,6 +196,12 @@ class Run:
         energy into the top modes (an explicit Taylor start gave ½E_β¹ = 855 instead of
         166.8 for the energy-decay scene at J = 80, Δt = 1e-3).  Its contact is the
         chosen law's (a spring's force at u⁰ weighted ½(1−2β), see contact.penalty).
+
+        It runs the loop's helpers and the law as the Python functions they are compiled
+        from (``py_func``, the law's ``func``), on the same arrays: one step, the same
+        floating-point operations in the same order, so the same numbers; compiling them
+        apart from the loop, which inlines them, cost 3–4 s on a fresh install.  What they
+        call that is compiled (energy_beta, box_qp, ...) is shared with the loop.
         """
         system, op, st, out = self.system, self.op, self.st, self.out
         dt, beta, M, K, B = self.dt, self.beta, system.M, system.K, system.B
@@ -188,11 +216,9 @@ class Run:
         if op.Z.size:   # quasi-static massless rows: K u¹ = f¹ + Cᵀλ¹ there, times β
             F0[op.Z] = beta * dt**2 * (self.loads[op.Z] @ self.load_averages(1, 1)[1])
         csr_product(self.ops.Cp, self.ops.Ci, self.ops.Cx, u0, st.y_prev)
-        move_bounds(self.ops, st, self.motion(np.array([dt]))[0])   # the bounds at t₁
-        kernel, explicit = self._kernels
-        first = self.ops._replace(params=first_params)
+        move_bounds.py_func(self.ops, st, self.motion(np.array([dt]))[0])   # bounds at t₁
         if self.law.explicit is not None:   # its force at u⁰ as load, implicit at u¹ (as K)
-            call_explicit(explicit, first, st, st.y_prev, st.y_prev, st.r_e)
+            self.law.explicit.func(st.y_prev, st.y_prev, st.lo, st.hi, first_params, st.r_e)
             F0 += dt**2 * (op.C.T @ st.r_e)
             st.r_e[:] = 0.0
         u1 = F0.copy()
@@ -205,7 +231,8 @@ class Run:
                 st.mu[:] = mu
             else:
                 st.y_cur[:] = st.y_prev
-                if call_law(kernel, first, st) < 0:
+                if self.law.kernel.func(self.ops.D, st.yf, st.y_cur, st.y_prev, st.lo, st.hi,
+                                        first_params, st.law_state, st.mu, st.active) < 0:
                     raise SolverError("the first step's contact problem could not be solved")
                 st.law_state[:] = 0
                 st.active[:] = False
@@ -218,7 +245,7 @@ class Run:
         out.obs[0] = Orows @ st.u_prev
         out.obsv[0] = Orows @ system.v0
         rows_matvec(op.Kb.rows, st.u_prev, st.Ku)   # K uⁿ⁻¹ for the energy
-        record(1, self.ops, st, out)
+        record.py_func(1, self.ops, st, out)
         out.frames_u[0], out.frames_v[0] = st.u_prev, system.v0
         self.E1 = 0.5 * energy_beta(op.Eb.rows, st.u_prev, st.u_cur, st.Ku, st.d)
         if not (np.isfinite(st.u_cur).all() and math.isfinite(self.E1)):

@@ -1,0 +1,145 @@
+"""Cold compile of the README's main job: the first run of a fresh install against a warm one.
+
+    python -m skfem_beam.bench.cold_compile [--repeat 3] [--job skfem_beam.cases.flat_obstacles]
+
+Each repeat copies the package (sources only) to a fresh temporary folder, so that no
+``__pycache__`` and no numba cache exist, runs the job there twice in child processes
+(cold, then warm), and reports both times (CPU and wall) and their difference: the compile a
+first run pays.  The cold child registers a ``numba:compile`` listener and times the
+law's C callbacks (``CFunc.compile``), so the compile time is attributed per function:
+``self`` excludes the functions compiled inside it (callees that are not inlined),
+``total`` includes them; a law compiled aside in a child process (a fresh install on
+two cores or more, see contact.base.Compiled) is not listed: ``--one-core`` lists it.  The
+CPU times include that child's.  The per-function times are CPU seconds, which a busy shared
+machine disturbs less than wall time.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+PACKAGE = Path(__file__).resolve().parents[1]
+
+
+def _listen() -> list:
+    """Records (name, start, end, depth) of every compile in this process."""
+    from numba.core import ccallback, event
+
+    records, stack = [], []
+
+    class Timer(event.Listener):
+        def on_start(self, ev):
+            stack.append(time.process_time())
+
+        def on_end(self, ev):
+            t0 = stack.pop()
+            d = ev.data or {}
+            disp = d.get("dispatcher")
+            name = getattr(getattr(disp, "py_func", None), "__qualname__", str(disp))
+            records.append((name, t0, time.process_time(), len(stack),
+                            str(d.get("args", ""))))
+
+    event.register("numba:compile", Timer())
+    original = ccallback.CFunc.compile
+
+    def timed(self):      # C callbacks (the laws) do not send a numba:compile event
+        stack.append(time.process_time())
+        try:
+            original(self)
+        finally:
+            t0 = stack.pop()
+            records.append((f"cfunc {self.__name__}", t0, time.process_time(), len(stack), ""))
+
+    ccallback.CFunc.compile = timed
+    return records
+
+
+def _child(job: str, out: str) -> None:
+    """Runs ``python -m job --out out`` in this process with the compile listener."""
+    import importlib
+    records = _listen()
+    t0 = time.process_time()
+    code = importlib.import_module(job).main(["--out", out, "--overwrite"])
+    cpu = time.process_time() - t0
+    rows = []
+    for i, (name, a, b, depth, args) in enumerate(records):
+        inner = sum(b2 - a2 for (_, a2, b2, d2, _) in records
+                    if d2 == depth + 1 and a <= a2 and b2 <= b)
+        rows.append({"name": name, "total_s": b - a, "self_s": b - a - inner, "depth": depth,
+                     "args": args})
+    print(json.dumps({"code": code, "cpu_s": cpu, "compiles": rows}))
+
+
+def _run(folder: Path, job: str, listen: bool, one_core: bool) -> tuple[float, float, dict]:
+    out = folder / "out"
+    # the listener runs from this file, so that an older checkout can be measured too
+    argv = ([sys.executable, str(Path(__file__).resolve()), "--child", job, str(out)]
+            if listen else [sys.executable, "-m", job, "--out", str(out), "--overwrite"])
+    before, t0 = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
+    # one core: the run compiles its law itself (not aside), so every compile is listed
+    pin = (lambda: os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})) if one_core else None
+    p = subprocess.run(argv, cwd=folder, env={**_env(), "PYTHONPATH": str(folder)},
+                       capture_output=True, text=True, check=True, preexec_fn=pin)
+    wall, after = time.perf_counter() - t0, resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
+    info = json.loads(p.stdout.strip().splitlines()[-1]) if listen else {}
+    info["stderr"] = p.stderr
+    return cpu, wall, info
+
+
+def _env() -> dict:
+    return {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_CACHE_DIR")}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="skfem_beam.bench.cold_compile",
+                                 description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--job", default="skfem_beam.cases.flat_obstacles")
+    ap.add_argument("--package", default=str(PACKAGE),
+                    help="the skfem_beam folder to copy (another checkout, to compare)")
+    ap.add_argument("--one-core", action="store_true",
+                    help="pin the runs to one core: the law compiles in the run itself, so the "
+                         "table lists it (by default it compiles in a child process, unlisted)")
+    ap.add_argument("--child", nargs=2, help=argparse.SUPPRESS)
+    args = ap.parse_args(argv)
+    if args.child:
+        _child(*args.child)
+        return 0
+    for r in range(args.repeat):
+        with tempfile.TemporaryDirectory() as tmp:
+            folder = Path(tmp)
+            shutil.copytree(args.package, folder / "skfem_beam",
+                            ignore=shutil.ignore_patterns("__pycache__"))
+            cold, cold_wall, info = _run(folder, args.job, True, args.one_core)
+            warm, warm_wall, again = _run(folder, args.job, False, args.one_core)
+        notice = "compiling numerical kernels"
+        print(f"run {r + 1}: CPU cold {cold:.2f} s, warm {warm:.2f} s, compile {cold - warm:.2f} s;"
+              f" wall cold {cold_wall:.2f} s, warm {warm_wall:.2f} s, compile "
+              f"{cold_wall - warm_wall:.2f} s (notice: cold {info['stderr'].count(notice)}, warm "
+              f"{again['stderr'].count(notice)})")
+        by = {}
+        for c in info["compiles"]:
+            by.setdefault(c["name"], [0.0, 0.0, 0])
+            by[c["name"]][0] += c["self_s"]
+            by[c["name"]][1] += c["total_s"] if c["depth"] == 0 else 0.0
+            by[c["name"]][2] += 1
+        top = sum(c["total_s"] for c in info["compiles"] if c["depth"] == 0)
+        print(f"  {'function':40s} {'self s':>7s} {'top-level s':>11s} {'compiles':>8s}"
+              f"   (top-level total {top:.2f} s)")
+        for name, (s, t, k) in sorted(by.items(), key=lambda kv: -kv[1][0]):
+            if s >= 0.05:
+                print(f"  {name:40s} {s:7.2f} {t:11.2f} {k:8d}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -157,6 +157,7 @@ class Run:
         self.load_bound = 0.0  # Σ‖Gⁿ‖_{N⁻¹}Δt so far: the a-priori energy bound grows with it
         self.n = 1             # the last computed state
         self.wall = 0.0
+        self._next = ((-1, -1), None)   # the next chunk's inputs, computed ahead (advance)
         self.status, self.message = "running", ""
         self._steps(1, 1, 0.0)   # load the compiled loop now, outside the timed loop
 
@@ -257,6 +258,12 @@ class Run:
         """φ(t) that moves the bounds (zero when they do not move)."""
         phi = self.system.bound_motion
         return np.asarray(phi(t), dtype=float) if phi is not None else np.zeros(np.shape(t))
+
+    def _inputs(self, n0, n1):
+        """((n0, n1), Inputs of steps n0..n1−1): loads, bound motion, massless-row load."""
+        G = self.load_coefficients(n0, n1)
+        return (n0, n1), Inputs(G, self.motion(np.arange(n0 + 1, n1 + 1) * self.dt),
+                                self.massless_load(n0, n1))
 
     def load_coefficients(self, n0, n1):
         """Gⁿ = βf^{n+1} + (1−2β)fⁿ + βf^{n−1} for n = n0..n1−1 (per chunk: flat memory)."""
@@ -387,7 +394,8 @@ class Run:
         if self.done or n1 <= n0:
             return
         t0 = time.perf_counter()
-        G = self.load_coefficients(n0, n1)
+        inputs = (self._next if self._next[0] == (n0, n1) else self._inputs(n0, n1))[1]
+        G = inputs.G
         self.load_bound += float((np.abs(G) @ self.load_norm).sum()) * self.dt \
             if G.shape[1] else 0.0
         # the bound grows with n: its chunk-end value is the loosest for the chunk
@@ -396,8 +404,6 @@ class Run:
         if not math.isfinite(Ebound):
             raise InputError(f"the load is too large for floating point: its work by step {n1} "
                              f"is {self.load_bound:g}")
-        inputs = Inputs(G, self.motion(np.arange(n0 + 1, n1 + 1) * self.dt),
-                        self.massless_load(n0, n1))
         code, at = self._steps(n0, n1, Ebound, inputs), n0
         while code == EVENTS_FULL:       # take the impact events, go on from where it stopped
             self._take_events()
@@ -406,6 +412,12 @@ class Run:
                                                       inputs.H[k:] if inputs.H.shape[0]
                                                       else inputs.H))
         self._take_events()
+        if code == 0 and n1 < self.n_steps:
+            # the next chunk's inputs now, while the writer thread may still be formatting
+            # the last chunk's rows but has not got this one's: computed while it formats
+            # them, they wait for the GIL it holds (measured: 2.5 s instead of 0.3 s over
+            # 2,000,000 steps saved at every step)
+            self._next = self._inputs(n1, min(2 * n1 - n0, self.n_steps))
         self.wall += time.perf_counter() - t0
         k = int(self.st.counters[3])
         if code == FAILED:

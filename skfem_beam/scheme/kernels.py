@@ -100,7 +100,7 @@ def free_step(ops, st, Gn, H, row):
     ``H[row]``: the load at the quasi-static massless rows (see massless_force)."""
     dt2 = ops.dt * ops.dt
     x, u_cur, u_prev = st.x, st.u_cur, st.u_prev
-    rows_matvec(ops.Kb, u_cur, st.Ku)
+    rows_matvec(ops.Kb, u_cur, st.Ku, 1.0, np.bool_(False))
     for i in range(x.size):
         s = -st.Ku[i]
         for k in range(Gn.size):
@@ -113,7 +113,7 @@ def free_step(ops, st, Gn, H, row):
     if ops.Bb.shape[0]:
         for i in range(st.d.size):
             st.d[i] = u_cur[i] - u_prev[i]
-        rows_matvec(ops.Bb, st.d, x, -ops.dt, True)
+        rows_matvec(ops.Bb, st.d, x, -ops.dt, np.bool_(True))
     if ops.Zr.size:
         massless_force(ops, st, H, row)
         for q in range(ops.Zr.size):

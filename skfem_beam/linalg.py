@@ -92,8 +92,10 @@ def _edge_row(P, x, j):
 
 
 @njit(cache=True)
-def rows_matvec(P, x, y, c=1.0, add=False):
-    """y = c P x (or y += c P x with ``add``) for banded P in row layout."""
+def rows_matvec(P, x, y, c, add):
+    """y = c P x (or y += c P x with ``add``) for banded P in row layout.  No defaults,
+    and compiled callers pass ``np.bool_(add)``: every call then has one signature and
+    the first run compiles it once (a bare True is a literal type, a second compile)."""
     n, w = P.shape
     kd = w // 2
     for j in range(min(kd, n)):

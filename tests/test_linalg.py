@@ -28,7 +28,7 @@ def test_banded_kernels_equal_dense(n, kd):
     assert np.abs(a @ b - x).max() < 1e-13 * np.abs(x).max() * np.linalg.cond(a)
 
     y = np.full(n, np.nan)   # overwritten, never read
-    rows_matvec(B.rows, x, y)
+    rows_matvec(B.rows, x, y, 1.0, False)
     assert np.abs(y - a @ x).max() < 1e-14 * np.abs(a).sum(axis=1).max() * np.abs(x).max()
     y2 = z.copy()
     rows_matvec(B.rows, x, y2, -0.5, True)

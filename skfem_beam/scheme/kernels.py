@@ -75,22 +75,44 @@ def csr_product(Rp, Ri, Rx, u, y):
         y[r] = s
 
 
-@njit(cache=True, inline="always")
-def massless_force(ops, st, H, row):
-    """st.ez ← (1−2β) K_Z uⁿ + β K_Z uⁿ⁻¹ − H_Z (Z the quasi-static massless rows, needs
-    st.Ku = K uⁿ).  Added to the β-scheme's right-hand side Δt²(Gⁿ − K uⁿ) on Z it gives
-    βΔt²(f^{n+1} − K(2uⁿ − uⁿ⁻¹)): the row K u^{n+1} = f^{n+1} + Cᵀλ times β, so that A
-    stays M + βΔt²K (symmetric, banded).  It is the rows' part of the contact force that
-    the energy sees (β λ^{n+1} + st.ez), see scheme.operators."""
-    beta = ops.beta
-    for q in range(ops.Zr.size):
+# Called from compiled code only, and out of line: branches that most runs never take (or
+# take once per event) are compiled once, small, instead of being copied into the loop.
+internal = njit(cache=True, _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+
+
+@internal
+def massless_force(Zr, Zp, Zi, Zx, beta, Ku, u_prev, H, row, ez):
+    """ez ← (1−2β) K_Z uⁿ + β K_Z uⁿ⁻¹ − H_Z (Z the quasi-static massless rows, K_Z their
+    rows of K as CSR (Zp, Zi, Zx), Ku = K uⁿ).  Added to the β-scheme's right-hand side
+    Δt²(Gⁿ − K uⁿ) on Z it gives βΔt²(f^{n+1} − K(2uⁿ − uⁿ⁻¹)): the row K u^{n+1} =
+    f^{n+1} + Cᵀλ times β, so that A stays M + βΔt²K (symmetric, banded).  It is the
+    rows' part of the contact force that the energy sees (β λ^{n+1} + ez), see
+    scheme.operators."""
+    for q in range(Zr.size):
         s = 0.0
-        for p in range(ops.Zp[q], ops.Zp[q + 1]):
-            s += ops.Zx[p] * st.u_prev[ops.Zi[p]]
-        s = (1.0 - 2.0 * beta) * st.Ku[ops.Zr[q]] + beta * s
+        for p in range(Zp[q], Zp[q + 1]):
+            s += Zx[p] * u_prev[Zi[p]]
+        s = (1.0 - 2.0 * beta) * Ku[Zr[q]] + beta * s
         if H.shape[0]:
             s -= H[row, q]
-        st.ez[q] = s
+        ez[q] = s
+
+
+@internal
+def massless_work(Zr, ez, d, mu, Cp, Ci, Cx, beta, dt):
+    """The step's contact work on the quasi-static massless rows, δ = ``d``: the energy
+    sees β λ^{n+1} + ez there, and finish_step counts λ^{n+1} (the law's μ is Δt²λ^{n+1},
+    W and D carry the β)."""
+    s = 0.0
+    for q in range(Zr.size):
+        s += ez[q] * d[Zr[q]]
+    for j in range(mu.size):
+        if mu[j] != 0.0:
+            c = 0.0
+            for p in range(Cp[j], Cp[j + 1]):
+                c += Cx[p] * d[Ci[p]]
+            s += (beta - 1.0) * mu[j] / (dt * dt) * c
+    return 0.5 * s
 
 
 @njit(cache=True, inline="always")
@@ -100,7 +122,7 @@ def free_step(ops, st, Gn, H, row):
     ``H[row]``: the load at the quasi-static massless rows (see massless_force)."""
     dt2 = ops.dt * ops.dt
     x, u_cur, u_prev = st.x, st.u_cur, st.u_prev
-    rows_matvec(ops.Kb, u_cur, st.Ku)
+    rows_matvec(ops.Kb, u_cur, st.Ku, 1.0, np.bool_(False))
     for i in range(x.size):
         s = -st.Ku[i]
         for k in range(Gn.size):
@@ -113,9 +135,10 @@ def free_step(ops, st, Gn, H, row):
     if ops.Bb.shape[0]:
         for i in range(st.d.size):
             st.d[i] = u_cur[i] - u_prev[i]
-        rows_matvec(ops.Bb, st.d, x, -ops.dt, True)
+        rows_matvec(ops.Bb, st.d, x, -ops.dt, np.bool_(True))
     if ops.Zr.size:
-        massless_force(ops, st, H, row)
+        massless_force(ops.Zr, ops.Zp, ops.Zi, ops.Zx, ops.beta, st.Ku, st.u_prev, H, row,
+                       st.ez)
         for q in range(ops.Zr.size):
             x[ops.Zr[q]] += dt2 * st.ez[q]
     band_solve(ops.Achol, x)
@@ -127,7 +150,8 @@ def free_step(ops, st, Gn, H, row):
 @njit(cache=True, inline="always")
 def finish_step(ops, st, Gn):
     """uⁿ⁺¹ = x_free + W μ; the step's damping and load work (below); shift
-    (uⁿ⁻¹, uⁿ) ← (uⁿ, uⁿ⁺¹) and their constrained values, st.dy ← C(uⁿ⁺¹ − uⁿ⁻¹).
+    (uⁿ⁻¹, uⁿ) ← (uⁿ, uⁿ⁺¹) and their constrained values, st.dy ← C(uⁿ⁺¹ − uⁿ⁻¹); then
+    μ ← the whole contact force (the law's explicit part added) and its work.
 
     The scheme's energy identity, from its equation times (uⁿ⁺¹ − uⁿ⁻¹)ᵀ/Δt²:
         ½E_β^{n+1} − ½E_β^n + δᵀBδ/(4Δt) = ½ Gⁿ·Lᵀδ + ½ λᵀCδ,   δ = uⁿ⁺¹ − uⁿ⁻¹,
@@ -147,19 +171,9 @@ def finish_step(ops, st, Gn):
         for i in range(x.size):
             s += ops.loads[i, k] * d[i]
         st.work[1] += 0.5 * Gn[k] * s
-    if ops.Zr.size:
-        # quasi-static massless rows: the energy sees β λ^{n+1} + ez there, and end_step
-        # counts λ^{n+1} (the law's μ is Δt²λ^{n+1}, W and D carry the β)
-        s = 0.0
-        for q in range(ops.Zr.size):
-            s += st.ez[q] * d[ops.Zr[q]]
-        for j in range(mu.size):
-            if mu[j] != 0.0:
-                c = 0.0
-                for p in range(ops.Cp[j], ops.Cp[j + 1]):
-                    c += ops.Cx[p] * d[ops.Ci[p]]
-                s += (ops.beta - 1.0) * mu[j] / (ops.dt * ops.dt) * c
-        st.work[2] += 0.5 * s
+    if ops.Zr.size:    # quasi-static massless rows
+        st.work[2] += massless_work(ops.Zr, st.ez, d, mu, ops.Cp, ops.Ci, ops.Cx, ops.beta,
+                                    ops.dt)
     for i in range(x.size):
         st.u_prev[i] = st.u_cur[i]
         st.u_cur[i] = x[i]
@@ -169,6 +183,13 @@ def finish_step(ops, st, Gn):
     csr_product(ops.Cp, ops.Ci, ops.Cx, st.u_cur, st.y_cur)
     for j in range(mu.size):
         st.dy[j] += st.y_cur[j]
+    dt2 = ops.dt * ops.dt
+    for j in range(st.r_e.size):   # the contact force: explicit and implicit parts
+        if st.r_e[j] != 0.0:
+            mu[j] += dt2 * st.r_e[j]
+    for j in range(mu.size):
+        if mu[j] != 0.0:
+            st.work[2] += 0.5 * mu[j] / dt2 * st.dy[j]
 
 
 @njit(cache=True)
@@ -245,6 +266,19 @@ def move_bounds(ops, st, phi):
         st.shi[r] = ops.shi[r] + ops.sshift[r] * phi
 
 
+@internal
+def write_event(events, counters, j, e):
+    """Event row k of the buffer from the value j's State.impact row ``e`` (then free)."""
+    k = counters[4]
+    events[k, 0] = j
+    events[k, 1] = e[0]
+    events[k, 2] = e[5]
+    for c in range(1, 5):
+        events[k, c + 2] = e[c]
+    counters[4] = k + 1
+    e[0] = -1.0
+
+
 @njit(cache=True, inline="always")
 def track_impacts(ops, st, out, step):
     """Contact bookkeeping after state step+1: impacts counted when a value enters
@@ -262,7 +296,7 @@ def track_impacts(ops, st, out, step):
         if a and not st.active_prev[j]:
             counters[0] += 1
             if ev[j, 0] >= 0.0:          # the last contact's trailing force ends here
-                write_event(out, counters, j, ev[j])
+                write_event(out.events, counters, j, ev[j])
             ev[j, 0] = step + 1
             # approach velocity (yⁿ − yⁿ⁻¹)/Δt, with yⁿ⁻¹ = yⁿ⁺¹ − dy
             ev[j, 1] = (st.y_prev[j] - st.y_cur[j] + st.dy[j]) / dt
@@ -280,7 +314,7 @@ def track_impacts(ops, st, out, step):
             if a:
                 ev[j, 4] = max(ev[j, 4], st.lo[j] - st.y_cur[j], st.y_cur[j] - st.hi[j])
             elif step + 1 > ev[j, 5]:    # the second state off: no force can trail further
-                write_event(out, counters, j, ev[j])
+                write_event(out.events, counters, j, ev[j])
         st.active_prev[j] = a
         any_active = any_active or a
     if any_active:
@@ -289,33 +323,11 @@ def track_impacts(ops, st, out, step):
 
 
 @njit(cache=True, inline="always")
-def write_event(out, counters, j, e):
-    """Event row k of the buffer from the value j's State.impact row ``e`` (then free)."""
-    k = counters[4]
-    out.events[k, 0] = j
-    out.events[k, 1] = e[0]
-    out.events[k, 2] = e[5]
-    for c in range(1, 5):
-        out.events[k, c + 2] = e[c]
-    counters[4] = k + 1
-    e[0] = -1.0
-
-
-@njit(cache=True, inline="always")
-def end_step(ops, st, out, step, Gn, Ebound):
-    """After the law: uⁿ⁺¹, the contact bookkeeping and the diagnostics of state step+1.
-    Returns UNSTABLE when its saved energy is non-finite or above Ebound, EVENTS_FULL
-    when the event buffer must be emptied before the next step, else 0."""
-    counters, dt2 = st.counters, ops.dt * ops.dt
-    finish_step(ops, st, Gn)
-    for j in range(st.r_e.size):   # the contact force: explicit and implicit parts
-        if st.r_e[j] != 0.0:
-            st.mu[j] += dt2 * st.r_e[j]
-    for j in range(st.mu.size):
-        if st.mu[j] != 0.0:
-            st.work[2] += 0.5 * st.mu[j] / dt2 * st.dy[j]
-    full = track_impacts(ops, st, out, step)
-    record(step + 1, ops, st, out)
+def stop_code(ops, st, out, step, Ebound, full):
+    """After the diagnostics of state step+1: UNSTABLE when its saved energy is non-finite
+    or above Ebound, else ``full`` (EVENTS_FULL when the event buffer must be emptied
+    before the next step, else 0); counters[3] ← step+1 when the loop must stop."""
+    counters = st.counters
     if (step + 1) % ops.save_every == 0 \
             and not abs(out.energy[(step + 1) // ops.save_every - counters[5]]) <= Ebound:
         counters[3] = step + 1
@@ -332,8 +344,9 @@ def end_step(ops, st, out, step, Gn, Ebound):
 @njit(cache=True, _nrt=False, nogil=True, no_cfunc_wrapper=True)
 def run_steps(law, explicit, ops, st, out, n0, n1, inputs, Ebound):
     """Steps n = n0..n1−1 (computing uⁿ⁺¹) with a compiled law: the bounds at t_{n+1},
-    the law's explicit force, the free step, the law, then `end_step`.  ``inputs``
-    (Inputs) hold Gⁿ and φ(t_{n+1}) at row n − n0.
+    the law's explicit force, the free step, the law, then `finish_step`, the impact
+    events, the diagnostics and `stop_code`.  ``inputs`` (Inputs) hold Gⁿ and φ(t_{n+1})
+    at row n − n0.
 
     Returns 0, FAILED (the law failed at step counters[3]), UNSTABLE (the energy saved
     at state counters[3] is non-finite or above Ebound) or EVENTS_FULL (stopped after
@@ -349,7 +362,10 @@ def run_steps(law, explicit, ops, st, out, n0, n1, inputs, Ebound):
             st.counters[3] = step + 1
             return FAILED
         st.counters[2] += its
-        code = end_step(ops, st, out, step, Gn, Ebound)
+        finish_step(ops, st, Gn)
+        full = track_impacts(ops, st, out, step)
+        record(step + 1, ops, st, out)
+        code = stop_code(ops, st, out, step, Ebound, full)
         if code:
             return code
     return 0
@@ -390,7 +406,10 @@ def run_steps_python(ops, st, out, n0, n1, inputs, Ebound):
         for j in range(st.mu.size):
             st.active[j] = st.mu[j] != 0.0
         st.counters[2] += its
-        code = end_step(ops, st, out, step, Gn, Ebound)
+        finish_step(ops, st, Gn)
+        full = track_impacts(ops, st, out, step)
+        record(step + 1, ops, st, out)
+        code = stop_code(ops, st, out, step, Ebound, full)
         if code:
             return code
     return 0

@@ -137,8 +137,8 @@ def mj_steps(ops, st, out, n0, n1, inputs, Ebound):
     n, m = st.x.size, st.mu.size
     for step in range(n0, n1):
         Gn = inputs.G[step - n0]
-        rows_matvec(ops.Kb, st.u_cur, st.Ku)
-        rows_matvec(ops.Kb, st.v, st.Kv)
+        rows_matvec(ops.Kb, st.u_cur, st.Ku, 1.0, np.bool_(False))
+        rows_matvec(ops.Kb, st.v, st.Kv, 1.0, np.bool_(False))
         x = st.x
         for i in range(n):
             s = -st.Ku[i] - dt * th * st.Kv[i]
@@ -146,7 +146,7 @@ def mj_steps(ops, st, out, n0, n1, inputs, Ebound):
                 s += Gn[k] * ops.loads[i, k]
             x[i] = dt * s
         if ops.Bb.shape[0]:
-            rows_matvec(ops.Bb, st.v, x, -dt, True)
+            rows_matvec(ops.Bb, st.v, x, -dt, np.bool_(True))
         band_solve(ops.Achol, x)
         for i in range(n):
             x[i] += st.v[i]                      # v_free

@@ -245,7 +245,7 @@ class Run:
         # states 0 and 1 (E_β needs two states: the energy saved at t = 0 is E_β¹)
         out.obs[0] = Orows @ st.u_prev
         out.obsv[0] = Orows @ system.v0
-        rows_matvec(op.Kb.rows, st.u_prev, st.Ku)   # K uⁿ⁻¹ for the energy
+        rows_matvec(op.Kb.rows, st.u_prev, st.Ku, 1.0, False)   # K uⁿ⁻¹ for the energy
         record.py_func(1, self.ops, st, out)
         out.frames_u[0], out.frames_v[0] = st.u_prev, system.v0
         self.E1 = 0.5 * energy_beta(op.Eb.rows, st.u_prev, st.u_cur, st.Ku, st.d)

@@ -88,6 +88,8 @@ class Run:
     pipeline drives it too when it streams files and writes checkpoints.
     """
 
+    _next = ((-1, -1), None)   # the next chunk's (n0, n1) and inputs, computed ahead (advance)
+
     def __init__(self, system, stepping: Stepping, law: str | ContactLaw = "auto"):
         self._build(system, stepping, law)
 
@@ -157,7 +159,6 @@ class Run:
         self.load_bound = 0.0  # Σ‖Gⁿ‖_{N⁻¹}Δt so far: the a-priori energy bound grows with it
         self.n = 1             # the last computed state
         self.wall = 0.0
-        self._next = ((-1, -1), None)   # the next chunk's inputs, computed ahead (advance)
         self.status, self.message = "running", ""
         self._steps(1, 1, 0.0)   # load the compiled loop now, outside the timed loop
 

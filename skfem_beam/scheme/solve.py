@@ -24,8 +24,9 @@ def solve(system, dt: float, T: float, beta: float = 0.5, solver: str | ContactL
     ``save_every``, ``frames``, ``load_window``, ``growth_limit``: see :class:`Stepping`.
 
     The run stops with status "unstable" when the discrete energy exceeds
-    ``growth_limit`` × the a-priori bound (√E¹ + Σ‖Gⁿ‖_{M⁻¹}Δt)² or a value turns
-    non-finite; what was computed up to the last good saved state is returned.
+    ``growth_limit`` × the a-priori bound (√E¹ + Σ‖Gⁿ‖_{N⁻¹}Δt)² (operators.load_norms)
+    or a value turns non-finite; what was computed up to the last good saved state is
+    returned.
     """
     stepping = Stepping(dt, T, beta, save_every, frames, load_window, growth_limit)
     rows = stepping.steps // stepping.save_every + 1

@@ -257,17 +257,16 @@ def _scene(kind, problem, data, text, files) -> Scene:
     if k is not None and law in LAWS[:2]:
         raise InputError(f"[contact] stiffness is the penalty spring: law = {law!r} does not "
                          "take it")
-    t = data.get("time", {})
+    t, mesh = data.get("time", {}), data.get("mesh", {})
     if "dt" not in t or "T" not in t:
         raise InputError("[time] needs dt and T (s)")
     beta = t.get("beta", 0.25 if kind == "bar" or law == "penalty" else 0.5)
     out = {**OUTPUT_DEFAULTS, **data.get("output", {})}
     stepping = Stepping(t["dt"], t["T"], beta, out["save_every"], out["frames"],
-                        massless=_massless(data.get("mesh", {})))
+                        massless=_massless(mesh))
     scene = Scene(kind, problem, stepping, law, k, contact.get("restitution", 0.0), out,
                   text, files, data)
     scene.contact_law        # the law's own checks (name, stiffness, restitution)
-    mesh = data.get("mesh", {})
     if kind == "beam":
         check_choice("[mesh] mass", mesh.get("mass", "consistent"), BEAM_MASSES)
     if scene.law == "moreau-jean" and "massless" in mesh:
@@ -629,8 +628,7 @@ def run_main(argv) -> int:
     args.dt, args.beta = scene.stepping.dt, scene.stepping.beta
     args.method = "penalty" if penalty else "contact"
     args.law = scene.scheme
-    args.solver = "auto" if args.law != "position" or scene.restitution \
-        or scene.law == "position" else scene.law
+    args.solver = "auto" if scene.law in LAWS or scene.restitution else scene.law
     args.stiffness, args.restitution = scene.stiffness, scene.restitution
     args.mass = scene.data.get("mesh", {}).get("mass", "consistent") \
         if scene.kind == "beam" else scene.problem.mass

@@ -16,6 +16,7 @@ from .checks import check_choice, check_finite
 from .errors import InputError, SolverError
 from .output.folder import (EXIT_INPUT, EXIT_SOLVER, EXIT_UNSTABLE, OPENED,  # noqa: F401
                             Interrupted, release, report, stamp)
+from .output.options import OutputOptions
 from .output.series import stored_args
 from .scheme.stepping import MASSLESS
 
@@ -92,6 +93,14 @@ def parse(p: Parser, argv=None):
     if getattr(args, "beta", 0.5) is None:   # the papers: β = 1/2 for contact, 1/4 for penalty
         args.beta = 0.25 if getattr(args, "method", "contact") == "penalty" else 0.5
     return args
+
+
+def output_options(args) -> OutputOptions:
+    """The output flags as one checked :class:`OutputOptions` (the only place they are
+    read from the command line)."""
+    return OutputOptions(out=args.out, overwrite=args.overwrite, resume=args.resume,
+                         format=args.format, frames=args.frames, save_every=args.save_every,
+                         flush_every=args.flush_every, checkpoint_every=args.checkpoint_every)
 
 
 def mesh_nodes(args):

@@ -29,7 +29,8 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
     cli.check_method(args)
     stepping = Stepping(args.dt, args.T, args.beta, args.save_every, args.frames,
                         massless=cli.massless(args))
-    out = prepare(args)                            # fail before the run, not after it
+    options = cli.output_options(args)
+    prepare(options)  # fail before the run, not after it
     system = beam_system(problem)
     add_probes(system, getattr(args, "probe", None) or [])
     kh = kappa_h(system)
@@ -102,7 +103,7 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
     def events(folder: Path, run, last: int) -> dict:
         return beam_impacts(folder, run, problem, last)
 
-    return execute(run, out, args, summary, Series(columns, events=events), finish)
+    return execute(run, options, summary, Series(columns, events=events), finish)
 
 
 def units(rho_S, system) -> dict:

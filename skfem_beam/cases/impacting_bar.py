@@ -87,7 +87,8 @@ def run_bar_case(bar: Bar, args, config: dict | None = None) -> int:
     penalty = args.method == "penalty" and bar.obstacle == "rigid"
     if penalty:   # the rigid obstacle approximated by a spring of stiffness 1/ε
         bar = replace(bar, k=check_positive("stiffness", args.stiffness))
-    out = prepare(args)                                  # fail before the run, not after
+    options = cli.output_options(args)
+    prepare(options)  # fail before the run, not after
     run = bar_run(bar, dt, T, beta=args.beta, method="moreau-jean" if args.law == "moreau-jean"
                   else args.method, solver=args.solver, frames=args.frames,
                   restitution=args.restitution, massless=cli.massless(args))
@@ -161,7 +162,7 @@ def run_bar_case(bar: Bar, args, config: dict | None = None) -> int:
             "errors": errors(b, exact) if exact is not None else None,
             "energy": energy_report(b)}
 
-    return execute(run, out, args, summary, stream, finish)
+    return execute(run, options, summary, stream, finish)
 
 
 if __name__ == "__main__":

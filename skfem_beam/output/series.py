@@ -38,6 +38,7 @@ from ..checks import check_count, check_nonnegative, check_positive
 from ..errors import InputError, SolverError
 from ..scheme import Run, drive
 from .fields import FieldWriter, check_format
+from .options import OutputOptions
 from .folder import (EXIT_SOLVER, SUMMARY, Folder, Interrupted, _plain, check_output_dir,
                      csv_rows, lock_folder, report)
 
@@ -418,26 +419,11 @@ def _restore(run: Run, ck: dict) -> int:
     return int(ck["used"])
 
 
-OUTPUT_FLAGS = ("frames", "save_every", "flush_every")
-
-
-def check_output_flags(args) -> None:
-    """The output flags every command shares (with skfem_beam.checks)."""
-    for flag in OUTPUT_FLAGS:
-        if hasattr(args, flag):
-            check_count(f"--{flag.replace('_', '-')}", getattr(args, flag))
-    if getattr(args, "checkpoint_every", None) is not None:
-        check_nonnegative("--checkpoint-every", args.checkpoint_every)
-    check_format(getattr(args, "format", "none"))
-
-
-def prepare(args) -> Path:
-    """Check ``--out`` (or the ``--resume`` folder) and the output flags before anything is
-    computed; return the folder."""
-    check_output_flags(args)
-    if getattr(args, "resume", None):
-        return _resume_folder(args.resume)
-    return check_output_dir(args.out, args.overwrite)
+def prepare(options: OutputOptions) -> Path:
+    """Check the output folder (or the resumed one) before anything is computed; return it."""
+    if options.resume:
+        return _resume_folder(options.resume)
+    return check_output_dir(options.out, options.overwrite)
 
 
 def _resume_folder(out) -> Path:
@@ -494,8 +480,9 @@ def _command(summary: dict) -> str:
         or f"python -m skfem_beam.cases.{summary.get('case', '<case>')}"
 
 
-def execute(run: Run, out: Path, args, summary: dict, series, finish) -> int:
-    """Drive ``run`` with streaming output into ``out``; return the exit code.
+def execute(run: Run, options: OutputOptions, summary: dict, series, finish) -> int:
+    """Drive ``run`` with streaming output into the folder of ``options`` (checked by
+    :func:`prepare`); return the exit code.
 
     ``series``: a :class:`Series` (or just its ``columns`` function).  ``finish(folder,
     data, run)``: charts and extra files from the rows in memory (``data``: name →
@@ -508,8 +495,9 @@ def execute(run: Run, out: Path, args, summary: dict, series, finish) -> int:
     """
     if not isinstance(series, Series):
         series = Series(series)
-    resume = bool(getattr(args, "resume", None))
-    every = getattr(args, "checkpoint_every", None)
+    out = Path(options.out)
+    resume = bool(options.resume)
+    every = options.checkpoint_every
     try:
         run.checkpoint()            # refuses a solver that cannot checkpoint: before any file
         can_checkpoint = True
@@ -523,19 +511,18 @@ def execute(run: Run, out: Path, args, summary: dict, series, finish) -> int:
         ck = read_checkpoint(out)       # checked again: the lock is held since the parse
         used = _restore(run, ck)
     with _Signals() as stop:
-        folder = Folder.open(out, summary, overwrite=getattr(args, "overwrite", False),
-                             resume=resume)
+        folder = Folder.open(out, summary, overwrite=options.overwrite, resume=resume)
         try:
-            return _stream(run, folder, args, series, finish, stop, used, ck, can_checkpoint)
+            return _stream(run, folder, options, series, finish, stop, used, ck,
+                           can_checkpoint)
         finally:
             folder.release()
 
 
-def _stream(run, folder, args, series, finish, stop, used, ck, can_checkpoint) -> int:
+def _stream(run, folder, options, series, finish, stop, used, ck, can_checkpoint) -> int:
     """The body of :func:`execute`, in the open ``folder``."""
     names = list(series.columns(run, 0, 0))
-    every = getattr(args, "checkpoint_every", None)
-    fmt = getattr(args, "format", "none")
+    every, fmt = options.checkpoint_every, options.format
     last_ck = time.monotonic()
     fields = rows = None
     kept = {"step": int(ck["n"]) if ck is not None else None}
@@ -588,7 +575,7 @@ def _stream(run, folder, args, series, finish, stop, used, ck, can_checkpoint) -
                               limit=None if series.keep_all else KEEP_ROWS)
             fields = _Fields(folder.path, run, fmt, series) if fmt != "none" else None
             on_chunk(run)                      # state 1 (and, on resume, the frames so far)
-            drive(run, chunk=getattr(args, "flush_every", 20000), on_chunk=on_chunk)
+            drive(run, chunk=options.flush_every, on_chunk=on_chunk)
             if can_checkpoint and run.status == "success":
                 save_checkpoint()              # so that --resume DIR --T longer extends it
         finally:
@@ -678,6 +665,4 @@ def stored_args(args, parser, argv=None):
         if k in config:
             stored[k] = config[k]
     stored.update(resume=args.resume, out=args.resume, overwrite=False, T=T)
-    stored = type(args)(**stored)
-    prepare(stored)
-    return stored
+    return type(args)(**stored)

@@ -7,6 +7,7 @@ shape) with the derivatives a prescribed motion needs: ``f(t)``, ``f.d(t)`` (fir
 - :class:`Table` a table t_i, φ_i (e.g. a measured support motion, :meth:`Table.from_csv`)
   interpolated by a cubic spline;
 - :func:`band_limited` a random sum of sines over a frequency band, reproducible by seed;
+- :func:`from_psd`, :func:`psd_from_csv` a random force with a given power spectral density;
 - :class:`Constant` c (a dead load; with :class:`Ramp` a slowly applied one).
 
 **Why a cubic spline for tables.** The lifting turns a support motion φ into the load
@@ -141,6 +142,76 @@ def band_limited(rms: float, f_low: float, f_high: float, seed: int = 0,
     return SumOfSines(tuple(a), tuple(2 * np.pi * f), tuple(rng.uniform(0, 2 * np.pi, count)))
 
 
+def from_psd(f, S, seed: int = 0, df: float | None = None,
+             source: str = "psd") -> SumOfSines:
+    """A random force (or motion) with the one-sided power spectral density S(f): ``f`` in
+    Hz (increasing, ≥ 0), ``S`` in unit²/Hz (≥ 0; e.g. N²/m²/Hz for a force per length),
+    linear between the table's points and zero outside.  The spectral representation
+    (Shinozuka): one sine at the middle of each band of width ``df`` over [f₀, f_last]
+    with amplitude √(2 S(f_k) df) and a random phase (``numpy.random.default_rng(seed)``),
+    so its mean square is Σ S(f_k) df, the table's ∫S df to the midpoint rule.  The
+    record repeats after 1/df s: ``df`` defaults to (f_last − f₀)/512; take df ≤ 1/T for a
+    run of length T that must not see the repetition."""
+    f, S = np.asarray(f, dtype=float), np.asarray(S, dtype=float)
+    if f.ndim != 1 or f.shape != S.shape or f.size < 2:
+        raise InputError(f"{source}: needs matching columns f, S of at least 2 rows "
+                         f"(got {f.size} and {S.size})")
+    for name, col in (("f", f), ("S", S)):
+        bad = ~np.isfinite(col) | (col < 0)
+        if bad.any():
+            i = int(np.argmax(bad))
+            raise InputError(f"{source}: {name}={col[i]:g} in row {i + 1} must be a finite "
+                             "number ≥ 0")
+    if (np.diff(f) <= 0).any():
+        i = int(np.argmax(np.diff(f) <= 0)) + 1
+        raise InputError(f"{source}: f is not increasing at row {i + 1} "
+                         f"(f={f[i]:g} Hz after {f[i - 1]:g})")
+    width = f[-1] - f[0]
+    df = width / 512 if df is None else check_positive("df", df)
+    count = max(1, int(round(width / df)))
+    if count > 100_000:
+        raise InputError(f"{source}: df={df:g} Hz gives {count} sines over "
+                         f"[{f[0]:g}, {f[-1]:g}] Hz; at most 100000 (raise df)")
+    df = width / count
+    fk = f[0] + (np.arange(count) + 0.5) * df
+    a = np.sqrt(2.0 * np.interp(fk, f, S) * df)
+    rng = np.random.default_rng(check_count("seed", seed, least=0))
+    return SumOfSines(tuple(a), tuple(2 * np.pi * fk), tuple(rng.uniform(0, 2 * np.pi, count)))
+
+
+def psd_from_csv(path, seed: int = 0, df: float | None = None) -> SumOfSines:
+    """:func:`from_psd` of a CSV table of two columns f (Hz), S (unit²/Hz); a first line
+    that is not numeric is taken as a header."""
+    f, S, _ = _two_columns(Path(path), "f, S")
+    return from_psd(f, S, seed, df, source=str(path))
+
+
+def _two_columns(path: Path, names: str) -> tuple[list, list, int]:
+    """The two numeric columns of a CSV file and its header lines (a non-numeric first
+    line is a header, 0 or 1); one error line naming the file and the row otherwise."""
+    try:
+        with open(path, newline="") as fh:
+            rows = [r for r in csv.reader(fh) if r and any(c.strip() for c in r)]
+    except OSError as e:
+        raise InputError(f"cannot read the table {path}: {e.strerror}") from None
+    header = 0
+    if rows:
+        try:
+            float(rows[0][0])
+        except ValueError:
+            header = 1
+    first, second = [], []
+    for i, r in enumerate(rows[header:], start=header + 1):
+        if len(r) < 2:
+            raise InputError(f"{path}: row {i} has {len(r)} column(s), needs {names}")
+        try:
+            first.append(float(r[0]))
+            second.append(float(r[1]))
+        except ValueError:
+            raise InputError(f"{path}: row {i} is not two numbers: {','.join(r)!r}") from None
+    return first, second, header
+
+
 @dataclass(frozen=True)
 class Table(_FromEval):
     """φ(t) given at times ``t`` (strictly increasing) by values ``phi``, interpolated by
@@ -174,27 +245,7 @@ class Table(_FromEval):
         """Two columns t, phi; a first line that is not numeric is taken as a header.
         Rows are counted as in the file (the header is row 1)."""
         path = Path(path)
-        try:
-            with open(path, newline="") as fh:
-                rows = [r for r in csv.reader(fh) if r and any(c.strip() for c in r)]
-        except OSError as e:
-            raise InputError(f"cannot read the table {path}: {e.strerror}") from None
-        header = 0
-        if rows:
-            try:
-                float(rows[0][0])
-            except ValueError:
-                header = 1
-        t, phi = [], []
-        for i, r in enumerate(rows[header:], start=header + 1):
-            if len(r) < 2:
-                raise InputError(f"{path}: row {i} has {len(r)} column(s), needs t, phi")
-            try:
-                t.append(float(r[0]))
-                phi.append(float(r[1]))
-            except ValueError:
-                raise InputError(f"{path}: row {i} is not two numbers: {','.join(r)!r}") \
-                    from None
+        t, phi, header = _two_columns(path, "t, phi")
         t_arr = np.asarray(t)
         bad = np.flatnonzero(np.diff(t_arr) <= 0) if t_arr.size > 1 else []
         if len(bad):   # named by its row in the file (a header is row 1)

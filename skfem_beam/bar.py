@@ -44,6 +44,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import scipy.sparse as sp
 
+from . import methods
 from .errors import InputError
 from .checks import check_choice, check_count, check_finite, check_nonnegative, check_positive
 from .semidiscrete import SceneView, SemiDiscrete
@@ -293,7 +294,7 @@ def bar_system(bar: Bar) -> SemiDiscrete:
     return system
 
 
-METHODS = ("contact", "penalty", "moreau-jean")
+METHODS = ("contact", "penalty", methods.MoreauJean.name)   # the API's words for the bar
 
 
 def spring_step_ratio(bar: Bar, dt: float) -> float:
@@ -357,10 +358,32 @@ def steps_to(T: float, dt: float) -> int:
     return int(np.ceil(T / dt - 1e-9))
 
 
-def bar_run(bar: Bar, dt: float, T: float, beta: float = 0.25, method: str = "contact",
+def bar_method(bar: Bar, method="contact", solver="auto", restitution: float = 0.0,
+               massless: str = "beta"):
+    """The bar's method: a method object (:mod:`skfem_beam.methods`) or the words of
+    METHODS with ``solver``, ``restitution`` and ``massless``.  An elastic obstacle *is*
+    the spring R = kU⁻ of stiffness ``bar.k``, whatever method steps it; a rigid one with
+    the penalty method is approximated by springs of ``bar.k``."""
+    if isinstance(method, str):
+        check_choice("method", method, METHODS)
+        law = "position" if method == "contact" else method
+        method = methods.make(law, solver, restitution, bar.k if law == "penalty" else None,
+                              None if massless == "beta" else massless, words=methods.KEYS)
+    if bar.obstacle != "elastic":
+        return method
+    if isinstance(method, methods.MoreauJean):
+        raise InputError(f"law={method.name!r} enforces a rigid obstacle; the elastic "
+                         "obstacle is a spring (use --law position or penalty)")
+    solver, e = (method.solver, method.restitution) \
+        if isinstance(method, methods.PositionLevel) else ("auto", 0.0)
+    return methods.make("penalty", solver, e, bar.k, method.massless, words=methods.KEYS)
+
+
+def bar_run(bar: Bar, dt: float, T: float, beta: float = 0.25, method="contact",
             solver: str = "auto", frames: int = 200, all_states_limit: int = 4_000_000,
             restitution: float = 0.0, massless: str = "beta"):
-    """The bar's :class:`~skfem_beam.scheme.Run` (not yet driven), to T + Δt.
+    """The bar's :class:`~skfem_beam.scheme.Run` (not yet driven), to T + Δt, with the
+    method of :func:`bar_method`.
 
     rigid + contact: the Signorini condition u(0) ≥ 0 (one constrained value, so the
     step is the projection of Lemma 4.1); rigid + penalty: a one-sided spring of
@@ -369,30 +392,21 @@ def bar_run(bar: Bar, dt: float, T: float, beta: float = 0.25, method: str = "co
     T so that the force centred on t_N is known.  It saves every step (the reaction at
     tₙ comes from step n + 1) and keeps every state as a frame when there are at most
     ``all_states_limit`` values (the energy split needs them); else ``frames`` frames.
-    ``massless``: how a redistributed mass's contact node steps (see Stepping).
     """
-    check_choice("method", method, METHODS)
-    from .contact import resolve
-    from .scheme import Run, Stepping
+    from .scheme import Stepping
+    method = bar_method(bar, method, solver, restitution, massless)
     system = bar_system(bar)
-    if _spring(bar, method) and bar.k == 0:
-        raise InputError("k=0 must be > 0 for a penalty spring")
-    to_T = Stepping(dt, T, beta, massless=massless)   # the checks of Δt, T, β, massless
+    to_T = Stepping(dt, T, beta, massless=method.massless)   # the checks of Δt, T, β
     n_steps = to_T.steps
     every_state = (n_steps + 2) * system.n <= all_states_limit
     stepping = replace(to_T, T=n_steps * dt + dt, frames=n_steps + 1 if every_state else frames)
-    if method == "moreau-jean":    # its energy is its own (½vᵀMv + ½uᵀKu), not the β split
-        from .scheme.moreau_jean import MoreauJean
-        if bar.obstacle != "rigid":
-            raise InputError("law='moreau-jean' enforces a rigid obstacle; the elastic "
-                             "obstacle is a spring (use --law position or penalty)")
-        return MoreauJean(system, replace(stepping, frames=frames), 0.5, restitution)
-    return Run(system, stepping, resolve(solver, bar.k if _spring(bar, method) else None,
-                                         restitution))
+    if isinstance(method, methods.MoreauJean):   # its energy is its own: no β split
+        stepping = replace(stepping, frames=frames)
+    return method.build(system, stepping)
 
 
-def _spring(bar: Bar, method: str) -> bool:
-    return bar.obstacle == "elastic" or method == "penalty"
+def _spring(bar: Bar, method) -> bool:
+    return bar.obstacle == "elastic" or getattr(method, "name", method) == "penalty"
 
 
 class BarSeries:

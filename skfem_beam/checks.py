@@ -40,6 +40,15 @@ def check_beta(beta) -> float:
     return beta
 
 
+def check_restitution(e, name: str = "restitution=") -> float:
+    """A Newton coefficient of restitution e ∈ [0, 1]; ``name``: the key or flag as the
+    user wrote it ("restitution=", "--restitution ")."""
+    e = check_finite(name.rstrip("= "), e)
+    if not 0.0 <= e <= 1.0:
+        raise InputError(f"{name}{e:g} must lie in [0, 1]")
+    return e
+
+
 def check_count(name: str, value, least: int = 1) -> int:
     """A whole number ≥ ``least`` (bools refused)."""
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < least:

@@ -11,14 +11,16 @@ import sys
 import threading
 
 from . import __version__
+from . import methods
 from .contact import SOLVERS
-from .checks import check_choice, check_finite
+from .checks import check_choice
 from .errors import InputError, SolverError
 from .output.folder import (EXIT_INPUT, EXIT_SOLVER, EXIT_UNSTABLE, OPENED,  # noqa: F401
                             Interrupted, release, report, stamp)
 from .output.options import OutputOptions
 from .output.series import stored_args
-from .scheme.stepping import MASSLESS
+from .scheme.stepping import MASSLESS, Stepping
+from .spec import RunSpec
 
 
 class Parser(argparse.ArgumentParser):
@@ -28,7 +30,6 @@ class Parser(argparse.ArgumentParser):
         self.exit(EXIT_INPUT, f"{self.prog}: error: {message}\n")
 
 
-LAWS = ("position", "moreau-jean", "penalty")
 
 
 def parser(prog: str, description: str, *, J=None, dt=None, T=None, beta=None,
@@ -55,13 +56,14 @@ def parser(prog: str, description: str, *, J=None, dt=None, T=None, beta=None,
         p.add_argument("--element", default="hermite", help="hermite | bspline")
     if solver:
         p.add_argument("--solver", default="auto", help=" | ".join(SOLVERS))
-    p.add_argument("--law", default=None, help=" | ".join(LAWS) + ": exact contact at "
+    p.add_argument("--law", default=None, help=" | ".join(methods.LAWS) + ": exact contact at "
                    "position level (the papers' scheme), at velocity level (Moreau–Jean, "
                    "θ = 1/2), or one-sided springs (default: from --method)")
     p.add_argument("--method", default="contact",
                    help="contact (= --law position) | penalty (= --law penalty)")
     p.add_argument("--restitution", type=float, default=0.0, metavar="E",
-                   help="Newton coefficient of restitution e in [0, 1] (position, moreau-jean)")
+                   help="Newton coefficient of restitution e in [0, 1] (position, "
+                        f"{methods.MoreauJean.name})")
     p.add_argument("--mass", default=mass[0], help=" | ".join(mass))
     if "redistributed" in mass:
         p.add_argument("--massless", default=None, help=" | ".join(MASSLESS) + ": how the "
@@ -87,12 +89,48 @@ def parser(prog: str, description: str, *, J=None, dt=None, T=None, beta=None,
 
 
 def parse(p: Parser, argv=None):
-    """Parse the flags; with --resume, the flags stored by the run being resumed."""
+    """Parse the flags; with --resume, the flags stored by the run being resumed.  The
+    method's words are checked once here, and β takes the method's default."""
     args = stored_args(p.parse_args(argv), p, argv)
-    check_law(args, p)
-    if getattr(args, "beta", 0.5) is None:   # the papers: β = 1/2 for contact, 1/4 for penalty
-        args.beta = 0.25 if getattr(args, "method", "contact") == "penalty" else 0.5
+    if hasattr(args, "law"):
+        check_law(args, p)
+        if args.beta is None:
+            args.beta = methods.default_beta(method(args))
     return args
+
+
+def check_law(args, p: Parser) -> None:
+    """--law (or its alias --method), --mass and --massless, and the method they name;
+    sets args.method to "penalty" for the penalty law and "contact" otherwise."""
+    if args.method not in ("contact", "penalty"):
+        raise InputError(f"--method {args.method!r} is not one of: contact, penalty")
+    if args.law is None:
+        args.law = "penalty" if args.method == "penalty" else "position"
+    check_choice("--law", args.law, methods.LAWS)
+    args.method = "penalty" if args.law == "penalty" else "contact"
+    allowed = next(a.help.split(" | ") for a in p._actions if a.dest == "mass")
+    check_choice("--mass", args.mass, allowed)
+    methods.check_massless(getattr(args, "massless", None), args.mass)
+    method(args)
+
+
+def method(args) -> methods.Method:
+    """The method the flags name (--law, --solver, --restitution, --stiffness N/m,
+    --massless)."""
+    return methods.make(args.law, getattr(args, "solver", "auto"), args.restitution,
+                        args.stiffness if args.law == "penalty" else None,
+                        getattr(args, "massless", None))
+
+
+def spec(args, config: dict | None = None) -> RunSpec:
+    """The flags as one :class:`~skfem_beam.spec.RunSpec`: Stepping, method, output
+    options, and summary.json's config (``config`` and every flag but --resume)."""
+    m = method(args)
+    stepping = Stepping(args.dt, args.T, args.beta, args.save_every, args.frames,
+                        massless=m.massless)
+    flags = {k: v for k, v in vars(args).items() if k != "resume"}
+    return RunSpec(stepping, m, output_options(args), {**(config or {}), **flags},
+                   mass=args.mass, probes=tuple(getattr(args, "probe", None) or ()))
 
 
 def output_options(args) -> OutputOptions:
@@ -109,62 +147,6 @@ def mesh_nodes(args):
         return None
     from .meshes import load_mesh
     return load_mesh(args.mesh, args.L)
-
-
-def check_law(args, p: Parser) -> None:
-    """--law (or its alias --method), --restitution and --mass, checked once; sets
-    args.method to "penalty" for the penalty law and "contact" otherwise."""
-    if not hasattr(args, "law"):
-        return
-    check_method(args)
-    if args.law is None:
-        args.law = "penalty" if args.method == "penalty" else "position"
-    check_choice("--law", args.law, LAWS)
-    args.method = "penalty" if args.law == "penalty" else "contact"
-    e = check_finite("--restitution", args.restitution)
-    if not 0.0 <= e <= 1.0:
-        raise InputError(f"--restitution {e:g} must lie in [0, 1]")
-    allowed = next(a.help.split(" | ") for a in p._actions if a.dest == "mass")
-    check_choice("--mass", args.mass, allowed)
-    check_massless(args)
-
-
-def check_massless(args) -> None:
-    """--massless: one of MASSLESS, and only with --mass redistributed and the β-scheme
-    (left None when not given: the run then steps its massless rows the default way)."""
-    rows = getattr(args, "massless", None)
-    if rows is None:
-        return
-    check_choice("--massless", rows, MASSLESS)
-    if args.mass != "redistributed":
-        raise InputError(f"--massless {rows} applies to --mass redistributed only "
-                         f"(--mass is {args.mass}: it has no massless rows)")
-    if args.law == "moreau-jean":
-        raise InputError(f"--massless {rows} applies to the β-scheme (--law position); "
-                         "--law moreau-jean does not take it")
-
-
-def massless(args) -> str:
-    """The Stepping's ``massless``: the flag's value, or the default "beta"."""
-    return getattr(args, "massless", None) or "beta"
-
-
-def make_run(system, stepping, args, stiffness=None):
-    """The run of ``system`` with the law the flags chose (β-scheme or Moreau–Jean)."""
-    from .contact import resolve
-    from .scheme import Run
-    if args.law == "moreau-jean":
-        from .scheme.moreau_jean import MoreauJean
-        if args.solver != "auto":
-            raise InputError(f"--law moreau-jean solves its own impulse problem: "
-                             f"--solver {args.solver} does not apply")
-        return MoreauJean(system, stepping, 0.5, args.restitution)
-    return Run(system, stepping, resolve(args.solver, stiffness, args.restitution))
-
-
-def check_method(args) -> None:
-    if args.method not in ("contact", "penalty"):
-        raise InputError(f"--method {args.method!r} is not one of: contact, penalty")
 
 
 def _terminate(signum, frame):

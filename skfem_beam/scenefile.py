@@ -42,13 +42,16 @@ from .errors import InputError
 from .problem import (Beam, BeamProblem, Damping, InitialState, Load, Material, Obstacles,
                       Section, Support)
 from .checks import check_choice
-from .cli import LAWS
+from . import methods
 from .contact import SOLVERS
+from .output.options import OutputOptions
 from .scheme import Stepping
-from .scheme.stepping import MASSLESS
+from .spec import RunSpec
 from .timefunctions import Constant, Sine, SumOfSines, Table, band_limited
 
 BEAM_MASSES = ("consistent", "redistributed")        # [mesh] mass of a beam
+SCENE_WORDS = methods.Words(solver="[contact] law = ", massless="[mesh] massless = ",
+                            law="[contact] law = ", restitution="[contact] restitution = ")
 
 V = None          # a value (checked by the object it builds)
 
@@ -103,7 +106,8 @@ class Scene:
     """A scene file read into the Python API's objects.
 
     ``problem``: a BeamProblem or a Bar; ``stepping``: the time grid; ``law``,
-    ``stiffness`` (N/m), ``restitution``: the contact law (``contact_law`` builds it);
+    ``stiffness`` (N/m), ``restitution``: the [contact] keys (``method`` builds the run's
+    method from them);
     ``output``: format, save_every, frames, flush_every, checkpoint_every; ``text``: the
     file as read and ``files`` the tables it read (path as written → text), so that a run
     can be rebuilt from its summary.json; ``data``: the parsed TOML with the overrides.
@@ -120,23 +124,15 @@ class Scene:
     data: dict = field(default_factory=dict)
 
     @property
-    def scheme(self) -> str:
-        """The class of time-stepping: position (the β-scheme), moreau-jean or penalty;
-        ``law`` is one of these or a position-level solver (auto, projection, ...)."""
-        return self.law if self.law in LAWS else "position"
-
-    @property
-    def contact_law(self):
-        """The β-scheme's contact law object, None for moreau-jean (its run is a
-        ``MoreauJean``, which solves its own impulse problem).  A beam's penalty stiffness
-        is divided by ρA: the equation is mass-normalised, docs/design.md §1."""
-        from .contact import resolve
-        k = self.stiffness
-        if k is not None and self.kind == "beam":
-            k = k / (self.problem.beam.rho_S or 1.0)
-        law = resolve("auto" if self.law in LAWS[:2] else self.law, k,
-                      self.restitution or 0.0)
-        return None if self.law == "moreau-jean" else law
+    def method(self) -> methods.Method:
+        """The run's method (:mod:`skfem_beam.methods`): ``law`` names a class
+        (methods.LAWS) or a position-level solver."""
+        law, solver = (self.law, "auto") if self.law in methods.LAWS else ("position", self.law)
+        if law == "penalty" and self.stiffness is None:
+            raise InputError("[contact] law='penalty' needs stiffness (N/m)")
+        massless = self.data.get("mesh", {}).get("massless")    # as written: None if not
+        return methods.make(law, solver, self.restitution or 0.0, self.stiffness, massless,
+                            words=SCENE_WORDS)
 
 
 # ---------------------------------------------------------------- the file's shape
@@ -253,39 +249,25 @@ def _scene(kind, problem, data, text, files) -> Scene:
     law, k = contact.get("law", "auto"), contact.get("stiffness")
     if k is not None and law == "auto":
         law = "penalty"
-    check_choice("[contact] law", law, (*LAWS, *SOLVERS))
-    if k is not None and law in LAWS[:2]:
+    check_choice("[contact] law", law, (*methods.LAWS, *SOLVERS))
+    if k is not None and law in methods.LAWS[:2]:
         raise InputError(f"[contact] stiffness is the penalty spring: law = {law!r} does not "
                          "take it")
     t, mesh = data.get("time", {}), data.get("mesh", {})
     if "dt" not in t or "T" not in t:
         raise InputError("[time] needs dt and T (s)")
-    beta = t.get("beta", 0.25 if kind == "bar" or law == "penalty" else 0.5)
     out = {**OUTPUT_DEFAULTS, **data.get("output", {})}
-    stepping = Stepping(t["dt"], t["T"], beta, out["save_every"], out["frames"],
-                        massless=_massless(mesh))
-    scene = Scene(kind, problem, stepping, law, k, contact.get("restitution", 0.0), out,
-                  text, files, data)
-    scene.contact_law        # the law's own checks (name, stiffness, restitution)
     if kind == "beam":
         check_choice("[mesh] mass", mesh.get("mass", "consistent"), BEAM_MASSES)
-    if scene.law == "moreau-jean" and "massless" in mesh:
-        raise InputError("[mesh] massless applies to the β-scheme: [contact] law = "
-                         "\"moreau-jean\" does not take it")
-    return scene
-
-
-def _massless(mesh: dict) -> str:
-    """[mesh] massless: how the massless rows of mass = "redistributed" step (Stepping);
-    refused with any other mass, which has no massless rows."""
     rows = mesh.get("massless")
-    if rows is None:
-        return "beta"
-    check_choice("[mesh] massless", rows, MASSLESS)
-    if mesh.get("mass") != "redistributed":
-        raise InputError(f"[mesh] massless = {rows!r} needs mass = \"redistributed\" "
-                         "(the other masses have no massless rows)")
-    return rows
+    methods.check_massless(rows, mesh.get("mass", "consistent"), "[mesh] massless")
+    scene = Scene(kind, problem, Stepping(t["dt"], t["T"], 0.5, massless=rows or "beta"), law, k,
+                  contact.get("restitution", 0.0), out, text, files, data)
+    method = scene.method          # the method's own checks (law, stiffness, restitution)
+    beta = t.get("beta", methods.default_beta(method, kind))
+    stepping = Stepping(t["dt"], t["T"], beta, out["save_every"], out["frames"],
+                        massless=rows or "beta")
+    return replace(scene, stepping=stepping)
 
 
 class _Reader:
@@ -604,47 +586,58 @@ def _run_parser() -> argparse.ArgumentParser:
 
 def run_main(argv) -> int:
     """``python -m skfem_beam run``: the scene through the scenes' own pipeline."""
-    from .output.series import read_summary, stored_args
+    from .output.series import stored_args
     p = _run_parser()
     args = stored_args(p.parse_args(argv), p, argv)
-    stored = {}
-    if args.resume:
-        config = read_summary(Path(args.resume))["config"]
-        if "scene_text" not in config:
-            raise InputError(f"--resume {args.resume}: not a run of python -m skfem_beam run")
-        stored = {"text": config["scene_text"], "files": config.get("scene_files", {})}
-    elif args.scene is None:
-        raise InputError("run needs a scene file: python -m skfem_beam run SCENE.toml")
-    scene = load(args.scene or "scene.toml", args.set or (), **stored)
-    probes = scene.output.get("probes", [])
-    for key, value in scene.output.items():
-        if key != "probes" and getattr(args, key) is None:
-            setattr(args, key, value)
-    if args.T is None:
-        args.T = scene.stepping.T
-    if args.out is None:
-        args.out = f"out/{Path(args.scene).stem}"
-    penalty = scene.law == "penalty"
-    args.dt, args.beta = scene.stepping.dt, scene.stepping.beta
-    args.method = "penalty" if penalty else "contact"
-    args.law = scene.scheme
-    args.solver = "auto" if scene.law in LAWS or scene.restitution else scene.law
-    args.stiffness, args.restitution = scene.stiffness, scene.restitution
-    args.mass = scene.data.get("mesh", {}).get("mass", "consistent") \
-        if scene.kind == "beam" else scene.problem.mass
-    args.massless = scene.stepping.massless
-    args.probe = [float(x) for x in np.atleast_1d(probes)]
-    config = {"command": "python -m skfem_beam run", "scene_text": scene.text,
-              "scene_files": scene.files}
+    scene = _scene_of(args.scene, args.set, args.resume)
+    spec = _spec(scene, {k: v for k, v in vars(args).items() if k != "resume"}, args.resume)
     name = f"scene {Path(args.scene).stem}" if args.scene else "scene"
     if scene.kind == "bar":
         from .cases.impacting_bar import run_bar_case
-        return run_bar_case(scene.problem, args, config)
+        return run_bar_case(scene.problem, spec)
     from .cases._beam import run_beam_case
-    if penalty and scene.stiffness is None:
-        raise InputError("[contact] law='penalty' needs stiffness (N/m)")
-    stops = _chart_stops(scene.problem)
-    return run_beam_case(name, scene.problem, args, config, stops=stops)
+    return run_beam_case(name, scene.problem, spec, stops=_chart_stops(scene.problem))
+
+
+def _scene_of(path, sets, resume) -> Scene:
+    """The scene file (or, resuming, the text the run stored) with the --set overrides."""
+    from .output.series import read_summary
+    stored = {}
+    if resume:
+        config = read_summary(Path(resume))["config"]
+        if "scene_text" not in config:
+            raise InputError(f"--resume {resume}: not a run of python -m skfem_beam run")
+        stored = {"text": config["scene_text"], "files": config.get("scene_files", {})}
+    elif path is None:
+        raise InputError("run needs a scene file: python -m skfem_beam run SCENE.toml")
+    return load(path or "scene.toml", sets or (), **stored)
+
+
+def _spec(scene: Scene, flags: dict, resume) -> RunSpec:
+    """The scene and the command line's flags (which override its [output] and [time] T)
+    as one RunSpec; summary.json's config records both, in the flags' names."""
+    for key, value in scene.output.items():
+        if key != "probes" and flags[key] is None:
+            flags[key] = value
+    flags["T"] = scene.stepping.T if flags["T"] is None else flags["T"]
+    flags["out"] = flags["out"] or f"out/{Path(flags['scene']).stem}"
+    options = OutputOptions(flags["out"], flags["overwrite"], resume, flags["format"],
+                            flags["frames"], flags["save_every"], flags["flush_every"],
+                            flags["checkpoint_every"])
+    stepping = replace(scene.stepping, T=flags["T"], save_every=options.save_every,
+                       frames=options.frames)
+    law, restitution = scene.law, scene.restitution
+    mass = scene.data.get("mesh", {}).get("mass", "consistent") if scene.kind == "beam" \
+        else scene.problem.mass
+    probes = [float(x) for x in np.atleast_1d(scene.output.get("probes", []))]
+    config = {"command": "python -m skfem_beam run", "scene_text": scene.text,
+              "scene_files": scene.files, **flags, "dt": stepping.dt, "beta": stepping.beta,
+              "method": "penalty" if law == "penalty" else "contact",
+              "law": law if law in methods.LAWS else "position",
+              "solver": "auto" if law in methods.LAWS or restitution else law,
+              "stiffness": scene.stiffness, "restitution": restitution, "mass": mass,
+              "massless": stepping.massless, "probe": probes}
+    return RunSpec(stepping, scene.method, options, config, mass, tuple(probes))
 
 
 def _chart_stops(problem: BeamProblem) -> tuple:

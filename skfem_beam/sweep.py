@@ -183,8 +183,8 @@ def run_value(settings: dict, value: float) -> dict:
     The statistics cover the sampled window (after the transient) only: the counters
     are read when the run reaches the end of the transient, and subtracted.
     """
-    from .contact import resolve
-    from .scheme import Run, Stepping, drive
+    from .methods import PositionLevel
+    from .scheme import Stepping, drive
     from .semidiscrete import beam_system
     t_start, cpu_start = time.perf_counter(), time.process_time()
     dt, spp, ntr, omega = section_plan(settings, value)
@@ -200,8 +200,9 @@ def run_value(settings: dict, value: float) -> dict:
         out["damping"] = damping_of(settings, value)
         system = beam_system(build_problem(settings, value, out["damping"]))
         # T half a step short of n·dt: the run takes ceil(T/dt) = n steps whatever the round-off
-        run = Run(system, Stepping(dt, (n_total - 0.5) * dt, settings["beta"], save_every=spp,
-                                   frames=1), resolve(settings["solver"]))
+        run = PositionLevel(settings["solver"]).build(
+            system, Stepping(dt, (n_total - 0.5) * dt, settings["beta"], save_every=spp,
+                             frames=1))
         pre = {"impacts": 0, "contacts": 0}
         while not run.done and run.n < n_trans:
             run.advance(min(run.n + CHUNK, n_trans))

@@ -16,6 +16,8 @@ import time
 import numpy as np
 import pytest
 
+from skfem_beam.methods import PositionLevel
+
 from conftest import exit_code
 from skfem_beam import cli
 from skfem_beam.cases import impacting_bar, point_stops
@@ -161,7 +163,7 @@ def test_failed_solver_keeps_the_impacts_so_far(tmp_path, monkeypatch, capsys):
     argv = ["--dt", "1e-4", "--T", "1", "--flush-every", "200", "--format", "none"]
     ref = tmp_path / "ref"
     assert exit_code(point_stops.main, argv + ["--out", str(ref)]) == 0
-    monkeypatch.setattr(cli, "make_run", lambda system, stepping, args, stiffness=None:
+    monkeypatch.setattr(PositionLevel, "build", lambda self, system, stepping:
                         Run(system, stepping, GivesUp(6001)))   # call 1: the start step
     out = tmp_path / "run"
     capsys.readouterr()

@@ -152,7 +152,7 @@ def test_command_line_massless_reaches_the_run(tmp_path):
 
 @pytest.mark.parametrize("args, word", [
     (["--mass", "redistributed", "--massless", "foo"], "--massless='foo' is not one of"),
-    (["--massless", "quasi-static"], "applies to --mass redistributed only"),
+    (["--massless", "quasi-static"], "--massless 'quasi-static' applies to a redistributed mass only"),
     (["--mass", "redistributed", "--massless", "beta", "--law", "moreau-jean"],
      "--law moreau-jean"),
 ])

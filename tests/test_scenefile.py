@@ -178,7 +178,7 @@ def test_heat_exchanger_tube_rattles_in_both_baffles(tmp_path):
     scene = load(example("heat_exchanger_tube"))
     pb = scene.problem
     assert pb.ends == ("pinned", "pinned") and pb.damping.alpha > 0
-    run = Run(beam_system(pb), scene.stepping, scene.contact_law)
+    run = scene.method.build(beam_system(pb), scene.stepping)
     drive(run)
     r = run.result()
     ev = r.impact_events
@@ -280,7 +280,7 @@ def test_penalty_law_runs_as_the_case_penalty_method(tmp_path):
 def test_restitution_runs_as_the_case_flag(tmp_path):
     """[contact] restitution = 0.5 is the case command's --restitution 0.5, bit for bit."""
     f = write(tmp_path, PIPE + '[contact]\nlaw = "auto"\nrestitution = 0.5\n')
-    assert load(f).contact_law.e == 0.5
+    assert load(f).method.restitution == 0.5
     a, b = tmp_path / "a", tmp_path / "b"
     assert exit_code(run_main, [str(example("point_stops")), "--out", str(a), "--T", "0.3",
                                 "--format", "none", "--set", "contact.restitution=0.5"]) == 0
@@ -307,7 +307,7 @@ def test_massless_key_is_the_case_flag(tmp_path, capsys):
     bad.mkdir()
     for sets, word in ((["mesh.mass=redistributed", "mesh.massless=midpoint"],
                         "[mesh] massless='midpoint' is not one of: beta, quasi-static"),
-                       (["mesh.massless=quasi-static"], 'needs mass = "redistributed"')):
+                       (["mesh.massless=quasi-static"], "[mesh] massless 'quasi-static' applies to a redistributed mass only")):
         assert_refused(run_main, [str(example("impacting_bar")), "--out", str(bad / "run"),
                                   *[x for s in sets for x in ("--set", s)]], word, capsys, bad)
 
@@ -338,7 +338,7 @@ def test_law_and_mass_keys_are_the_case_flags(tmp_path, scene, sets, flags):
     (["contact.law=bogus"], "[contact] law='bogus' is not one of: position, moreau-jean"),
     (["contact.law=position", "contact.stiffness=1e6"], "law = 'position' does not take it"),
     (["contact.law=moreau-jean", "mesh.mass=redistributed", "mesh.massless=beta"],
-     '[mesh] massless applies to the β-scheme'),
+     '[mesh] massless = beta applies to the β-scheme'),
 ])
 def test_bad_law_and_mass_keys_are_refused(tmp_path, capsys, sets, word):
     assert_refused(run_main, [str(example("point_stops")), "--out", str(tmp_path / "run"),

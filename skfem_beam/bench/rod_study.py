@@ -30,6 +30,7 @@ import numpy as np
 
 from .. import scenes
 from ..bar import l2_time, run_bar
+from ..methods import MOREAU_JEAN
 from ..reference import exact_of
 from .work_precision import COURANTS, rung
 
@@ -102,7 +103,7 @@ SETTINGS = [
     *[(f"position, {mass}, β={b}, e={e:g}", "position", mass, dict(beta=beta, restitution=e))
       for mass in ("average", "consistent", "lumped")
       for b, beta in (("1/4", 0.25), ("1/2", 0.5)) for e in (0.0, 0.5, 1.0)],
-    *[(f"Moreau–Jean, average, θ={th}, e={e:g}", "moreau-jean", "average",
+    *[(f"Moreau–Jean, average, θ={th}, e={e:g}", MOREAU_JEAN, "average",
        dict(theta=theta, restitution=e))
       for th, theta in (("1/2", 0.5), ("1", 1.0)) for e in (0.0, 1.0)],
     ("penalty k=1e3, average, β=1/4", "penalty", "average", dict(beta=0.25, stiffness=1e3)),

@@ -32,10 +32,10 @@ import numpy as np
 
 from .. import scenes
 from ..bar import bar_system, l2_time
-from ..contact import resolve
 from ..reference import exact_of
-from ..scheme import Run, Stepping, drive
-from ..scheme.moreau_jean import moreau_jean
+from .. import methods
+from ..methods import MOREAU_JEAN
+from ..scheme import solve
 
 COURANTS = (0.04, 0.4)
 BENCHMARKS = {"rod": (scenes.periodic_rod, 12.0, 0.125),
@@ -46,12 +46,12 @@ METHODS = [
     ("position, consistent, β=1/2", "position", "consistent", dict(beta=0.5)),
     ("penalty k=1e3, average, β=1/4", "penalty", "average", dict(beta=0.25, stiffness=1e3)),
     ("penalty k=1e5, average, β=1/4", "penalty", "average", dict(beta=0.25, stiffness=1e5)),
-    ("Moreau–Jean θ=1/2 e=0, average", "moreau-jean", "average", dict(theta=0.5)),
+    ("Moreau–Jean θ=1/2 e=0, average", MOREAU_JEAN, "average", dict(theta=0.5)),
     ("modified mass (redistributed), β=1/2", "modified mass", "redistributed", dict(beta=0.5)),
     ("modified mass (redistributed), β=1/4, quasi-static", "modified mass", "redistributed",
      dict(beta=0.25, massless="quasi-static")),
 ]
-STYLE = {"position": "-", "penalty": "--", "moreau-jean": "-.", "modified mass": ":"}
+STYLE = {"position": "-", "penalty": "--", MOREAU_JEAN: "-.", "modified mass": ":"}
 
 
 def run_method(system, dt, T, kw, frames):
@@ -61,14 +61,13 @@ def run_method(system, dt, T, kw, frames):
     see Stepping)."""
     e = kw.get("restitution", 0.0)
     if "theta" in kw:
-        return moreau_jean(system, dt, T, theta=kw["theta"], restitution=e, frames=frames,
-                           progress=False)
-    # solve()'s own steps, with the Stepping that carries ``massless``
-    run = Run(system, Stepping(dt, T, kw["beta"], frames=frames,
-                               massless=kw.get("massless", "beta")),
-              resolve("auto", kw.get("stiffness"), e))
-    drive(run, progress=False)
-    return run.result()
+        method = methods.MoreauJean(kw["theta"], e)
+    elif "stiffness" in kw:     # per unit of the equation, as the studies give it
+        method = methods.Penalty(kw["stiffness"], equation_units=True)
+    else:
+        method = methods.PositionLevel("auto", e, kw.get("massless", "beta"))
+    return solve(system, dt, T, kw.get("beta", 0.5), frames=frames, progress=False,
+                 method=method)
 
 
 def field_errors(result, exact, points: int = 4) -> dict:

@@ -11,45 +11,58 @@ from ..output.events import beam_impacts
 from ..output.fields import physical_tip
 from ..output.probes import probe_columns, probe_units
 from ..output.series import Series, execute, prepare
-from ..scheme import Stepping
+from ..methods import Penalty
 from ..scheme.kernels import WORK_TERMS
-from ..checks import check_positive
+from ..spec import RunSpec
 from ..semidiscrete import add_probes, beam_system
 from ..spaces.redistribution import redistributed
 from ..stability import kappa_h, linear_limit
 
 
 
-def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) -> int:
-    """Discretise ``problem``, run it with the flags in ``args``, write DIR, return exit code.
-
-    ``extra(folder, data, run)`` may write more files into the output folder (``data``:
-    the timeseries columns, from memory).
-    """
-    cli.check_method(args)
-    stepping = Stepping(args.dt, args.T, args.beta, args.save_every, args.frames,
-                        massless=cli.massless(args))
-    options = cli.output_options(args)
-    prepare(options)  # fail before the run, not after it
+def run_beam_case(case: str, problem, spec: RunSpec, stops=(), extra=None) -> int:
+    """Discretise ``problem``, run it as ``spec`` says, write its folder, return the exit
+    code.  ``extra(folder, data, run)`` may write more files into the output folder
+    (``data``: the timeseries columns, from memory)."""
+    prepare(spec.options)                         # fail before the run, not after it
     system = beam_system(problem)
-    add_probes(system, getattr(args, "probe", None) or [])
-    kh = kappa_h(system)
-    limit = linear_limit(kh, args.beta)
-    if args.dt > limit:
-        cli.warn(f"dt={args.dt:g} s is above the linear stability limit "
-                 f"2/√(κ_h(1−4β)) = {limit:.4g} s for beta={args.beta:g} (κ_h={kh:.4g} s⁻²); "
-                 "the run will likely go unstable")
-    stiffness = None
-    rho_S = problem.beam.rho_S
-    if args.method == "penalty":
-        # physical N/m → the mass-normalised equation u_tt + k²u'''' = f needs N/m per kg/m
-        stiffness = check_positive("stiffness", args.stiffness) / (rho_S or 1.0)
-    if args.mass == "redistributed":
+    add_probes(system, list(spec.probes))
+    kh, limit = stability_warning(system, spec.stepping)
+    if spec.mass == "redistributed":
         system = redistributed(system)
-    run = cli.make_run(system, stepping, args, stiffness)
+    run = spec.method.build(system, spec.stepping)
+    rho_S = problem.beam.rho_S
+    penalty = isinstance(spec.method, Penalty)
+    summary = {
+        "case": case, "J": problem.J, "dt": run.dt, "T": run.n_steps * run.dt, "beta": run.beta,
+        "element": problem.element, "method": "penalty" if penalty else "contact",
+        "kappa_h": kh, "linear_stability_limit_dt": limit,
+        "units": {**units(rho_S, system), "probes": probe_units(system)},
+        "penalty_stiffness_N_per_m": spec.method.stiffness if penalty else None,
+        "config": spec.config,
+    }
 
-    view = system.view
+    def events(folder: Path, run, last: int) -> dict:
+        return beam_impacts(folder, run, problem, last)
 
+    series = Series(beam_columns(system.view, rho_S), events=events)
+    return execute(run, spec.options, summary, series,
+                   beam_charts(case, problem, rho_S, stops, extra))
+
+
+def stability_warning(system, stepping):
+    """κ_h and the linear limit 2/√(κ_h(1−4β)); a warning line when Δt is above it."""
+    kh = kappa_h(system)
+    limit = linear_limit(kh, stepping.beta)
+    if stepping.dt > limit:
+        cli.warn(f"dt={stepping.dt:g} s is above the linear stability limit "
+                 f"2/√(κ_h(1−4β)) = {limit:.4g} s for beta={stepping.beta:g} (κ_h={kh:.4g} "
+                 "s⁻²); the run will likely go unstable")
+    return kh, limit
+
+
+def beam_columns(view, rho_S):
+    """timeseries.csv's columns of saved rows k0..k1 of a beam run."""
     def columns(run, k0, k1):
         force = run.lam[k0:k1].sum(axis=1)   # net force on the beam, m²/s² = N/(kg/m)
         t = np.arange(k0, k1) * run.save_every * run.dt
@@ -68,10 +81,14 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
         if rho_S:
             cols.update({f"{k}_J": v * rho_S for k, v in terms.items()})
         return {**cols, **probe_columns(run, k0, k1)}
+    return columns
 
+
+def beam_charts(case, problem, rho_S, stops, extra):
+    """The charts of a beam run (and the case's ``extra`` files), from the rows in memory."""
     def finish(folder: Path, data: dict, run):
-        t, beta, dt = data["t"], run.beta, run.dt
-        about = f"β={beta:g}, Δt={dt:g} s, J={problem.J}, {problem.element}"
+        t = data["t"]
+        about = f"{scheme_label(run)}, Δt={run.dt:g} s, J={problem.J}, {problem.element}"
         trajectory_chart(folder / "tip_displacement.png", t, {"ũ(L, t)": data["tip_displacement"]},
                          stops=stops, title=f"{case}: tip displacement ({about})")
         joules = "energy_J" in data         # in J when the mass per length ρS is known
@@ -91,19 +108,13 @@ def run_beam_case(case: str, problem, args, config: dict, stops=(), extra=None) 
                     title=f"{case}: displacement ũ(x, t) at saved times ({about})")
         if extra is not None:
             extra(folder, data, run)
+    return finish
 
-    summary = {
-        "case": case, "J": problem.J, "dt": run.dt, "T": run.n_steps * run.dt, "beta": run.beta,
-        "element": problem.element, "method": args.method,
-        "kappa_h": kh, "linear_stability_limit_dt": limit,
-        "units": {**units(rho_S, system), "probes": probe_units(system)},
-        "penalty_stiffness_N_per_m": args.stiffness if args.method == "penalty" else None,
-        "config": {**config, **{k: v for k, v in vars(args).items() if k != "resume"}},
-    }
-    def events(folder: Path, run, last: int) -> dict:
-        return beam_impacts(folder, run, problem, last)
 
-    return execute(run, options, summary, Series(columns, events=events), finish)
+def scheme_label(run) -> str:
+    """β=… for the β-scheme, θ=… for Moreau–Jean (its run reports θ, not β)."""
+    theta = getattr(run, "theta", None)
+    return f"θ={theta:g}" if theta is not None else f"β={run.beta:g}"
 
 
 def units(rho_S, system) -> dict:

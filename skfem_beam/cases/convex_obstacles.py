@@ -18,7 +18,7 @@ def main(argv=None) -> int:
                                  nodes=cli.mesh_nodes(args))
     lo, hi = pb.obstacles.bounds([pb.beam.L])      # the gap at the tip, for the chart
     config = {"f": "sin(10 t)", "u0": "0", "v0": "0", "g": "±(0.005 + 0.03 (x − L/2)²)"}
-    return run_beam_case("convex_obstacles", pb, args, config, stops=(lo[0], hi[0]))
+    return run_beam_case("convex_obstacles", pb, cli.spec(args, config), stops=(lo[0], hi[0]))
 
 
 if __name__ == "__main__":

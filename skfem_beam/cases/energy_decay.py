@@ -43,7 +43,7 @@ def main(argv=None) -> int:
                          ylabel="energy (m³/s²)")
 
     config = {"f": "0", "u0": "0.005 x²", "v0": "-x", "g": "±(0.2 + 0.3 (x − L/2)²)"}
-    return run_beam_case("energy_decay", pb, args, config, extra=energy_files)
+    return run_beam_case("energy_decay", pb, cli.spec(args, config), extra=energy_files)
 
 
 if __name__ == "__main__":

@@ -20,7 +20,7 @@ def main(argv=None) -> int:
     pb = scenes.flat_obstacles(J=args.J, element=args.element, L=args.L, k2=args.k2,
                                gap=args.gap, nodes=cli.mesh_nodes(args))
     config = {"f": "sin(10 t)", "u0": "0", "v0": "0", "g": "±gap on [L/2, L]"}
-    return run_beam_case("flat_obstacles", pb, args, config, stops=(-args.gap, args.gap))
+    return run_beam_case("flat_obstacles", pb, cli.spec(args, config), stops=(-args.gap, args.gap))
 
 
 if __name__ == "__main__":

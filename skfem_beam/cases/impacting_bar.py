@@ -6,7 +6,7 @@
         [--obstacle-at left|right] [--N 100]
         [--dt 1e-3] [--T 3] [--beta 0.25] [--method contact|penalty]
         [--mass average|consistent|lumped|redistributed] [--massless beta|quasi-static]
-        [--law position|moreau-jean|penalty] [--restitution E] [--save-every 1] [--frames 200] [--out DIR]
+        [--law LAW] [--restitution E] [--save-every 1] [--frames 200] [--out DIR]
         [--checkpoint-every S] [--resume DIR]
 
 Example 1 of Do, Raupp & Feijoo is the default (add ``--obstacle elastic`` for the
@@ -37,7 +37,8 @@ from ..bar import (Bar, BarSeries, bar_run, contact_periods, describe, energy_re
 from ..output.charts import compare_chart
 from ..output.events import bar_impacts
 from ..output.series import Series, execute, prepare
-from ..checks import check_positive
+from ..methods import Penalty
+from ..spec import RunSpec
 from ..reference import BarExact
 from ..spaces.lagrange import MASSES
 
@@ -75,45 +76,53 @@ def main(argv=None) -> int:
     bar = Bar(a=args.a, b=args.b, rho=args.rho, L=args.L, f=args.f, v0=v0, u0=u0,
               obstacle=args.obstacle, k=args.k, N=args.N, mass=args.mass,
               far_end=args.far_end, obstacle_at=args.obstacle_at, A=args.A)
-    return run_bar_case(bar, args)
+    return run_bar_case(bar, cli.spec(args))
 
 
-def run_bar_case(bar: Bar, args, config: dict | None = None) -> int:
-    """Run ``bar`` with the flags in ``args`` (dt, T, beta, method, solver, stiffness,
-    the output flags), write DIR through the streaming pipeline, return the exit code.
-    ``config``: more entries for summary.json's config (beside the flags)."""
-    cli.check_method(args)
-    dt, T = args.dt, args.T          # checked by the run's Stepping (bar_run)
-    penalty = args.method == "penalty" and bar.obstacle == "rigid"
-    if penalty:   # the rigid obstacle approximated by a spring of stiffness 1/ε
-        bar = replace(bar, k=check_positive("stiffness", args.stiffness))
-    options = cli.output_options(args)
-    prepare(options)  # fail before the run, not after
-    run = bar_run(bar, dt, T, beta=args.beta, method="moreau-jean" if args.law == "moreau-jean"
-                  else args.method, solver=args.solver, frames=args.frames,
-                  restitution=args.restitution, massless=cli.massless(args))
-    try:
-        exact = BarExact.of(bar, T)
-    except RuntimeError as e:      # very long runs with many switches
-        cli.warn(f"no exact solution written: {e}")
-        exact = None
-    series = BarSeries(bar, run, T, args.method, every=args.save_every, exact=exact)
+def run_bar_case(bar: Bar, spec: RunSpec) -> int:
+    """Run ``bar`` as ``spec`` says (its Stepping's Δt, T, β; its method; its output
+    options), write the folder through the streaming pipeline, return the exit code."""
+    s = spec.stepping
+    if isinstance(spec.method, Penalty) and bar.obstacle == "rigid":
+        bar = replace(bar, k=spec.method.stiffness)   # the rigid obstacle as springs 1/ε
+    prepare(spec.options)                                # fail before the run, not after
+    run = bar_run(bar, s.dt, s.T, beta=s.beta, method=spec.method, frames=s.frames)
+    exact = bar_exact(bar, s.T)
+    method = "penalty" if isinstance(spec.method, Penalty) else "contact"
+    series = BarSeries(bar, run, s.T, method, every=s.save_every, exact=exact)
     spring = series.spring
-    if spring and spring_step_ratio(bar, dt) > 1:
-        cli.warn(f"stiff spring: √(k/m₀)·Δt = {spring_step_ratio(bar, dt):.3g} > 1 (m₀ the "
+    if spring and spring_step_ratio(bar, s.dt) > 1:
+        cli.warn(f"stiff spring: √(k/m₀)·Δt = {spring_step_ratio(bar, s.dt):.3g} > 1 (m₀ the "
                  f"contact node's mass); impacts on it are under-resolved and may gain "
                  f"energy: lower --dt or use --method contact")
     # field frames: about --frames of the states up to T (every state is kept for the
     # energy split when it fits; else the run keeps --frames frames itself)
-    field_every = max(1, series.n_steps // args.frames) if run.frame_every == 1 else run.frame_every
+    field_every = max(1, series.n_steps // s.frames) if run.frame_every == 1 \
+        else run.frame_every
     stream = Series(series.columns, ready=series.ready, field_every=field_every,
                     field_until=series.n_steps, keep_all=True,   # errors need every row
                     events=lambda folder, run, last: bar_impacts(folder, run, bar, last))
+    summary = bar_summary(bar, run, series, method, spec.config)
+    return execute(run, spec.options, summary, stream, bar_charts(bar, series, exact, s.T))
 
-    summary = {
+
+def bar_exact(bar: Bar, T: float):
+    """The exact solution where it is known, else None (a warning when it could not be
+    computed)."""
+    try:
+        return BarExact.of(bar, T)
+    except RuntimeError as e:      # very long runs with many switches
+        cli.warn(f"no exact solution written: {e}")
+        return None
+
+
+def bar_summary(bar: Bar, run, series, method: str, config: dict) -> dict:
+    """summary.json's entries of a bar run (before the run's own)."""
+    spring = series.spring
+    return {
         "case": CASE, "J": bar.N, "N": bar.N, "dt": run.dt, "T": series.n_steps * run.dt,
         "beta": run.beta, "element": "p1", "mass": bar.mass,
-        "method": args.method, "obstacle": bar.obstacle,
+        "method": method, "obstacle": bar.obstacle,
         "spring_stiffness": bar.k if spring else None,
         "bar": {"a": bar.a, "b": bar.b, "rho": bar.rho, "L": bar.L, "f": bar.f,
                 "v0": describe(bar.v0), "u0": describe(bar.u0), "k": bar.k, "c": bar.c,
@@ -130,8 +139,13 @@ def run_bar_case(bar: Bar, args, config: dict | None = None) -> int:
                   "wall_time_s": "the time loop alone (one step past T, for R at T)"},
         "notes": ("energy = kinetic + strain + obstacle, the scheme's E_β/2 split; "
                   "energy_final and the energy report add the load potential −fL·ū"),
-        "config": {**(config or {}), **{k: v for k, v in vars(args).items() if k != "resume"}},
+        "config": config,
     }
+
+
+def bar_charts(bar: Bar, series, exact, T: float):
+    """The charts and the summary entries of a bar run, from its rows in memory."""
+    spring = series.spring
 
     def finish(folder, data, run):
         b = series.bar_run(data, run.result())
@@ -162,7 +176,7 @@ def run_bar_case(bar: Bar, args, config: dict | None = None) -> int:
             "errors": errors(b, exact) if exact is not None else None,
             "energy": energy_report(b)}
 
-    return execute(run, options, summary, stream, finish)
+    return finish
 
 
 if __name__ == "__main__":

@@ -19,7 +19,7 @@ def main(argv=None) -> int:
                             amplitude=args.amplitude, omega=args.omega,
                             nodes=cli.mesh_nodes(args))
     config = {"u0": "0", "v0": "-amplitude*omega*h(x) (L2 projection)"}
-    return run_beam_case("point_stops", pb, args, config, stops=(-args.gap, args.gap))
+    return run_beam_case("point_stops", pb, cli.spec(args, config), stops=(-args.gap, args.gap))
 
 
 if __name__ == "__main__":

@@ -14,8 +14,7 @@ a step (the O(Δt) penetration of the Paoli–Schatzman scheme), reported as nod
 """
 import numpy as np
 
-from ..checks import check_finite
-from ..errors import InputError
+from ..checks import check_restitution
 from .active_set import box_qp
 from .base import ContactLaw, compiled_law
 
@@ -50,10 +49,7 @@ class Restitution(ContactLaw):
     name = "restitution"
 
     def __init__(self, e: float):
-        e = check_finite("restitution", e)
-        if not 0.0 <= e <= 1.0:
-            raise InputError(f"restitution={e:g} must lie in [0, 1]")
-        self.e = e
+        self.e = check_restitution(e)
 
     def setup(self, step, first=False):
         self.kernel = restitution_projection if step.decoupled else restitution_active_set

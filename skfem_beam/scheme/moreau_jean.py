@@ -69,9 +69,12 @@ MJState = namedtuple("MJState", [
 ])
 
 
+NAME = "moreau-jean"     # the method's name everywhere (flags, scene files, results)
+
+
 class MoreauJeanLaw(ContactLaw):
     """The name a Moreau–Jean result reports as its solver."""
-    name = "moreau-jean"
+    name = NAME
 
 
 @njit(cache=True)
@@ -221,7 +224,7 @@ class MoreauJean(Run):
 
     def _build(self, system, stepping, law) -> None:
         if system.bound_motion is not None:
-            raise InputError("law='moreau-jean' does not handle obstacles that move with a "
+            raise InputError(f"law={NAME!r} does not handle obstacles that move with a "
                              "support: use the position-level scheme")
         s, m, n, th = stepping, system.C.shape[0], system.n, self.theta
         self.system, self.stepping, self.law, self.solver = system, s, law, law.name
@@ -285,10 +288,10 @@ class MoreauJean(Run):
         return mj_steps(self.ops, self.st, self.out, n0, n1, inputs, Ebound)
 
     def checkpoint(self) -> dict:
-        raise InputError("checkpoints are not implemented for law='moreau-jean'")
+        raise InputError(f"checkpoints are not implemented for law={NAME!r}")
 
     def restore(self, ck: dict) -> None:
-        raise InputError("law='moreau-jean' runs cannot be resumed")
+        raise InputError(f"law={NAME!r} runs cannot be resumed")
 
 
 def moreau_jean(system, dt: float, T: float, theta: float = 0.5, restitution: float = 0.0,
@@ -296,8 +299,9 @@ def moreau_jean(system, dt: float, T: float, theta: float = 0.5, restitution: fl
                 chunk: int = 20000) -> Result:
     """Integrate ``system`` over [0, T] with Moreau–Jean (θ-scheme, Newton impact law
     with coefficient ``restitution``); the :class:`Result` of :func:`solve`, with
-    ``beta`` holding θ and ``solver`` "moreau-jean"."""
-    run = MoreauJean(system, Stepping(dt, T, 0.5, save_every, frames), theta, restitution)
-    drive(run, chunk, progress)
-    return run.result()
+    ``beta`` holding θ and ``solver`` the method's name."""
+    from .solve import solve
+    from ..methods import MoreauJean as Method
+    return solve(system, dt, T, method=Method(theta, restitution), save_every=save_every,
+                 frames=frames, progress=progress, chunk=chunk)
 

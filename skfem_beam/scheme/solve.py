@@ -4,7 +4,7 @@ from __future__ import annotations
 import math
 import sys
 
-from ..contact import ContactLaw, resolve
+from ..contact import ContactLaw
 from ..errors import InputError
 from .run import Run
 from .stepping import Result, Stepping
@@ -12,15 +12,20 @@ from .stepping import Result, Stepping
 MAX_VALUES = 2 * 10**8    # saved values a Result may hold (1.6 GB)
 
 
-def solve(system, dt: float, T: float, beta: float = 0.5, solver: str | ContactLaw = "auto",
-          stiffness: float | None = None, save_every: int = 1, frames: int = 200,
-          progress: bool | None = None, chunk: int = 20000, load_window: str = "forward",
-          growth_limit: float = 10.0) -> Result:
-    """Integrate ``system`` over [0, T] with step ``dt``.
+def solve(system, dt: float, T: float, beta: float | None = None,
+          solver: str | ContactLaw = "auto", stiffness: float | None = None,
+          save_every: int = 1, frames: int = 200, progress: bool | None = None,
+          chunk: int = 20000, load_window: str = "forward", growth_limit: float = 10.0,
+          method=None) -> Result:
+    """Integrate ``system`` over [0, T] with step ``dt``, in the style of ``solve_ivp``.
 
-    ``solver``: the contact law, by name (see :mod:`skfem_beam.contact`) or a law object;
-    with ``stiffness`` = κ the obstacles are instead one-sided springs (normal compliance,
-    κ in the units of the semi-discrete equation, i.e. per unit mass for the beam).
+    ``method``: a :mod:`skfem_beam.methods` object, which reaches every class
+    (``PositionLevel(solver, restitution, massless)``, ``Penalty(stiffness)`` in N/m,
+    ``MoreauJean(theta, restitution)``); without it, ``solver`` names the position-level
+    contact law (see :mod:`skfem_beam.contact`) or is a law object, and ``stiffness`` = κ
+    makes the obstacles one-sided springs (normal compliance, κ in the units of the
+    semi-discrete equation, i.e. per unit mass for the beam).  ``beta``: the β-scheme's
+    β (default: a method's own, 1/2 for exact contact, 1/4 for springs; 1/2 without one).
     ``save_every``, ``frames``, ``load_window``, ``growth_limit``: see :class:`Stepping`.
 
     The run stops with status "unstable" when the discrete energy exceeds
@@ -28,7 +33,14 @@ def solve(system, dt: float, T: float, beta: float = 0.5, solver: str | ContactL
     or a value turns non-finite; what was computed up to the last good saved state is
     returned.
     """
-    stepping = Stepping(dt, T, beta, save_every, frames, load_window, growth_limit)
+    from .. import methods      # here: methods builds its runs from this package
+    if method is not None and (solver != "auto" or stiffness is not None):
+        raise InputError("pass either method= or solver=/stiffness=, not both")
+    if beta is None:     # the method's own; 1/2 for solver=/stiffness= (as they always were)
+        beta = method.default_beta if method is not None else 0.5
+    method = methods.of(method if method is not None else solver, stiffness)
+    stepping = Stepping(dt, T, beta, save_every, frames, load_window, growth_limit,
+                        massless=method.massless)
     rows = stepping.steps // stepping.save_every + 1
     values = rows * (2 * len(system.observe) + system.C.shape[0] + 4)
     if values > MAX_VALUES:   # a Result holds every saved row; the commands stream them
@@ -36,7 +48,7 @@ def solve(system, dt: float, T: float, beta: float = 0.5, solver: str | ContactL
                          f"steps would hold {rows:.3g} rows in memory: raise save_every to at "
                          f"least {math.ceil(stepping.save_every * values / MAX_VALUES)}, or "
                          f"run it from the command line, which streams them to disk")
-    run = Run(system, stepping, resolve(solver, stiffness))
+    run = method.build(system, stepping)
     drive(run, chunk, progress)
     return run.result()
 

@@ -1,0 +1,26 @@
+"""What every front end builds once and hands to a scene's runner (``cases._beam``,
+``cases.impacting_bar``): the time grid, the method, the output options and the
+summary's config.  The command line builds it from its flags (``cli.spec``), a scene
+file from its keys (``scenefile.run_main``); nothing below them reads their words."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from .methods import Method
+from .output.options import OutputOptions
+from .scheme.stepping import Stepping
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """``stepping``: Δt, T, β and what is kept; ``method``: :mod:`skfem_beam.methods`;
+    ``options``: the output folder and streaming; ``config``: summary.json's record of
+    what the user asked for, in the front end's own words (a resume compares it);
+    ``mass``: the beam's mass matrix (consistent | redistributed); ``probes``: abscissae
+    (m) whose displacement, velocity, moment and shear are written."""
+    stepping: Stepping
+    method: Method
+    options: OutputOptions
+    config: dict = field(default_factory=dict)
+    mass: str = "consistent"
+    probes: tuple = ()

@@ -426,7 +426,7 @@ class BarSeries:
         self.sign = bar.gap_sign                 # U = sign·(C u), R = sign·λ
         self.end = "u0" if bar.obstacle_at == "left" else "uL"
         Um0 = max(-self.sign * float((s.C @ s.u0)[0]), 0.0)
-        self.obstacle0 = 0.5 * bar.k * (run.beta * 0.0 + Um0 * Um0) if self.spring else 0.0
+        self.obstacle0 = 0.5 * bar.k * (Um0 * Um0) if self.spring else 0.0
         self.energy0 = 0.5 * s.v0 @ (s.M @ s.v0) + 0.5 * s.u0 @ (s.K @ s.u0) + self.obstacle0
 
     def ready(self, run) -> int:
@@ -454,7 +454,7 @@ class BarSeries:
             obstacle = np.zeros(n.size)
         kinetic = np.full(n.size, np.nan)
         strain = np.full(n.size, np.nan)
-        if run.frame_every == 1:                 # every state kept: the energy split
+        if run.frame_every == 1 and beta is not None:   # every state kept: the β split
             U, P = run.fr[n], run.fr[np.maximum(n - 1, 0)]
             d = U - P
             Md, Kd = (s.M @ d.T).T, (s.K @ d.T).T

@@ -62,7 +62,7 @@ class _PythonActiveSet(ContactLaw):
         class Solve:
             state = np.zeros(step.D.shape[0], np.int8)
 
-            def solve(self, x_free, y_free):
+            def solve(self, x_free, y_free, lo, hi):
                 mu = np.zeros(y_free.size)
                 return mu, box_qp(step.D, y_free, step.lo, step.hi, self.state, mu)
         return Solve()

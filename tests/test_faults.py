@@ -147,7 +147,7 @@ class GivesUp(ContactLaw):
         d, lo, hi, calls = np.diag(step.D), step.lo, step.hi, [0]
 
         class Solver:
-            def solve(self, x, yf):
+            def solve(self, x, yf, lo, hi):
                 calls[0] += 1
                 if calls[0] == self.calls:
                     raise SolverError("gave up on purpose")

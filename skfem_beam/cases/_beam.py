@@ -35,6 +35,7 @@ def run_beam_case(case: str, problem, spec: RunSpec, stops=(), extra=None) -> in
     penalty = isinstance(spec.method, Penalty)
     summary = {
         "case": case, "J": problem.J, "dt": run.dt, "T": run.n_steps * run.dt, "beta": run.beta,
+        "theta": run.theta,
         "element": problem.element, "method": "penalty" if penalty else "contact",
         "kappa_h": kh, "linear_stability_limit_dt": limit,
         "units": {**units(rho_S, system), "probes": probe_units(system)},
@@ -88,7 +89,7 @@ def beam_charts(case, problem, rho_S, stops, extra):
     """The charts of a beam run (and the case's ``extra`` files), from the rows in memory."""
     def finish(folder: Path, data: dict, run):
         t = data["t"]
-        about = f"{scheme_label(run)}, Δt={run.dt:g} s, J={problem.J}, {problem.element}"
+        about = f"{run.label}, Δt={run.dt:g} s, J={problem.J}, {problem.element}"
         trajectory_chart(folder / "tip_displacement.png", t, {"ũ(L, t)": data["tip_displacement"]},
                          stops=stops, title=f"{case}: tip displacement ({about})")
         joules = "energy_J" in data         # in J when the mass per length ρS is known
@@ -109,12 +110,6 @@ def beam_charts(case, problem, rho_S, stops, extra):
         if extra is not None:
             extra(folder, data, run)
     return finish
-
-
-def scheme_label(run) -> str:
-    """β=… for the β-scheme, θ=… for Moreau–Jean (its run reports θ, not β)."""
-    theta = getattr(run, "theta", None)
-    return f"θ={theta:g}" if theta is not None else f"β={run.beta:g}"
 
 
 def units(rho_S, system) -> dict:

@@ -31,7 +31,7 @@ def main(argv=None) -> int:
     other = None if args.compare_beta < 0 else check_beta(args.compare_beta)
 
     def energy_files(folder, data, run):
-        columns = {"t": data["t"], f"energy_beta_{run.beta:g}": data["energy"]}
+        columns = {"t": data["t"], f"energy_{run.label.replace('=', '_')}": data["energy"]}
         if other is not None:
             r2 = solve(beam_system(pb), args.dt, args.T, other, solver=args.solver,
                        save_every=args.save_every, frames=2)

@@ -121,7 +121,7 @@ def bar_summary(bar: Bar, run, series, method: str, config: dict) -> dict:
     spring = series.spring
     return {
         "case": CASE, "J": bar.N, "N": bar.N, "dt": run.dt, "T": series.n_steps * run.dt,
-        "beta": run.beta, "element": "p1", "mass": bar.mass,
+        "beta": run.beta, "theta": run.theta, "element": "p1", "mass": bar.mass,
         "method": method, "obstacle": bar.obstacle,
         "spring_stiffness": bar.k if spring else None,
         "bar": {"a": bar.a, "b": bar.b, "rho": bar.rho, "L": bar.L, "f": bar.f,
@@ -153,7 +153,7 @@ def bar_charts(bar: Bar, series, exact, T: float):
         side = "" if (bar.obstacle_at, bar.far_end) == ("left", "free") else \
             f" at x={'0' if bar.obstacle_at == 'left' else 'L'}, {bar.far_end} far end"
         title = (f"{bar.obstacle} obstacle{f' k={bar.k:g}' if spring else ''}{side}, f={bar.f:g}, "
-                 f"N={bar.N}, Δt={run.dt:g}, β={run.beta:g}, {bar.mass} mass")
+                 f"N={bar.N}, Δt={run.dt:g}, {run.label}, {bar.mass} mass")
         compare_chart(folder / "displacement.png", b.t, {"u(0, t)": b.u0, "u(L, t)": b.uL},
                       {"u(0, t) exact": data.get("u_0_exact"),
                        "u(L, t) exact": data.get("u_L_exact")}, title, "displacement (m)")

@@ -28,11 +28,14 @@ DAQP_INF = 1e30      # daqp's "no bound"
 
 
 class DAQPSolver:
-    """Per-run daqp workspace; ``solve(x_free, y_free) -> (μ, iterations)``."""
+    """Per-run daqp workspace; ``solve(x_free, y_free, lo, hi) -> (μ, iterations)`` with
+    the step's bounds (updated in daqp's model when they move); ``checkpoint()`` /
+    ``restore()``: the exact finish's warm start (daqp's own working set only changes how
+    fast the unique active set is found)."""
 
     def __init__(self, lo, hi, D):
-        self.lo = np.ascontiguousarray(lo, dtype=float)
-        self.hi = np.ascontiguousarray(hi, dtype=float)
+        self.lo = np.array(lo, dtype=float)     # a copy: it follows moving bounds
+        self.hi = np.array(hi, dtype=float)
         self.D = np.ascontiguousarray(D, dtype=float)
         m = self.lo.size
         self.s = bound_scale(self.lo, self.hi)
@@ -53,7 +56,11 @@ class DAQPSolver:
         # H is SPD: no proximal regularisation; feasibility to round-off, not 1e-6
         self.model.settings = {"eps_prox": 0.0, "primal_tol": 1e-12, "iter_limit": 100 * m + 100}
 
-    def solve(self, x_free, y_free):
+    def solve(self, x_free, y_free, lo=None, hi=None):
+        if lo is not None and not (np.array_equal(lo, self.lo) and np.array_equal(hi, self.hi)):
+            self.lo[:], self.hi[:] = lo, hi
+            self.model.update(bupper=np.minimum(self.hi / self.s, DAQP_INF),
+                              blower=np.maximum(self.lo / self.s, -DAQP_INF))
         self.model.update(f=-(self.Hs @ y_free))
         _, _, flag, info = self.model.solve()
         if flag != 1:
@@ -63,6 +70,13 @@ class DAQPSolver:
         self.repairs += exact_finish(self.D, y_free, self.lo, self.hi, info["lam"],
                                      self.state, mu, self.s, "daqp")
         return mu, int(info["iterations"])
+
+    def checkpoint(self) -> dict:
+        return {"active": self.state.copy()}
+
+    def restore(self, saved: dict) -> None:
+        if "active" in saved:
+            self.state[:] = saved["active"]
 
 
 class DAQP(ContactLaw):

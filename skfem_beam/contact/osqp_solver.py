@@ -51,13 +51,17 @@ _NULL = _NullWriter()
 
 
 class OSQPSolver:
-    """Per-run OSQP workspace; ``solve(x_free, y_free) -> (μ, ADMM iterations)``."""
+    """Per-run OSQP workspace; ``solve(x_free, y_free, lo, hi) -> (μ, ADMM iterations)``
+    with the step's bounds (they move with a support: OSQP's l, u are updated, its
+    factorisation is not); ``checkpoint()``/``restore()``: the exact finish's warm start
+    (the answer's bits depend on the active set found, which is unique but at grazing
+    contact; OSQP's own warm start only changes how fast it is found)."""
 
     def __init__(self, A, C, lo, hi, D):
         A = sp.csc_matrix(A, dtype=float)
         C = sp.csc_matrix(C, dtype=float)
-        self.lo = np.ascontiguousarray(lo, dtype=float)
-        self.hi = np.ascontiguousarray(hi, dtype=float)
+        self.lo = np.array(lo, dtype=float)     # a copy: it follows moving bounds
+        self.hi = np.array(hi, dtype=float)
         self.D = np.ascontiguousarray(D, dtype=float)
         self.s = bound_scale(self.lo, self.hi)
         abar = float(A.diagonal().mean())
@@ -73,7 +77,10 @@ class OSQPSolver:
                         eps_abs=EPS, eps_rel=EPS, polishing=True, warm_starting=True,
                         max_iter=100000)
 
-    def solve(self, x_free, y_free):
+    def solve(self, x_free, y_free, lo=None, hi=None):
+        if lo is not None and not (np.array_equal(lo, self.lo) and np.array_equal(hi, self.hi)):
+            self.lo[:], self.hi[:] = lo, hi
+            self.prob.update(l=self.lo / self.s, u=self.hi / self.s)
         self.prob.update(q=self.qmat @ x_free)
         out = sys.stdout
         sys.stdout = _NULL
@@ -96,6 +103,13 @@ class OSQPSolver:
         self.repairs += exact_finish(self.D, y_free, self.lo, self.hi, duals, self.state, mu,
                                      self.s, "OSQP")
         return mu, int(info.iter)
+
+    def checkpoint(self) -> dict:
+        return {"active": self.state.copy()}
+
+    def restore(self, saved: dict) -> None:
+        if "active" in saved:
+            self.state[:] = saved["active"]
 
 
 class OSQP(ContactLaw):

@@ -144,7 +144,8 @@ class _Scene:
         head = f"{case}: " if case else ""
         sc = f", displacement ×{self.scale:g}" if self.scale != 1 else ""
         # plain ASCII: VTK's default font has no Greek letters
-        return f"{head}L = {self.L:g} m, beta = {r.beta:g}, dt = {r.dt:g} s{sc}"
+        scheme = f"theta = {r.theta:g}" if r.theta is not None else f"beta = {r.beta:g}"
+        return f"{head}L = {self.L:g} m, {scheme}, dt = {r.dt:g} s{sc}"
 
 
 def render_beam(path, result, times=None, scale=None, samples_per_element: int = 8,

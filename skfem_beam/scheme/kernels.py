@@ -63,6 +63,8 @@ WORK_TERMS = ("damping", "input", "contact")   # the columns of State.work and S
 EVENT_COLUMNS = ("value", "start_step", "end_step", "velocity", "peak_force", "impulse",
                  "max_violation")
 FAILED, UNSTABLE, EVENTS_FULL = 1, 2, 3
+# State.counters by name (the compiled loops index them by these numbers)
+IMPACTS, CONTACT_STEPS, ITERATIONS, STOPPED_AT, EVENTS_WRITTEN, ROW0 = range(6)
 
 
 @njit(cache=True)
@@ -383,7 +385,7 @@ class PythonLaw:
 def _solve_in_python() -> int:
     st = PythonLaw.state
     try:
-        m, its = PythonLaw.solver.solve(st.x, st.yf)
+        m, its = PythonLaw.solver.solve(st.x, st.yf, st.lo, st.hi)
     except Exception as e:        # handed back to the run, which raises it with the step
         PythonLaw.error = e
         return -1
@@ -394,9 +396,10 @@ def _solve_in_python() -> int:
 @njit(cache=True)
 def run_steps_python(ops, st, out, n0, n1, inputs, Ebound):
     """The same steps as `run_steps` with the law solved in Python (`PythonLaw.solver`,
-    e.g. OSQP or daqp, set up for bounds at rest): the compiled loop calls it for μ."""
+    e.g. OSQP or daqp, given the step's bounds): the compiled loop calls it for μ."""
     for step in range(n0, n1):
         Gn = inputs.G[step - n0]
+        move_bounds(ops, st, inputs.phi[step - n0])
         free_step(ops, st, Gn, inputs.H, step - n0)
         with objmode(its="int64"):
             its = _solve_in_python()

@@ -30,7 +30,8 @@ input Δt f·v^θ, contact pᵀCv^θ, and "damping" Δt v^θᵀBv^θ plus the θ
 dissipation (θ − ½)(ΔvᵀMΔv + Δt² v^θᵀKv^θ), so energy − energy[0] + damping = input +
 contact holds to round-off.  θ = ½, e = 1 conserves the energy at impacts; e = 0 loses
 the constrained node's normal kinetic energy at each impact (O(h) on a mesh).
-Obstacles that move with a support and checkpoints are not supported (refused).
+Obstacles that move with a support are refused; runs checkpoint and resume bit for bit
+like the β-scheme's (:class:`Run` drives both).
 """
 from __future__ import annotations
 
@@ -38,7 +39,6 @@ from collections import namedtuple
 from dataclasses import replace
 
 import numpy as np
-import scipy.sparse as sp
 from numba import njit
 
 from ..checks import check_finite
@@ -47,10 +47,11 @@ from ..contact.base import ContactLaw
 from ..contact.restitution import Restitution
 from ..errors import InputError
 from ..linalg import Banded, band_solve, rows_dot, rows_matvec
-from .kernels import FAILED, UNSTABLE, Inputs, Series, csr_product, track_impacts
+from .beta import observers, penetration_samples
+from .kernels import (FAILED, ITERATIONS, ROW0, STOPPED_AT, UNSTABLE, Inputs, Series,
+                      csr_product, track_impacts)
 from .operators import csr_arrays, load_norms, step_operators
-from .run import FIRST_ROWS, Run
-from .solve import drive
+from .run import Run
 from .stepping import Result, Stepping
 
 MJOps = namedtuple("MJOps", [
@@ -91,7 +92,7 @@ def mj_record(n, ops, st, out):
         stats[2] = max(stats[2], s - st.shi[r])
     dt2 = ops.dt * ops.dt
     if n % ops.save_every == 0:
-        k = n // ops.save_every - st.counters[5]   # rows from counters[5] on (see Run)
+        k = n // ops.save_every - st.counters[ROW0]   # rows from there on (see Run)
         for r in range(ops.Op.size - 1):     # observed values and the velocity v itself
             out.obs[k, r] = 0.0
             out.obsv[k, r] = 0.0
@@ -155,9 +156,9 @@ def mj_steps(ops, st, out, n0, n1, inputs, Ebound):
             x[i] += st.v[i]                      # v_free
         its = mj_impulse(ops, st)
         if its < 0:
-            st.counters[3] = step + 1
+            st.counters[STOPPED_AT] = step + 1
             return FAILED
-        st.counters[2] += its
+        st.counters[ITERATIONS] += its
         for j in range(m):
             if st.p[j] != 0.0:
                 for i in range(n):
@@ -193,11 +194,11 @@ def mj_steps(ops, st, out, n0, n1, inputs, Ebound):
         full = track_impacts(ops, st, out, step)
         mj_record(step + 1, ops, st, out)
         if (step + 1) % ops.save_every == 0 \
-                and not abs(out.energy[(step + 1) // ops.save_every - st.counters[5]]) <= Ebound:
-            st.counters[3] = step + 1
+                and not abs(out.energy[(step + 1) // ops.save_every - st.counters[ROW0]]) <= Ebound:
+            st.counters[STOPPED_AT] = step + 1
             return UNSTABLE
         if full:
-            st.counters[3] = step + 1
+            st.counters[STOPPED_AT] = step + 1
             return full
     return 0
 
@@ -211,87 +212,104 @@ def check_theta(theta) -> float:
                      f"unconditionally stable there)")
 
 
-class MoreauJean(Run):
-    """A Moreau–Jean run of ``system`` on ``stepping`` (its β is not used), with
-    ``theta`` ∈ [1/2, 1] and Newton restitution ``restitution`` ∈ [0, 1]; the interface
-    of :class:`Run` (advance, result, the saved buffers), so that :func:`drive` and the
-    output pipeline run it as they run the β-scheme."""
+# checkpointed: every field of MJState but the step's scratch (p, wf, x, dv, Ku, Kv)
+_MJ_SCRATCH = ("p", "wf", "x", "dv", "Ku", "Kv")
+
+
+class MoreauJeanScheme:
+    """Moreau–Jean of ``system`` on ``stepping`` (its β is not used) as a one-step
+    integrator, with ``theta`` ∈ [1/2, 1] and Newton restitution ``restitution`` ∈ [0, 1];
+    the interface of :class:`~.beta.BetaScheme`, so that :class:`Run` drives both."""
+
+    CHECKPOINT = {f: f for f in MJState._fields if f not in _MJ_SCRATCH}
+    pysolver = None
 
     def __init__(self, system, stepping: Stepping, theta: float = 0.5,
                  restitution: float = 0.0):
         self.theta, self.e = check_theta(theta), Restitution(restitution).e
-        super().__init__(system, stepping, MoreauJeanLaw())
-
-    def _build(self, system, stepping, law) -> None:
         if system.bound_motion is not None:
             raise InputError(f"law={NAME!r} does not handle obstacles that move with a "
                              "support: use the position-level scheme")
-        s, m, n, th = stepping, system.C.shape[0], system.n, self.theta
-        self.system, self.stepping, self.law, self.solver = system, s, law, law.name
-        self.dt, self.beta, self.n_steps = s.dt, th, s.steps
+        s, th = stepping, self.theta
+        self.system, self.stepping, self.law = system, s, MoreauJeanLaw()
+        self.solver = self.law.name
+        self.dt, self.beta, self.n_steps = s.dt, None, s.steps
         self.save_every, self.frame_every, self.shift = s.save_every, s.frame_every, 0.0
         # Â = M + Δt²θ²K + ΔtθB is step_operators' A with β = θ² and B scaled by 2θ
         B = system.B
-        self.op = op = step_operators(replace(system, B=None if B is None else 2 * th * B),
-                                      s.dt, th * th)
-        self.pysolver = None
+        self.op = step_operators(replace(system, B=None if B is None else 2 * th * B),
+                                 s.dt, th * th)
         self.loads = np.ascontiguousarray(system.loads, dtype=float)
         self.load_norm = load_norms(system, s.dt, th * th)
-        O = sp.csr_matrix(np.vstack(list(system.observe.values()))) if system.observe \
-            else sp.csr_matrix((0, n))
-        if system.sample_E is not None and system.sample_E.shape[0]:
-            samples, slo, shi = csr_arrays(system.sample_E), system.sample_lo, system.sample_hi
-        else:
-            samples, slo, shi = (np.zeros(1, np.int64), np.zeros(0, np.int64), np.zeros(0)), \
-                np.zeros(0), np.zeros(0)
-        lo, hi = (np.ascontiguousarray(b, dtype=float) for b in (system.lo, system.hi))
-        self.ops = MJOps(s.dt, th, self.e, s.save_every, s.frame_every, op.Kb.rows,
-                         Banded(system.M).rows, Banded(B).rows if B is not None
-                         else np.zeros((0, 1)), op.Ab.chol, self.loads, *csr_arrays(op.C),
-                         op.W, op.D, *csr_arrays(O), *samples)
-        z = np.zeros
-        self.st = MJState(z(n), system.u0.astype(float), system.v0.astype(float),
-                          z(m), op.C @ system.u0, z(m), op.C @ system.v0, z(m),
-                          lo, hi, np.array(slo, float), np.array(shi, float), z(m), z(m),
-                          z(m, np.int8), z(m, np.bool_), z(m, np.bool_), z(4),
-                          z(6, np.int64), z(3), np.full((m, 6), -1.0), z(m),
-                          z(m), z(m), z(n), z(n), z(n), z(n))
-        self.st.u_prev[:] = self.st.u_cur
-        self.st.y_prev[:] = self.st.y_cur
-        nsave = min(s.steps // s.save_every + 1, FIRST_ROWS)    # grown as the run needs them
-        nframes, nobs = s.steps // s.frame_every + 1, O.shape[0]
-        self.out = Series(np.full((nsave, nobs), np.nan), np.full((nsave, nobs), np.nan),
-                          np.full(nsave, np.nan), z((nsave, 3)), z((nsave, m)),
-                          np.full((nframes, n), np.nan), np.full((nframes, n), np.nan),
-                          z((nframes, m)), z((max(4096, 4 * m), 7)))
-        self.events = []
-        mj_record(0, self.ops, self.st, self.out)     # state 0: the data themselves
-        self.E1 = float(self.out.energy[0])
-        self.load_bound, self.n, self.wall = 0.0, 0, 0.0
-        self.status, self.message = "running", ""
-        self._steps(0, 0, 0.0)      # load the compiled loop now, outside the timed loop
-        self.advance(1)
+        self.Orows = observers(system)
+        self.ops = self._ops()
+        self.st = self._state()
 
-    def load_coefficients(self, n0, n1):
-        """f^{n+θ}: the load functions at tₙ + θΔt, n = n0..n1−1."""
+    def _ops(self) -> MJOps:
+        system, s, op = self.system, self.stepping, self.op
+        samples, _, _ = penetration_samples(system)
+        B = system.B
+        return MJOps(s.dt, self.theta, self.e, s.save_every, s.frame_every, op.Kb.rows,
+                     Banded(system.M).rows, Banded(B).rows if B is not None
+                     else np.zeros((0, 1)), op.Ab.chol, self.loads, *csr_arrays(op.C),
+                     op.W, op.D, *csr_arrays(self.Orows), *samples)
+
+    def _state(self) -> MJState:
+        system, op, z = self.system, self.op, np.zeros
+        n, m = system.n, system.C.shape[0]
+        _, slo, shi = penetration_samples(system)
+        lo, hi = (np.ascontiguousarray(b, dtype=float) for b in (system.lo, system.hi))
+        u0, v0 = system.u0.astype(float), system.v0.astype(float)
+        return MJState(u_prev=u0.copy(), u_cur=u0, v=v0, y_prev=op.C @ system.u0,
+                       y_cur=op.C @ system.u0, dy=z(m), yv=op.C @ system.v0, yp=z(m),
+                       lo=lo, hi=hi, slo=np.array(slo, float), shi=np.array(shi, float),
+                       lo_e=z(m), hi_e=z(m), law_state=z(m, np.int8), active=z(m, np.bool_),
+                       active_prev=z(m, np.bool_), stats=z(4), counters=z(6, np.int64),
+                       work=z(3), impact=np.full((m, 6), -1.0), mu=z(m), p=z(m), wf=z(m),
+                       x=z(n), dv=z(n), Ku=z(n), Kv=z(n))
+
+    def series(self, rows: int, nframes: int) -> Series:
+        """Saved-series buffers (Moreau–Jean keeps its frames, whatever the run asked)."""
+        n, m, nobs = self.system.n, self.system.C.shape[0], self.Orows.shape[0]
+        z = np.zeros
+        return Series(np.full((rows, nobs), np.nan), np.full((rows, nobs), np.nan),
+                      np.full(rows, np.nan), z((rows, 3)), z((rows, m)),
+                      np.full((nframes, n), np.nan), np.full((nframes, n), np.nan),
+                      z((nframes, m)), z((max(4096, 4 * m), 7)))
+
+    def start(self, out) -> int:
+        """State 0 is the data themselves: recorded; the driver steps on from there."""
+        mj_record(0, self.ops, self.st, out)
+        return 0
+
+    def inputs(self, n0, n1):
+        """((n0, n1), Inputs): f^{n+θ}, the load functions at tₙ + θΔt, n = n0..n1−1."""
         t = (np.arange(n0, n1) + self.theta) * self.dt
         if not self.loads.shape[1]:
-            return np.zeros((n1 - n0, 0))
-        return np.ascontiguousarray(np.column_stack(
-            [np.broadcast_to(np.asarray(a(t), dtype=float), t.shape) for a in
-             self.system.load_time]))
+            G = np.zeros((n1 - n0, 0))
+        else:
+            G = np.ascontiguousarray(np.column_stack(
+                [np.broadcast_to(np.asarray(a(t), dtype=float), t.shape) for a in
+                 self.system.load_time]))
+        return (n0, n1), Inputs(G, np.zeros(n1 - n0))
 
-    def _steps(self, n0, n1, Ebound, inputs=None):
-        self._hold_rows(n1 // self.save_every)
+    def steps(self, out, n0, n1, Ebound, inputs=None):
         if inputs is None:
             inputs = Inputs(np.zeros((0, self.loads.shape[1])), np.zeros(0))
-        return mj_steps(self.ops, self.st, self.out, n0, n1, inputs, Ebound)
+        return mj_steps(self.ops, self.st, out, n0, n1, inputs, Ebound)
 
-    def checkpoint(self) -> dict:
-        raise InputError(f"checkpoints are not implemented for law={NAME!r}")
+    def restored(self) -> None:
+        """Every field it needs is in the checkpoint."""
 
-    def restore(self, ck: dict) -> None:
-        raise InputError(f"law={NAME!r} runs cannot be resumed")
+
+class MoreauJean(Run):
+    """A Moreau–Jean run of ``system`` on ``stepping`` (its β is not used), with
+    ``theta`` ∈ [1/2, 1] and Newton restitution ``restitution`` ∈ [0, 1]: the driver of
+    :class:`Run` over :class:`MoreauJeanScheme` (chunks, events, checkpoints)."""
+
+    def __init__(self, system, stepping: Stepping, theta: float = 0.5,
+                 restitution: float = 0.0):
+        self._drive(MoreauJeanScheme(system, stepping, theta, restitution))
 
 
 def moreau_jean(system, dt: float, T: float, theta: float = 0.5, restitution: float = 0.0,

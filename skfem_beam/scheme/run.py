@@ -1,48 +1,23 @@
-"""One integration of a system: the start step, chunks of steps, checkpoints."""
+"""The driver of a run: a one-step integrator (:mod:`.beta`, :mod:`.moreau_jean`) taken
+over the time grid in chunks, its saved rows (released once written), impact events,
+checkpoints and restores, the same for every method."""
 from __future__ import annotations
 
 import math
-import sys
 import time
 
 import numpy as np
-import scipy.sparse
-from numba import typeof, types
-from numba.core import event
 
-from ..contact import ContactLaw, StepData, resolve
-from ..contact.base import NoContact, no_explicit
-from ..contact.registry import Auto
+from ..contact import ContactLaw
 from ..errors import InputError, SolverError
-from ..linalg import band_solve, rows_matvec
 from ..stability import kappa_h, linear_limit
-from .kernels import (EVENTS_FULL, FAILED, UNSTABLE, WORK_TERMS, Inputs, Ops, PythonLaw,
-                      Series, State, csr_product, energy_beta, move_bounds, record, run_steps,
-                      run_steps_python)
-from .operators import csr_arrays, load_norms, step_operators
+from .beta import BetaScheme
+from .kernels import (EVENTS_FULL, EVENTS_WRITTEN, FAILED, ROW0, STOPPED_AT, UNSTABLE,
+                      WORK_TERMS, Inputs, PythonLaw)
 from .stepping import Result, Stepping
 
-_GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(4)
 FIRST_ROWS = 1 << 15      # saved rows allocated at first; more as a chunk needs them
 SAVED = ("obs", "obsv", "energy", "work", "lam")   # the saved series (rows × columns)
-
-
-class _CompileNotice(event.Listener):
-    """One line on stderr, once per process, when numba starts compiling: the first run
-    of a fresh install compiles the kernels (tens of seconds); later runs load them from
-    numba's cache and compile nothing, so they say nothing."""
-    said = False
-
-    def on_start(self, ev):
-        if not _CompileNotice.said:
-            _CompileNotice.said = True
-            print("compiling numerical kernels (first run only) …", file=sys.stderr, flush=True)
-
-    def on_end(self, ev):
-        pass
-
-
-event.register("numba:compile", _CompileNotice())
 
 
 class SavedRows:
@@ -79,229 +54,64 @@ class SavedRows:
 
 
 class Run:
-    """The scheme's state and saved series for ``system`` on the grid ``stepping``,
-    with the contact law ``law`` (a name of ``contact.LAWS``, "auto", or a law object).
+    """A run of ``system`` on the grid ``stepping``: with ``law`` (a name of
+    ``contact.LAWS``, "auto", or a law object) the β-scheme (:class:`.beta.BetaScheme`);
+    :class:`~.moreau_jean.MoreauJean` drives Moreau–Jean the same way.
 
     ``advance(n1)`` steps up to state n1; ``checkpoint()``/``restore()`` give the full
-    state (uⁿ⁻¹, uⁿ, step, warm starts, running diagnostics), so that a restored run
-    continues bit for bit.  :func:`~skfem_beam.scheme.solve` drives it; the output
+    state (the integrator's fields, warm starts, running diagnostics), so that a restored
+    run continues bit for bit.  :func:`~skfem_beam.scheme.solve` drives it; the output
     pipeline drives it too when it streams files and writes checkpoints.
     """
 
     _next = ((-1, -1), None)   # the next chunk's (n0, n1) and inputs, computed ahead (advance)
 
     def __init__(self, system, stepping: Stepping, law: str | ContactLaw = "auto"):
-        self._build(system, stepping, law)
+        self._drive(BetaScheme(system, stepping, law))
 
-    def _build(self, system, stepping, law) -> None:
-        """Operators, the law, the state and buffers, the start step (a subclass with
-        another integrator, e.g. Moreau–Jean, builds its own)."""
-        s, m = stepping, system.C.shape[0]
-        n_steps = s.steps
-        self.system, self.stepping = system, s
-        self.dt, self.beta, self.n_steps = s.dt, s.beta, n_steps
-        self.save_every, self.frame_every = s.save_every, s.frame_every
-        self.shift = 0.5 * s.dt if s.load_window == "centered" else 0.0
-        self.op = op = step_operators(system, s.dt, s.beta, s.massless)
-        step = StepData(op.A, op.C, op.D, np.ascontiguousarray(system.lo, dtype=float),
-                        np.ascontiguousarray(system.hi, dtype=float), s.dt, s.beta)
-        law = resolve(law) if not isinstance(law, ContactLaw) else law
-        if m == 0:
-            law = NoContact()
-        elif isinstance(law, Auto):
-            law = law.choose(step)
-        self.law, self.solver = law, law.name
-        params = law.setup(step)
-        self.pysolver = law.solver(step) if law.kernel is None else None
-        if op.Z.size and (law.kernel is None or law.explicit is not None):
-            raise InputError(f"massless='quasi-static' needs an exact compiled contact law "
-                             f"(projection, active-set, restitution), not {law.name!r}")
-
-        self.loads = np.ascontiguousarray(system.loads, dtype=float)
-        self.load_norm = load_norms(system, s.dt, s.beta)
-        Orows = scipy.sparse.csr_matrix(np.vstack(list(system.observe.values()))) \
-            if system.observe else scipy.sparse.csr_matrix((0, system.n))
-        if system.sample_E is not None and system.sample_E.shape[0]:
-            samples = csr_arrays(system.sample_E)
-            slo = np.ascontiguousarray(system.sample_lo, dtype=float)
-            shi = np.ascontiguousarray(system.sample_hi, dtype=float)
-        else:
-            samples = (np.zeros(1, np.int64), np.zeros(0, np.int64), np.zeros(0))
-            slo = shi = np.zeros(0)
-        moving = system.bound_motion is not None
-        if moving and self.pysolver is not None:
-            raise InputError(f"solver={law.name!r} is set up for bounds at rest; with obstacles "
-                             f"that move with a support use active-set or projection")
-        shift = np.ascontiguousarray(system.bound_shift, dtype=float) if moving else np.zeros(0)
-        sshift = np.ascontiguousarray(system.sample_shift, dtype=float) \
-            if moving and slo.size else np.zeros(0)
-        self.ops = Ops(s.dt, s.beta, s.save_every, s.frame_every, op.Kb.rows, op.Bb,
-                       op.Ab.chol, op.Eb.rows, self.loads, *csr_arrays(op.C), step.lo, step.hi,
-                       shift, sshift, op.W, op.D, *csr_arrays(Orows), *samples, slo, shi, params,
-                       op.Z, *csr_arrays(system.K.tocsr()[op.Z]))
-        n = system.n
-        self.st = State(np.empty(n), np.empty(n), np.empty(m), np.empty(m),
-                        step.lo.copy(), step.hi.copy(), slo.copy(), shi.copy(),
-                        np.zeros(m, np.int8), np.zeros(m, np.bool_), np.zeros(m, np.bool_),
-                        np.zeros(4), np.zeros(6, np.int64), np.zeros(3),
-                        np.full((m, 6), -1.0), np.zeros(m),
-                        np.empty(n), np.empty(m), np.zeros(m), np.empty(n), np.empty(n),
-                        np.zeros(m), np.zeros(op.Z.size))
-        nframes, nobs = n_steps // s.frame_every + 1, Orows.shape[0]
-        rows = min(n_steps // s.save_every + 1, FIRST_ROWS)   # grown as the run needs them
-        self.out = Series(np.full((rows, nobs), np.nan), np.full((rows, nobs), np.nan),
-                          np.full(rows, np.nan), np.zeros((rows, 3)), np.zeros((rows, m)),
-                          np.full((nframes, n), np.nan), np.full((nframes, n), np.nan),
-                          np.zeros((nframes, m)), np.zeros((max(4096, 4 * m), 7)))
+    def _drive(self, scheme) -> None:
+        """Take ``scheme`` (a one-step integrator: BetaScheme, MoreauJeanScheme) from its
+        first state: buffers, the start, the compiled loop loaded outside the timed loop."""
+        self.scheme, self.system, self.stepping = scheme, scheme.system, scheme.stepping
+        self.dt, self.beta, self.theta = scheme.dt, scheme.beta, scheme.theta
+        self.n_steps, self.save_every = scheme.n_steps, scheme.save_every
+        self.frame_every = scheme.frame_every
+        rows = min(self.n_steps // self.save_every + 1, FIRST_ROWS)   # grown as needed
+        self.out = scheme.series(rows, self.n_steps // self.frame_every + 1)
         self.events = []       # impact event rows taken from the compiled loop's buffer
-        self._compile_side_by_side()
-        self._start(Orows, law.setup(step, first=True))
         self.load_bound = 0.0  # Σ‖Gⁿ‖_{N⁻¹}Δt so far: the a-priori energy bound grows with it
-        self.n = 1             # the last computed state
         self.wall = 0.0
         self.status, self.message = "running", ""
-        self._steps(1, 1, 0.0)   # load the compiled loop now, outside the timed loop
+        self.n = scheme.start(self.out)     # the last computed state
+        self.E1 = float(self.out.energy[0])
+        self._steps(self.n, self.n, 0.0)
+        if self.n == 0:                     # a scheme that starts from the data itself
+            self.advance(1)
+
+    # the integrator's parts, as the output pipeline and the tests read them
+    st = property(lambda self: self.scheme.st)
+    ops = property(lambda self: self.scheme.ops)
+    op = property(lambda self: self.scheme.op)
+    law = property(lambda self: self.scheme.law)
+    solver = property(lambda self: self.scheme.solver)
+    pysolver = property(lambda self: self.scheme.pysolver)
+    loads = property(lambda self: self.scheme.loads)
+    load_norm = property(lambda self: self.scheme.load_norm)
 
     @property
-    def _kernels(self):
-        """The compiled law and its explicit part (no-ops for a law solved in Python)."""
-        return ((self.law.kernel or NoContact.kernel).cfunc,
-                (self.law.explicit or no_explicit).cfunc)
+    def label(self) -> str:
+        """"beta=…" for the β-scheme, "theta=…" for Moreau–Jean (for titles and messages)."""
+        return f"theta={self.theta:g}" if self.theta is not None else f"beta={self.beta:g}"
 
-    def _compile_side_by_side(self) -> None:
-        """A fresh install (this process has compiled a kernel already, so numba's cache is
-        cold) compiles the law in a child process while this one compiles the loop for
-        these arrays' types; then it waits for the law (see contact.base.Compiled)."""
-        if self.law.kernel is None or not _CompileNotice.said:
-            return
-        kernel, explicit = self.law.kernel, self.law.explicit or no_explicit
-        # the types of the arguments exactly as _steps passes them: the same compiled loop
-        loop = (types.FunctionType(kernel.signature), types.FunctionType(explicit.signature))
-        args = (self.ops, self.st, self.out, 1, 1,
-                Inputs(np.zeros((0, self.loads.shape[1])), np.zeros(0)), 0.0)
-        loop += tuple(typeof(a) for a in args)
-        if loop in run_steps.overloads:
-            return
-        for k in (self.law.kernel, self.law.explicit):
-            if k is not None:
-                k.compile_aside()
-        run_steps.compile(loop)
-        _ = self._kernels     # wait for the law: the start step calls what it compiled
-
-    def _start(self, Orows, first_params) -> None:
-        """u¹: one step of the scheme itself, from u⁰ and the fictitious u⁻¹ = u¹ − 2Δt v⁰
-        (central difference at t = 0).  Substituted, it reads
-
-            A u¹ = M(u⁰ + Δt v⁰) − Δt²/2 (1−2β) K u⁰ + βΔt³ K v⁰ − Δt²/2 B v⁰ + Δt²/2 f(0),
-
-        second order and implicit in K: rough data (u0'' ≠ 0 at a free end) pump no
-        energy into the top modes (an explicit Taylor start gave ½E_β¹ = 855 instead of
-        166.8 for the energy-decay scene at J = 80, Δt = 1e-3).  Its contact is the
-        chosen law's (a spring's force at u⁰ weighted ½(1−2β), see contact.penalty).
-
-        It runs the loop's helpers and the law as the Python functions they are compiled
-        from (``py_func``, the law's ``func``), on the same arrays: one step, the same
-        floating-point operations in the same order, so the same numbers; compiling them
-        apart from the loop, which inlines them, cost 3–4 s on a fresh install.  What they
-        call that is compiled (energy_beta, box_qp, ...) is shared with the loop.
-        """
-        system, op, st, out = self.system, self.op, self.st, self.out
-        dt, beta, M, K, B = self.dt, self.beta, system.M, system.K, system.B
-        u0, v0 = system.u0.astype(float), system.v0.astype(float)
-        st.u_prev[:] = u0
-        f0 = self.loads @ np.array([float(a(np.array([0.0]))[0]) for a in system.load_time]) \
-            if self.loads.shape[1] else np.zeros(system.n)
-        F0 = M @ (u0 + dt * v0) - 0.5 * dt**2 * (1 - 2 * beta) * (K @ u0) \
-            + beta * dt**3 * (K @ v0) + 0.5 * dt**2 * f0
-        if B is not None:
-            F0 -= 0.5 * dt**2 * (B @ v0)
-        if op.Z.size:   # quasi-static massless rows: K u¹ = f¹ + Cᵀλ¹ there, times β
-            F0[op.Z] = beta * dt**2 * (self.loads[op.Z] @ self.load_averages(1, 1)[1])
-        csr_product(self.ops.Cp, self.ops.Ci, self.ops.Cx, u0, st.y_prev)
-        move_bounds.py_func(self.ops, st, self.motion(np.array([dt]))[0])   # bounds at t₁
-        if self.law.explicit is not None:   # its force at u⁰ as load, implicit at u¹ (as K)
-            self.law.explicit.func(st.y_prev, st.y_prev, st.lo, st.hi, first_params, st.r_e)
-            F0 += dt**2 * (op.C.T @ st.r_e)
-            st.r_e[:] = 0.0
-        u1 = F0.copy()
-        band_solve(op.Ab.chol, u1)
-        if st.mu.size:
-            st.x[:] = u1
-            csr_product(self.ops.Cp, self.ops.Ci, self.ops.Cx, u1, st.yf)
-            if self.pysolver is not None:
-                mu, _ = self.pysolver.solve(u1, st.yf.copy())
-                st.mu[:] = mu
-            else:
-                st.y_cur[:] = st.y_prev
-                if self.law.kernel.func(self.ops.D, st.yf, st.y_cur, st.y_prev, st.lo, st.hi,
-                                        first_params, st.law_state, st.mu, st.active) < 0:
-                    raise SolverError("the first step's contact problem could not be solved")
-                st.law_state[:] = 0
-                st.active[:] = False
-            u1 = u1 + op.W @ st.mu
-        st.u_cur[:] = u1
-        csr_product(self.ops.Cp, self.ops.Ci, self.ops.Cx, u1, st.y_cur)
-        st.mu[:] = 0.0     # state 1 records no contact force
-
-        # states 0 and 1 (E_β needs two states: the energy saved at t = 0 is E_β¹)
-        out.obs[0] = Orows @ st.u_prev
-        out.obsv[0] = Orows @ system.v0
-        rows_matvec(op.Kb.rows, st.u_prev, st.Ku, 1.0, False)   # K uⁿ⁻¹ for the energy
-        record.py_func(1, self.ops, st, out)
-        out.frames_u[0], out.frames_v[0] = st.u_prev, system.v0
-        self.E1 = 0.5 * energy_beta(op.Eb.rows, st.u_prev, st.u_cur, st.Ku, st.d)
-        if not (np.isfinite(st.u_cur).all() and math.isfinite(self.E1)):
-            raise InputError("the initial state and load are too large for floating point: "
-                             f"the first step's energy is {self.E1:g}")
-        out.energy[0] = self.E1
-
-    def motion(self, t):
-        """φ(t) that moves the bounds (zero when they do not move)."""
-        phi = self.system.bound_motion
-        return np.asarray(phi(t), dtype=float) if phi is not None else np.zeros(np.shape(t))
-
-    def _inputs(self, n0, n1):
-        """((n0, n1), Inputs of steps n0..n1−1): loads, bound motion, massless-row load."""
-        G = self.load_coefficients(n0, n1)
-        return (n0, n1), Inputs(G, self.motion(np.arange(n0 + 1, n1 + 1) * self.dt),
-                                self.massless_load(n0, n1))
-
-    def load_coefficients(self, n0, n1):
-        """Gⁿ = βf^{n+1} + (1−2β)fⁿ + βf^{n−1} for n = n0..n1−1 (per chunk: flat memory)."""
-        if not self.loads.shape[1]:
-            return np.zeros((n1 - n0, 0))
-        f, beta = self.load_averages(n0, n1), self.beta
-        return np.ascontiguousarray(beta * f[2:] + (1 - 2 * beta) * f[1:-1] + beta * f[:-2])
-
-    def massless_load(self, n0, n1):
-        """The load at the quasi-static massless rows, (1−2β)fⁿ + βf^{n−1} there, for
-        n = n0..n1−1 (kernels.massless_force); none without such rows or loads."""
-        Z = self.op.Z
-        if not (Z.size and self.loads.shape[1]):
-            return np.zeros((0, Z.size))
-        f, beta = self.load_averages(n0, n1), self.beta
-        return np.ascontiguousarray(((1 - 2 * beta) * f[1:-1] + beta * f[:-2]) @ self.loads[Z].T)
-
-    def load_averages(self, n0, n1):
-        """fᵐ_k, m = n0−1..n1: the load functions averaged over each step's window."""
-        nk = self.loads.shape[1]
-        dt = self.dt
-        t = np.arange(n0 - 1, n1 + 1) * dt - self.shift
-        f = np.empty((t.size, nk))
-        for b in range(0, t.size, 4096):   # blocks that stay in cache: 1.7× faster (measured)
-            s = t[b:b + 4096] + 0.5 * dt * (1.0 + _GAUSS_X[:, None])   # 4 Gauss points/step
-            for k, a in enumerate(self.system.load_time):
-                # fⁿ = (1/Δt)∫ f dt, exact to O((ωΔt)⁸); summed elementwise, so that a value
-                # does not depend on where the chunk starts (a resumed run goes on bit for bit)
-                v = np.asarray(a(s), dtype=float)
-                f[b:b + 4096, k] = (_GAUSS_W[0] * v[0] + _GAUSS_W[1] * v[1]
-                                    + _GAUSS_W[2] * v[2] + _GAUSS_W[3] * v[3]) / 2.0
-        return f
+    @property
+    def stopped_at(self) -> int:
+        """The step where the compiled loop last stopped (a failed step: the one after)."""
+        return int(self.st.counters[STOPPED_AT])
 
     @property
     def row0(self) -> int:
         """The first saved row still held (rows before it were released)."""
-        return int(self.st.counters[5])
+        return int(self.st.counters[ROW0])
 
     def release(self, k: int) -> None:
         """Drop the saved rows before row k (their values were written elsewhere): memory
@@ -311,7 +121,7 @@ class Run:
             for name in SAVED:
                 a = getattr(self.out, name)
                 a[:len(a) - shift] = a[shift:]
-            self.st.counters[5] += shift
+            self.st.counters[ROW0] += shift
 
     def _hold_rows(self, last: int) -> None:
         """Room in the saved-series buffers for rows up to ``last`` (doubling)."""
@@ -329,32 +139,15 @@ class Run:
             self.out = self.out._replace(**grown)
 
     def _steps(self, n0, n1, Ebound, inputs=None):
-        """The compiled loop over steps n0..n1−1 (see kernels.run_steps)."""
+        """The integrator's loop over steps n0..n1−1, with room for their saved rows."""
         self._hold_rows(n1 // self.save_every)
-        if inputs is None:
-            inputs = Inputs(np.zeros((0, self.loads.shape[1])), np.zeros(0),
-                            np.zeros((0, self.op.Z.size)))
-        if self.pysolver is None:
-            try:
-                return run_steps(*self._kernels, self.ops, self.st, self.out, n0, n1, inputs,
-                                 Ebound)
-            except TypeError as e:
-                # numba 0.68: a Ctrl-C landing while the dispatcher unboxes the law's C
-                # callback surfaces as this TypeError (seen once in CI): it is the interrupt
-                if "_get_wrapper_address" in str(e):
-                    raise KeyboardInterrupt from e
-                raise
-        PythonLaw.solver, PythonLaw.state, PythonLaw.error = self.pysolver, self.st, None
-        try:
-            return run_steps_python(self.ops, self.st, self.out, n0, n1, inputs, Ebound)
-        finally:
-            PythonLaw.solver = PythonLaw.state = None
+        return self.scheme.steps(self.out, n0, n1, Ebound, inputs)
 
     def _take_events(self) -> None:
-        k = int(self.st.counters[4])
+        k = int(self.st.counters[EVENTS_WRITTEN])
         if k:
             self.events.append(self.out.events[:k].copy())
-            self.st.counters[4] = 0
+            self.st.counters[EVENTS_WRITTEN] = 0
 
     def _all_events(self) -> np.ndarray:
         return np.concatenate(self.events) if self.events else np.zeros((0, 7))
@@ -395,7 +188,7 @@ class Run:
         if self.done or n1 <= n0:
             return
         t0 = time.perf_counter()
-        inputs = (self._next if self._next[0] == (n0, n1) else self._inputs(n0, n1))[1]
+        inputs = (self._next if self._next[0] == (n0, n1) else self.scheme.inputs(n0, n1))[1]
         G = inputs.G
         self.load_bound += float((np.abs(G) @ self.load_norm).sum()) * self.dt \
             if G.shape[1] else 0.0
@@ -408,7 +201,8 @@ class Run:
         code, at = self._steps(n0, n1, Ebound, inputs), n0
         while code == EVENTS_FULL:       # take the impact events, go on from where it stopped
             self._take_events()
-            at, k = int(self.st.counters[3]), int(self.st.counters[3]) - n0
+            at = self.stopped_at
+            k = at - n0
             code = self._steps(at, n1, Ebound, Inputs(G[k:], inputs.phi[k:],
                                                       inputs.H[k:] if inputs.H.shape[0]
                                                       else inputs.H))
@@ -418,9 +212,9 @@ class Run:
             # the last chunk's rows but has not got this one's: computed while it formats
             # them, they wait for the GIL it holds (measured: 2.5 s instead of 0.3 s over
             # 2,000,000 steps saved at every step)
-            self._next = self._inputs(n1, min(2 * n1 - n0, self.n_steps))
+            self._next = self.scheme.inputs(n1, min(2 * n1 - n0, self.n_steps))
         self.wall += time.perf_counter() - t0
-        k = int(self.st.counters[3])
+        k = self.stopped_at
         if code == FAILED:
             why = f": {PythonLaw.error}" if PythonLaw.error is not None else ""
             if PythonLaw.error is not None and not isinstance(PythonLaw.error, SolverError):
@@ -428,12 +222,13 @@ class Run:
             raise SolverError(f"the {self.solver} contact solver failed at step {k} "
                               f"(t={k * self.dt:.6g} s){why}")
         if code == UNSTABLE:
-            limit = linear_limit(kappa_h(self.system), self.beta)
             self.status = "unstable"
             self.message = (f"unstable at step {k} (t={k * self.dt:.6g} s): energy "
                             f"{self.energy[k // self.save_every]:.3g} exceeds {Ebound:.3g}; "
-                            f"dt={self.dt:g} s, beta={self.beta:g}, linear stability limit "
-                            f"2/√(κ_h(1−4β)) = {limit:.4g} s")
+                            f"dt={self.dt:g} s, {self.label}")
+            if self.beta is not None:
+                limit = linear_limit(kappa_h(self.system), self.beta)
+                self.message += f", linear stability limit 2/√(κ_h(1−4β)) = {limit:.4g} s"
             self.n = (k // self.save_every - 1) * self.save_every   # last good saved state
             return
         self.n = n1
@@ -452,20 +247,22 @@ class Run:
     u_prev = property(lambda self: self.st.u_prev)
     u_cur = property(lambda self: self.st.u_cur)
 
-    _STATE = {"u_prev": "u_prev", "u_cur": "u_cur", "state": "law_state",
-              "active_prev": "active_prev", "stats": "stats", "counters": "counters",
-              "lo": "lo", "hi": "hi", "slo": "slo", "shi": "shi", "work_sums": "work",
-              "impact": "impact"}
     _FRAMES = {"fr": "frames_u", "frv": "frames_v", "frf": "frames_f"}
 
     def checkpoint(self) -> dict:
-        """Everything needed to continue bit for bit (saved series are the caller's; the
-        field frames, a few hundred at most, come along so they can be written anew)."""
-        if self.pysolver is not None:
-            raise InputError(f"checkpoints need a compiled contact law (projection, "
-                             f"active-set, penalty), not {self.solver!r}")
-        return {**{k: getattr(self.st, v).copy() for k, v in self._STATE.items()},
-                **{k: getattr(self.out, v).copy() for k, v in self._FRAMES.items()},
+        """Everything needed to continue bit for bit: the integrator's state (its
+        CHECKPOINT fields, and a Python-solved law's warm start), the events, the counters
+        of the driver (saved series are the caller's; the field frames, a few hundred at
+        most, come along so they can be written anew)."""
+        sc = self.scheme
+        solver = sc.pysolver
+        if solver is not None and not hasattr(solver, "checkpoint"):
+            raise InputError(f"checkpoints need a law that can save its state, not "
+                             f"{self.solver!r}")
+        saved = {k: getattr(sc.st, v).copy() for k, v in sc.CHECKPOINT.items()}
+        if solver is not None:
+            saved.update({f"solver_{k}": np.array(v) for k, v in solver.checkpoint().items()})
+        return {**saved, **{k: getattr(self.out, v).copy() for k, v in self._FRAMES.items()},
                 "events": self._all_events(), "n": self.n, "load_bound": self.load_bound,
                 "wall": self.wall, "E1": self.E1, "frame_every": self.frame_every}
 
@@ -476,17 +273,19 @@ class Run:
         every = int(ck.get("frame_every", self.frame_every))
         if every != self.frame_every:
             nframes, out = self.n_steps // every + 1, self.out
-            self.frame_every, self.ops = every, self.ops._replace(frame_every=every)
+            self.frame_every = self.scheme.frame_every = every
+            self.scheme.ops = self.ops._replace(frame_every=every)
             self.out = out._replace(**{v: np.full((nframes, getattr(out, v).shape[1]),
                                                   0.0 if v == "frames_f" else np.nan)
                                        for v in self._FRAMES.values()})
-        for k, v in self._STATE.items():
-            getattr(self.st, v)[...] = ck[k]
+        sc = self.scheme
+        for k, v in sc.CHECKPOINT.items():
+            getattr(sc.st, v)[...] = ck[k]
         for k, v in self._FRAMES.items():
             getattr(self.out, v)[:len(ck[k])] = ck[k]
-        ops = self.ops
-        csr_product(ops.Cp, ops.Ci, ops.Cx, self.st.u_prev, self.st.y_prev)
-        csr_product(ops.Cp, ops.Ci, ops.Cx, self.st.u_cur, self.st.y_cur)
+        sc.restored()
+        if sc.pysolver is not None:
+            sc.pysolver.restore({k[7:]: ck[k] for k in ck if k.startswith("solver_")})
         self.events = [np.asarray(ck["events"], dtype=float).reshape(-1, 7)]
         self.n, self.load_bound, self.wall, self.E1 = int(ck["n"]), float(ck["load_bound"]), \
             float(ck["wall"]), float(ck["E1"])
@@ -507,7 +306,7 @@ class Run:
             frames_u=out.frames_u[:nf], frames_v=out.frames_v[:nf],
             frames_force=out.frames_f[:nf],
             status=self.status, message=self.message, steps=self.n, dt=self.dt,
-            T=self.n_steps * self.dt, beta=self.beta, solver=self.solver, wall_time_s=self.wall,
+            T=self.n_steps * self.dt, beta=self.beta, theta=self.theta, solver=self.solver, wall_time_s=self.wall,
             max_nodal_violation=float(max(st[0], 0.0)),
             max_penetration=float(max(st[1], st[2], st[0], 0.0)),
             max_penetration_below=float(st[1]), max_penetration_above=float(st[2]),

@@ -73,8 +73,9 @@ class Result:
     ``contact_force``: nodal contact forces λ (saved × m, force per unit mass per
     length, m²/s² for the beam); ``frames_t``, ``frames_u``, ``frames_v`` (backward
     difference velocity), ``frames_force`` (λ): decimated coefficient vectors;
-    ``status``: "success" or "unstable"; ``message`` says why; ``solver``: the contact
-    law's name; ``work``: the damping, load-input and contact work done since state 1
+    ``status``: "success" or "unstable"; ``message`` says why; ``beta``: the
+    β-scheme's β (None for Moreau–Jean), ``theta``: Moreau–Jean's θ (None for the
+    β-scheme); ``solver``: the contact law's name; ``work``: the damping, load-input and contact work done since state 1
     (at the saved times, in the units of ``energy``): the scheme's identity
     energy − energy[0] + work["damping"] = work["input"] + work["contact"] holds to
     round-off (impacts lose energy: the contact work is ≤ 0 for exact contact);
@@ -94,7 +95,8 @@ class Result:
     steps: int
     dt: float
     T: float
-    beta: float
+    beta: float | None
+    theta: float | None
     solver: str
     wall_time_s: float
     max_nodal_violation: float

@@ -1,0 +1,116 @@
+"""One method object per class (skfem_beam.methods): its defaults and checks, solve()
+reaching every class, and every method's run checkpointing and resuming bit for bit
+(Moreau–Jean and the laws solved in Python included), the latter with moving bounds."""
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from skfem_beam import methods, scenes
+from skfem_beam.errors import InputError
+from skfem_beam.methods import MoreauJean, Penalty, PositionLevel
+from skfem_beam.scheme import Stepping, drive, solve
+from skfem_beam.scheme.moreau_jean import moreau_jean
+from skfem_beam.semidiscrete import beam_system
+
+from test_motion import observe_constraints, span_problem
+
+PS = [sys.executable, "-m", "skfem_beam.cases.point_stops", "--dt", "1e-4",
+      "--flush-every", "150", "--format", "none"]
+
+
+def test_defaults_and_checks():
+    assert PositionLevel().default_beta == 0.5 and Penalty(1e6).default_beta == 0.25
+    assert methods.default_beta(MoreauJean(), "bar") == 0.25
+    for bad, word in [(lambda: PositionLevel(restitution=1.5), "restitution=1.5 must lie"),
+                      (lambda: PositionLevel("simplex"), "solver='simplex' is not one of"),
+                      (lambda: Penalty(0.0), "stiffness=0 must be > 0"),
+                      (lambda: MoreauJean(theta=0.2), "theta=0.2 must lie in [1/2, 1]"),
+                      (lambda: methods.make("moreau-jean", "osqp"), "does not apply"),
+                      (lambda: methods.make("penalty", restitution=0.5, stiffness=1.0),
+                       "cannot be combined with stiffness")]:
+        with pytest.raises(InputError, match=word.replace("[", r"\[").replace("(", r"\(")):
+            bad()
+
+
+def test_penalty_stiffness_in_newtons_is_converted_once():
+    """Penalty(k N/m) on the papers' pipe (ρS known) is the law solve(stiffness=k/ρS)
+    gives, bit for bit."""
+    system = beam_system(scenes.point_stops())
+    k = 1e7
+    a = solve(system, 5e-5, 0.15, 0.25, method=Penalty(k))
+    b = solve(system, 5e-5, 0.15, 0.25, stiffness=k / scenes.PIPE_RHO_S)
+    assert a.impacts > 0 and np.array_equal(a.energy, b.energy)
+    assert np.array_equal(a.contact_force, b.contact_force)
+
+
+def test_solve_reaches_moreau_jean_and_restitution():
+    system = beam_system(scenes.point_stops())
+    mj = solve(system, 5e-5, 0.05, method=MoreauJean(0.5, 0.0))
+    assert mj.solver == "moreau-jean" and mj.theta == 0.5 and mj.beta is None
+    old = moreau_jean(system, 5e-5, 0.05)
+    assert np.array_equal(mj.energy, old.energy)
+    e = solve(system, 5e-5, 0.05, method=PositionLevel(restitution=0.5))
+    assert e.solver == "restitution" and e.theta is None and e.beta == 0.5
+
+
+CASES = [MoreauJean(), MoreauJean(1.0, 0.5), PositionLevel("osqp"), PositionLevel("daqp"),
+         PositionLevel("active-set")]
+
+
+@pytest.mark.parametrize("method", CASES, ids=lambda m: f"{m.name}-{getattr(m, 'solver', '')}")
+def test_a_restored_run_goes_on_bit_for_bit(method):
+    """Checkpoint at step 1200 of 3000, restore into a new run, drive to the end: every
+    row after the checkpoint, every impact event and the last state are the
+    uninterrupted run's, to the bit."""
+    system = beam_system(scenes.point_stops())
+    stepping = Stepping(5e-5, 0.15, 0.5)
+    a = method.build(system, stepping)
+    drive(a, chunk=150)
+    b = method.build(system, stepping)
+    b.advance(1200)
+    ck = b.checkpoint()
+    c = method.build(system, stepping)
+    c.restore(ck)
+    drive(c, chunk=150)
+    ra, rc = a.result(), c.result()
+    assert ra.impacts > 5
+    assert np.array_equal(ra.energy[1201:], rc.energy[1201:])
+    assert np.array_equal(ra.contact_force[1201:], rc.contact_force[1201:])
+    assert np.array_equal(a.u_cur, c.u_cur) and np.array_equal(a.u_prev, c.u_prev)
+    for k in ra.impact_events:
+        assert np.array_equal(ra.impact_events[k], rc.impact_events[k]), k
+
+
+@pytest.mark.parametrize("extra", [["--law", "moreau-jean"], ["--solver", "osqp"],
+                                   ["--solver", "daqp"]])
+def test_command_line_extension_equals_the_longer_run(tmp_path, extra):
+    """A finished run extended by --resume DIR --T longer (restored from its final
+    checkpoint) writes the timeseries.csv and impacts.csv of the longer run, byte for
+    byte: Moreau–Jean, OSQP and daqp checkpoint and resume like the compiled laws."""
+    a, b = tmp_path / "a", tmp_path / "b"
+    subprocess.run(PS + extra + ["--T", "0.1", "--checkpoint-every", "0", "--out", str(a)],
+                   check=True, capture_output=True)
+    subprocess.run(PS + ["--resume", str(a), "--T", "0.2"], check=True, capture_output=True)
+    subprocess.run(PS + extra + ["--T", "0.2", "--out", str(b)], check=True,
+                   capture_output=True)
+    for name in ("timeseries.csv", "impacts.csv"):
+        assert (a / name).read_bytes() == (b / name).read_bytes(), name
+    s = json.loads((a / "summary.json").read_text())
+    assert s["status"] == "success" and s["steps"] == 2000 and s["impacts"] > 0
+
+
+@pytest.mark.parametrize("solver", ["osqp", "daqp"])
+def test_python_laws_take_moving_bounds(solver):
+    """Obstacles carried by a shaken support (bounds moving every step): OSQP and daqp
+    give the active set's run to round-off and hold the moving bounds at the nodes."""
+    s = observe_constraints(beam_system(span_problem(True, "paper")))
+    ref = solve(s, dt=1e-4, T=0.3, solver="active-set")
+    r = solve(s, dt=1e-4, T=0.3, solver=solver)
+    assert ref.impacts > 3 and r.impacts == ref.impacts
+    y = np.column_stack([r.observed[f"y{i}"] for i in range(s.C.shape[0])])
+    shift = np.outer(s.bound_motion(r.t), s.bound_shift)
+    assert np.maximum(s.lo + shift - y, y - s.hi - shift).max() <= 1e-12
+    assert np.abs(r.observed["y0"] - ref.observed["y0"]).max() <= 1e-10

@@ -103,3 +103,23 @@ def test_summary_records_configuration_and_version(tmp_path):
     s = json.loads((out / "summary.json").read_text())
     assert s["config"]["gap"] == 0.05 and s["config"]["T"] == 0.01
     assert s["package_version"] and s["status"] == "success"
+
+
+def test_a_run_killed_after_its_last_checkpoint_resumes_at_once(tmp_path):
+    """Killed after the final checkpoint but before summary.json said "success" (here:
+    its status set back to "running"): --resume finishes at once (no loop), with the
+    uninterrupted run's files and status "success"."""
+    ref, out = tmp_path / "ref", tmp_path / "out"
+    base = CASE + ["--T", "0.1", "--format", "none"]
+    subprocess.run(base + ["--out", str(ref)], check=True, capture_output=True)
+    subprocess.run(base + ["--out", str(out)], check=True, capture_output=True)
+    path = out / "summary.json"
+    path.write_text(json.dumps({**json.loads(path.read_text()), "status": "running"}))
+    t0 = time.monotonic()
+    p = subprocess.run(CASE + ["--resume", str(out)], capture_output=True, text=True,
+                       timeout=60)
+    assert p.returncode == 0, p.stderr
+    assert time.monotonic() - t0 < 30
+    for name in ("timeseries.csv", "impacts.csv"):
+        assert (out / name).read_bytes() == (ref / name).read_bytes(), name
+    assert json.loads(path.read_text())["status"] == "success"

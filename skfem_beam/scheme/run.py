@@ -289,6 +289,8 @@ class Run:
         self.events = [np.asarray(ck["events"], dtype=float).reshape(-1, 7)]
         self.n, self.load_bound, self.wall, self.E1 = int(ck["n"]), float(ck["load_bound"]), \
             float(ck["wall"]), float(ck["E1"])
+        if self.n >= self.n_steps:       # a checkpoint at the last step: nothing to compute
+            self.status, self.message = "success", "the run reached T"
 
     def result(self) -> Result:
         """The run so far (its saved series from ``row0``: all of them unless an output

@@ -5,7 +5,7 @@ import math
 import sys
 
 from ..contact import ContactLaw
-from ..errors import InputError
+from ..errors import InputError, SolverError
 from .run import Run
 from .stepping import Result, Stepping
 
@@ -65,6 +65,9 @@ def drive(run: Run, chunk: int = 20000, progress: bool | None = None, on_chunk=N
         while not run.done:
             n0 = run.n
             run.advance(n0 + chunk)
+            if run.n == n0 and not run.done:     # never loop without progress
+                raise SolverError(f"the run made no progress at step {n0} of "
+                                  f"{run.n_steps}; stopped")
             if bar is not None:
                 bar.update(run.n - n0)
             if on_chunk is not None:

@@ -9,16 +9,19 @@ import argparse
 import signal
 import sys
 import threading
+from pathlib import Path
 
 from . import __version__
 from . import methods
 from .contact import SOLVERS
-from .checks import check_choice
+from .checks import check_choice, check_positive
 from .errors import InputError, SolverError
 from .output.folder import (EXIT_INPUT, EXIT_SOLVER, EXIT_UNSTABLE, OPENED,  # noqa: F401
                             Interrupted, release, report, stamp)
 from .output.options import OutputOptions
-from .output.series import stored_args
+from .output.folder import lock_folder
+from .output.series import (_resume_folder, check_resumable, read_checkpoint,
+                            read_summary)
 from .scheme.stepping import MASSLESS, Stepping
 from .spec import RunSpec
 
@@ -188,3 +191,53 @@ def main_guard(main) -> None:
 
 def warn(message: str) -> None:
     print(f"warning: {message}", file=sys.stderr)
+
+
+# ------------------------------------------------------------ --resume: the stored flags
+
+def _given(parser, argv) -> dict:
+    """The flags written on the command line (not the defaults)."""
+    actions = [a for a in parser._actions if a.default is not argparse.SUPPRESS]
+    saved = [a.default for a in actions]
+    try:
+        for a in actions:
+            a.default = argparse.SUPPRESS
+        return vars(parser.parse_args(argv))
+    finally:
+        for a, d in zip(actions, saved):
+            a.default = d
+
+
+def stored_args(args, parser, argv=None):
+    """For ``--resume DIR``: the flags of the run stored in DIR/summary.json, once DIR is
+    locked and its summary, checkpoint and rows agree.  ``--T`` may grow (extending the
+    run); any other flag that differs from the stored one is refused by name."""
+    if not getattr(args, "resume", None):
+        return args
+    out = _resume_folder(args.resume)
+    lock_folder(out)
+    summary, ck = read_summary(out), read_checkpoint(out)
+    config = summary["config"]
+    given = _given(parser, argv)
+    T = config.get("T")
+    for k, v in given.items():
+        if k == "resume" or k == "out" and Path(v).resolve() == out.resolve():
+            continue
+        if k == "T" and T is not None and check_positive("T", v) >= T:
+            T = v
+            continue
+        flag = f"--{k.replace('_', '-')}"
+        if k == "T":
+            raise InputError(f"--resume {out}: {flag} {v:g} is shorter than the run's T={T:g} "
+                             "(a run can only be extended)")
+        if k not in config or config[k] != v:
+            raise InputError(f"--resume {out}: {flag} {v} differs from the run's "
+                             f"{config.get(k)!r}; a resumed run keeps its flags (only --T "
+                             "may grow)")
+    check_resumable(out, summary, ck, extend=T is not None and T > config.get("T", T))
+    stored = vars(parser.parse_args([]))
+    for k in stored:
+        if k in config:
+            stored[k] = config[k]
+    stored.update(resume=args.resume, out=args.resume, overwrite=False, T=T)
+    return type(args)(**stored)

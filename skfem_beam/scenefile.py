@@ -586,7 +586,7 @@ def _run_parser() -> argparse.ArgumentParser:
 
 def run_main(argv) -> int:
     """``python -m skfem_beam run``: the scene through the scenes' own pipeline."""
-    from .output.series import stored_args
+    from .cli import stored_args
     p = _run_parser()
     args = stored_args(p.parse_args(argv), p, argv)
     scene = _scene_of(args.scene, args.set, args.resume)

@@ -7,4 +7,4 @@
 - :mod:`.render`: pyvista pictures and animations of a run.
 """
 from .folder import Folder, check_output_dir, report, stamp, write_summary  # noqa: F401
-from .series import Series, execute, prepare, stored_args  # noqa: F401
+from .series import Series, execute, prepare  # noqa: F401

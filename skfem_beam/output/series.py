@@ -16,7 +16,6 @@ buffers, and which field frames to write.
 """
 from __future__ import annotations
 
-import argparse
 import hashlib
 import io
 import json
@@ -34,13 +33,12 @@ from typing import Callable
 
 import numpy as np
 
-from ..checks import check_count, check_nonnegative, check_positive
 from ..errors import InputError, SolverError
 from ..scheme import Run, drive
-from .fields import FieldWriter, check_format
+from .fields import FieldWriter
 from .options import OutputOptions
 from .folder import (EXIT_SOLVER, SUMMARY, Folder, Interrupted, _plain, check_output_dir,
-                     csv_rows, lock_folder, report)
+                     csv_rows, report)
 
 CHECKPOINT = "checkpoint.npz"
 CHECKPOINT_FORMAT = 3       # 3: impact events hold their first step off (State.impact)
@@ -505,7 +503,6 @@ def execute(run: Run, options: OutputOptions, summary: dict, series, finish) -> 
         if every is not None:
             raise
         can_checkpoint = False
-    names = list(series.columns(run, 0, 0))
     used, ck = 0, None
     if resume:
         ck = read_checkpoint(out)       # checked again: the lock is held since the parse
@@ -520,149 +517,129 @@ def execute(run: Run, options: OutputOptions, summary: dict, series, finish) -> 
 
 
 def _stream(run, folder, options, series, finish, stop, used, ck, can_checkpoint) -> int:
-    """The body of :func:`execute`, in the open ``folder``."""
-    names = list(series.columns(run, 0, 0))
-    every, fmt = options.checkpoint_every, options.format
-    last_ck = time.monotonic()
-    fields = rows = None
-    kept = {"step": int(ck["n"]) if ck is not None else None}
+    """The body of :func:`execute`, in the open ``folder``: the run to its end, or what a
+    stop (signal, failed solver, failed write) leaves and says."""
+    s = _Stream(run, folder, options, series, stop, used, ck, can_checkpoint)
+    try:
+        entries = s.to_the_end(finish)
+    except Interrupted as e:
+        return s.interrupted(e)
+    except SolverError as e:
+        # the loop stopped inside a chunk: its events reach the state before the failed step
+        folder.fail(e, steps=run.n, **s.write_events(run.stopped_at - 1))
+        raise
+    except OSError as e:
+        return s.failed_write(e)
+    final = folder.close(**entries)
+    return report(final, folder.path)
 
-    def save_checkpoint():
-        rows.sync()
-        write_checkpoint(folder / CHECKPOINT, _checkpoint(run, rows, used), folder.summary["config"])
-        kept["step"] = run.n
+
+class _Stream:
+    """A run streaming into its folder: rows and frames written after every chunk, the
+    checkpoints, and the words of what is kept when it stops."""
+
+    def __init__(self, run, folder, options, series, stop, used, ck, can_checkpoint):
+        self.run, self.folder, self.options, self.series = run, folder, options, series
+        self.stop, self.used, self.ck, self.can_checkpoint = stop, used, ck, can_checkpoint
+        self.last_ck = time.monotonic()
+        self.rows = self.fields = None
+        self.kept = int(ck["n"]) if ck is not None else None   # the last checkpoint's step
+
+    def save_checkpoint(self) -> None:
+        run, folder = self.run, self.folder
+        self.rows.sync()
+        write_checkpoint(folder / CHECKPOINT, _checkpoint(run, self.rows, self.used),
+                         folder.summary["config"])
+        self.kept = run.n
         folder.write(checkpoint_step=run.n)
 
-    def on_chunk(run):
-        nonlocal last_ck, used
-        k1 = series.rows_ready(run)
-        if k1 > used:
-            rows.append(series.columns(run, used, k1))
-            used = k1
-            run.release(used - 1)       # written: memory stays flat (one row kept before)
-        if fields is not None:
-            fields.update()
-        if stop.signum is not None and not run.done:
-            raise Interrupted(stop.signum)
-        if every is not None and time.monotonic() - last_ck >= every and not run.done:
-            save_checkpoint()
-            last_ck = time.monotonic()
+    def on_chunk(self, run) -> None:
+        k1 = self.series.rows_ready(run)
+        if k1 > self.used:
+            self.rows.append(self.series.columns(run, self.used, k1))
+            self.used = k1
+            run.release(self.used - 1)   # written: memory stays flat (one row kept before)
+        if self.fields is not None:
+            self.fields.update()
+        if self.stop.signum is not None and not run.done:
+            raise Interrupted(self.stop.signum)
+        every = self.options.checkpoint_every
+        if every is not None and time.monotonic() - self.last_ck >= every and not run.done:
+            self.save_checkpoint()
+            self.last_ck = time.monotonic()
 
-    def write_events(last: int, quiet: bool = True) -> dict:
+    def to_the_end(self, finish) -> dict:
+        """Stream the run to its end, then the charts and impacts.csv: the summary's
+        entries."""
+        run, series, fmt = self.run, self.series, self.options.format
+        try:
+            self.rows = SeriesFile(self.folder / "timeseries.csv",
+                                   list(series.columns(run, 0, 0)), keep=self.ck,
+                                   limit=None if series.keep_all else KEEP_ROWS)
+            self.fields = _Fields(self.folder.path, run, fmt, series) if fmt != "none" else None
+            self.on_chunk(run)              # state 1 (and, on resume, the frames so far)
+            drive(run, chunk=self.options.flush_every, on_chunk=self.on_chunk)
+            if self.can_checkpoint and run.status == "success":
+                self.save_checkpoint()      # so that --resume DIR --T longer extends it
+        finally:
+            if self.rows is not None:
+                self.rows.close()
+            if self.fields is not None:
+                self.fields.close()
+        data = self.rows.data()
+        entries = outcome(run.result(), data)
+        entries.update(finish(self.folder.path, data, run) or {})
+        entries.update(self.write_events(run.n, quiet=False))
+        return entries
+
+    def write_events(self, last: int, quiet: bool = True) -> dict:
         """impacts.csv of the events up to state ``last`` (its summary entries); nothing
         when the command has none, or (``quiet``, a run already stopping on an error) when
         the disk refuses it: that run's own error is the one to report."""
-        if series.events is None:
+        if self.series.events is None:
             return {}
         try:
-            return series.events(folder.path, run, last)
+            return self.series.events(self.folder.path, self.run, last)
         except OSError:
             if not quiet:
                 raise
             return {}
 
-    def what_is_kept() -> str:
+    def what_is_kept(self) -> str:
+        run, rows, kept = self.run, self.rows, self.kept
         t = (rows.rows - 1) * run.save_every * run.dt if rows is not None and rows.rows else 0.0
-        ck_line = (f"the checkpoint at step {kept['step']} (t={kept['step'] * run.dt:.6g} s)"
-                   if kept["step"] is not None else "no checkpoint")
-        frames = f", {fields.written} field frames" if fields is not None else ""
+        ck_line = (f"the checkpoint at step {kept} (t={kept * run.dt:.6g} s)"
+                   if kept is not None else "no checkpoint")
+        frames = f", {self.fields.written} field frames" if self.fields is not None else ""
         return (f"kept {rows.rows if rows is not None else 0} whole rows of timeseries.csv "
-                f"(to t={t:.6g} s){frames} and {ck_line} in {folder.path}")
+                f"(to t={t:.6g} s){frames} and {ck_line} in {self.folder.path}")
 
-    try:
-        try:
-            rows = SeriesFile(folder / "timeseries.csv", names, keep=ck,
-                              limit=None if series.keep_all else KEEP_ROWS)
-            fields = _Fields(folder.path, run, fmt, series) if fmt != "none" else None
-            on_chunk(run)                      # state 1 (and, on resume, the frames so far)
-            drive(run, chunk=options.flush_every, on_chunk=on_chunk)
-            if can_checkpoint and run.status == "success":
-                save_checkpoint()              # so that --resume DIR --T longer extends it
-        finally:
-            if rows is not None:
-                rows.close()
-            if fields is not None:
-                fields.close()
-        data = rows.data()
-        entries = outcome(run.result(), data)
-        entries.update(finish(folder.path, data, run) or {})
-        entries.update(write_events(run.n, quiet=False))
-    except Interrupted as e:
-        name = signal.Signals(e.signum).name
-        why = ""
-        if can_checkpoint:
+    def interrupted(self, e: Interrupted) -> int:
+        """SIGINT/SIGTERM between chunks: a checkpoint, status "interrupted", one line."""
+        run, folder = self.run, self.folder
+        name, why = signal.Signals(e.signum).name, ""
+        if self.can_checkpoint:
             try:
-                save_checkpoint()
+                self.save_checkpoint()
             except OSError as err:
                 why = f" (no new checkpoint: {err.strerror})"
-        entries = outcome(run.result(), rows.data())
-        entries.update(write_events(run.n))
+        entries = outcome(run.result(), self.rows.data())
+        entries.update(self.write_events(run.n))
         folder.close(**{**entries, "status": "interrupted", "steps": run.n,
                         "message": f"interrupted by {name} at step {run.n} "
                                    f"(t={run.n * run.dt:.6g} s)"})
         resume = (f"continue with: {_command(folder.summary)} --resume {folder.path}"
-                  if kept["step"] is not None else "no checkpoint: it cannot be resumed")
-        print(f"interrupted by {name}: {what_is_kept()}{why}; {resume}", file=sys.stderr)
+                  if self.kept is not None else "no checkpoint: it cannot be resumed")
+        print(f"interrupted by {name}: {self.what_is_kept()}{why}; {resume}", file=sys.stderr)
         return e.code
-    except SolverError as e:
-        # the loop stopped inside a chunk: its events reach the state before the failed step
-        folder.fail(e, steps=run.n, **write_events(int(run.st.counters[3]) - 1))
-        raise
-    except OSError as e:
-        folder.fail(e, steps=run.n, kept=what_is_kept(), **write_events(run.n))
+
+    def failed_write(self, e: OSError) -> int:
+        """A write refused (full disk, ...): status "failed", what is kept, exit 3."""
+        run, folder = self.run, self.folder
+        folder.fail(e, steps=run.n, kept=self.what_is_kept(), **self.write_events(run.n))
         resume = (f"once there is room, continue with: {_command(folder.summary)} --resume "
-                  f"{folder.path}" if kept["step"] is not None else
+                  f"{folder.path}" if self.kept is not None else
                   "without a checkpoint (--checkpoint-every) it cannot be resumed")
-        print(f"error: could not write the results: {e}; {what_is_kept()}; {resume}",
+        print(f"error: could not write the results: {e}; {self.what_is_kept()}; {resume}",
               file=sys.stderr)
         return EXIT_SOLVER
-    final = folder.close(**entries)
-    return report(final, folder.path)
-
-
-def _given(parser, argv) -> dict:
-    """The flags written on the command line (not the defaults)."""
-    actions = [a for a in parser._actions if a.default is not argparse.SUPPRESS]
-    saved = [a.default for a in actions]
-    try:
-        for a in actions:
-            a.default = argparse.SUPPRESS
-        return vars(parser.parse_args(argv))
-    finally:
-        for a, d in zip(actions, saved):
-            a.default = d
-
-
-def stored_args(args, parser, argv=None):
-    """For ``--resume DIR``: the flags of the run stored in DIR/summary.json, once DIR is
-    locked and its summary, checkpoint and rows agree.  ``--T`` may grow (extending the
-    run); any other flag that differs from the stored one is refused by name."""
-    if not getattr(args, "resume", None):
-        return args
-    out = _resume_folder(args.resume)
-    lock_folder(out)
-    summary, ck = read_summary(out), read_checkpoint(out)
-    config = summary["config"]
-    given = _given(parser, argv)
-    T = config.get("T")
-    for k, v in given.items():
-        if k == "resume" or k == "out" and Path(v).resolve() == out.resolve():
-            continue
-        if k == "T" and T is not None and check_positive("T", v) >= T:
-            T = v
-            continue
-        flag = f"--{k.replace('_', '-')}"
-        if k == "T":
-            raise InputError(f"--resume {out}: {flag} {v:g} is shorter than the run's T={T:g} "
-                             "(a run can only be extended)")
-        if k not in config or config[k] != v:
-            raise InputError(f"--resume {out}: {flag} {v} differs from the run's "
-                             f"{config.get(k)!r}; a resumed run keeps its flags (only --T "
-                             "may grow)")
-    check_resumable(out, summary, ck, extend=T is not None and T > config.get("T", T))
-    stored = vars(parser.parse_args([]))
-    for k in stored:
-        if k in config:
-            stored[k] = config[k]
-    stored.update(resume=args.resume, out=args.resume, overwrite=False, T=T)
-    return type(args)(**stored)

@@ -173,11 +173,19 @@ class BetaScheme:
         call that is compiled (energy_beta, box_qp, ...) is shared with the loop.
         """
         self._compile_side_by_side(out)
-        Orows, first_params = self.Orows, self.law.setup(self.step, first=True)
+        first_params = self.law.setup(self.step, first=True)
+        u0 = self.system.u0.astype(float)
+        self.st.u_prev[:] = u0
+        u1 = self._first_free_step(u0, first_params)
+        self._first_contact(u1, first_params)
+        self._record_first_states(out)
+        return 1
+
+    def _first_free_step(self, u0, first_params) -> np.ndarray:
+        """The start step's solution without the law's multipliers (docstring of start)."""
         system, op, st = self.system, self.op, self.st
         dt, beta, M, K, B = self.dt, self.beta, system.M, system.K, system.B
-        u0, v0 = system.u0.astype(float), system.v0.astype(float)
-        st.u_prev[:] = u0
+        v0 = system.v0.astype(float)
         f0 = self.loads @ np.array([float(a(np.array([0.0]))[0]) for a in system.load_time]) \
             if self.loads.shape[1] else np.zeros(system.n)
         F0 = M @ (u0 + dt * v0) - 0.5 * dt**2 * (1 - 2 * beta) * (K @ u0) \
@@ -192,8 +200,13 @@ class BetaScheme:
             self.law.explicit.func(st.y_prev, st.y_prev, st.lo, st.hi, first_params, st.r_e)
             F0 += dt**2 * (op.C.T @ st.r_e)
             st.r_e[:] = 0.0
-        u1 = F0.copy()
-        band_solve(op.Ab.chol, u1)
+        band_solve(op.Ab.chol, F0)
+        return F0
+
+    def _first_contact(self, u1, first_params) -> None:
+        """u¹ = the free solution + W μ with the chosen law's μ (state 1 records no
+        contact force)."""
+        op, st = self.op, self.st
         if st.mu.size:
             st.x[:] = u1
             csr_product(self.ops.Cp, self.ops.Ci, self.ops.Cx, u1, st.yf)
@@ -210,9 +223,11 @@ class BetaScheme:
             u1 = u1 + op.W @ st.mu
         st.u_cur[:] = u1
         csr_product(self.ops.Cp, self.ops.Ci, self.ops.Cx, u1, st.y_cur)
-        st.mu[:] = 0.0     # state 1 records no contact force
+        st.mu[:] = 0.0
 
-        # states 0 and 1 (E_β needs two states: the energy saved at t = 0 is E_β¹)
+    def _record_first_states(self, out) -> None:
+        """States 0 and 1 (E_β needs two states: the energy saved at t = 0 is E_β¹)."""
+        system, op, st, Orows = self.system, self.op, self.st, self.Orows
         out.obs[0] = Orows @ st.u_prev
         out.obsv[0] = Orows @ system.v0
         rows_matvec(op.Kb.rows, st.u_prev, st.Ku, 1.0, False)   # K uⁿ⁻¹ for the energy
@@ -223,7 +238,6 @@ class BetaScheme:
             raise InputError("the initial state and load are too large for floating point: "
                              f"the first step's energy is {self.E1:g}")
         out.energy[0] = self.E1
-        return 1
 
     def motion(self, t):
         """φ(t) that moves the bounds (zero when they do not move)."""

@@ -29,6 +29,23 @@ PAPER_MESHES = {
 _POINT_CELLS = ("vertex",)   # Gmsh physical points may come along; they are ignored
 
 
+def _read(path: Path):
+    """meshio.read, with its failures as one InputError line."""
+    said = io.StringIO()
+    try:
+        # meshio prints every failed attempt and then calls sys.exit(1) when no reader
+        # for the extension accepts the file: capture the text, turn the exit into ours
+        with redirect_stdout(said), redirect_stderr(said):
+            return meshio.read(path)
+    except (Exception, SystemExit) as e:   # ReadError, KeyError, ValueError, … too
+        lines = [s.strip() for s in said.getvalue().splitlines() if s.strip()]
+        msg = str(e).strip() if isinstance(e, Exception) else ""
+        msg = msg.splitlines()[0] if msg else (lines[-1] if lines else "")
+        if isinstance(e, Exception) and type(e).__name__ != "ReadError":
+            msg = f"{type(e).__name__}: {msg}".rstrip(": ")
+        raise InputError(f"cannot read mesh {path}: {msg.removeprefix('Error: ')}") from None
+
+
 def load_mesh(path, L: float) -> np.ndarray:
     """Nodes 0 = x_0 < … < x_J = L of the line mesh in ``path``.
 
@@ -42,19 +59,7 @@ def load_mesh(path, L: float) -> np.ndarray:
     path = Path(path)
     if not path.is_file():
         raise InputError(f"mesh file {path} does not exist")
-    said = io.StringIO()
-    try:
-        # meshio prints every failed attempt and then calls sys.exit(1) when no reader
-        # for the extension accepts the file: capture the text, turn the exit into ours
-        with redirect_stdout(said), redirect_stderr(said):
-            mesh = meshio.read(path)
-    except (Exception, SystemExit) as e:   # ReadError, KeyError, ValueError, … too
-        lines = [s.strip() for s in said.getvalue().splitlines() if s.strip()]
-        msg = str(e).strip() if isinstance(e, Exception) else ""
-        msg = msg.splitlines()[0] if msg else (lines[-1] if lines else "")
-        if isinstance(e, Exception) and type(e).__name__ != "ReadError":
-            msg = f"{type(e).__name__}: {msg}".rstrip(": ")
-        raise InputError(f"cannot read mesh {path}: {msg.removeprefix('Error: ')}") from None
+    mesh = _read(path)
     other = sorted({c.type for c in mesh.cells} - {"line", *_POINT_CELLS})
     if other:
         raise InputError(f"mesh {path} is not a line mesh: it has {', '.join(other)} cells")

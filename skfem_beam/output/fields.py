@@ -190,19 +190,7 @@ def sample_line(system, samples_per_element: int = 8) -> LineSamples:
         elif beam:                                 # per side, averaged like u''
             side = _side_values(lift.h_dd, space, smp.x, s)
             h_dd = R @ (side if EIf is None else EIf * side)
-    g1 = np.full(x.size, -np.inf)
-    g2 = np.full(x.size, np.inf)
-    contact = np.abs(x[:, None] - np.asarray(system.x_contact)[None, :]).argmin(axis=0)
-    near = np.abs(x[contact] - system.x_contact) <= 1e-9 * max(1.0, L)
-    if not near.all():
-        raise InputError(f"constrained value at x={system.x_contact[~near][0]:g} is not a node")
-    carried = fixed = None
-    if view.obstacles is not None:
-        g1, g2 = view.obstacles.bounds(x)
-        if lift is not None and view.obstacles.carried:   # combine: any part carried
-            carried, fixed = _split_obstacles(view.obstacles, x)
-    else:
-        g1[contact], g2[contact] = system.lo, system.hi
+    g1, g2, contact, carried, fixed = _obstacle_lines(system, view, x, L)
     # the bar's field force is the obstacle's push R ≥ 0, as in timeseries.csv: λ at a
     # lower bound (x = 0), −λ at an upper one (x = L, where U = −u(L))
     push = None
@@ -214,6 +202,25 @@ def sample_line(system, samples_per_element: int = 8) -> LineSamples:
                        k2=view.k2 if beam else None, L=L,
                        motion=None if lift is None else lift.motion, h=h, h_dd=h_dd,
                        carried=carried, fixed=fixed, push=push)
+
+
+def _obstacle_lines(system, view, x, L):
+    """g1, g2 at the points x (−∞/+∞ where there is none), the points of the constrained
+    values, and the carried/fixed parts of the obstacles when a support moves them."""
+    g1 = np.full(x.size, -np.inf)
+    g2 = np.full(x.size, np.inf)
+    contact = np.abs(x[:, None] - np.asarray(system.x_contact)[None, :]).argmin(axis=0)
+    near = np.abs(x[contact] - system.x_contact) <= 1e-9 * max(1.0, L)
+    if not near.all():
+        raise InputError(f"constrained value at x={system.x_contact[~near][0]:g} is not a node")
+    carried = fixed = None
+    if view.obstacles is not None:
+        g1, g2 = view.obstacles.bounds(x)
+        if view.lift is not None and view.obstacles.carried:   # combine: any part carried
+            carried, fixed = _split_obstacles(view.obstacles, x)
+    else:
+        g1[contact], g2[contact] = system.lo, system.hi
+    return g1, g2, contact, carried, fixed
 
 
 class _XdmfSeries(meshio.xdmf.TimeSeriesWriter):

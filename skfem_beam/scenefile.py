@@ -214,10 +214,12 @@ def apply_set(data: dict, assignment: str) -> None:
 
 # ---------------------------------------------------------------- reading
 
-def load(path, overrides=(), files: dict | None = None, text: str | None = None) -> Scene:
+def load(path, overrides=(), files: dict | None = None, text: str | None = None,
+         dynamic: bool = True) -> Scene:
     """Read the scene file ``path`` (``overrides``: ``KEY=VALUE`` strings as ``--set``).
     ``text``/``files``: the file's and its tables' stored texts (a resumed run) instead of
-    the file system."""
+    the file system.  ``dynamic=False``: the structure alone (natural frequencies need
+    no [time], [contact] or [output]: they are not read, and ``stepping`` is None)."""
     path = Path(path)
     if text is None:
         try:
@@ -241,6 +243,8 @@ def load(path, overrides=(), files: dict | None = None, text: str | None = None)
     with tempfile.TemporaryDirectory() as tmp:
         reader.tmp = Path(tmp)
         problem = (_beam_problem if kind == "beam" else _bar)(data, reader)
+    if not dynamic:
+        return Scene(kind, problem, None, text=text, files=reader.read, data=data)
     return _scene(kind, problem, data, text, reader.read)
 
 
@@ -333,6 +337,20 @@ def _section(d: dict, where: str) -> Section:
     if "rect" in d:
         return Section.rect(**_need(d["rect"], ("b", "h"), f"{where}.rect"))
     return Section(**_need(d, ("I", "A"), where))
+
+
+def _bar_area(d: dict) -> float:
+    """A bar's [section]: its area A (m²), given as A or by a tube, rod or rect (a bar
+    has no bending, so no I)."""
+    from .checks import check_positive
+    forms = [k for k in ("tube", "rod", "rect", "A") if k in d]
+    if len(forms) != 1 or "I" in d:
+        raise InputError(f"a bar's [section] needs one of A, tube, rod, rect (got "
+                         f"{', '.join(forms + (['I'] if 'I' in d else [])) or 'none'}; a bar "
+                         "has no I)")
+    if "A" in d:
+        return check_positive("section.A", d["A"])
+    return _section(d, "section").A
 
 
 def _need(d: dict, keys, where: str) -> dict:
@@ -537,7 +555,7 @@ def _bar_profile(d, name: str, value: str):
 def _bar(data: dict, reader: _Reader) -> Bar:
     L = _need(data.get("geometry", {}), ("L",), "geometry")["L"]
     mat = _material(data.get("material", {}), "material")
-    A = _section(data["section"], "section").A if "section" in data else None
+    A = _bar_area(data["section"]) if "section" in data else None
     obstacles = data.get("obstacles", [])
     if len(obstacles) != 1 or "x" not in obstacles[0]:
         raise InputError("a bar needs one [[obstacles]] with x = 0 or x = L (the end it "
@@ -660,7 +678,7 @@ def modes_main(argv) -> int:
     p.add_argument("--out", default=None, help="write DIR/modes.csv")
     p.add_argument("--overwrite", action="store_true", help="replace an existing --out folder")
     args = p.parse_args(argv)
-    scene = load(args.scene, args.set or ())
+    scene = load(args.scene, args.set or (), dynamic=False)
     if scene.kind != "beam":
         raise InputError(f"modes: {args.scene} is a {scene.kind}; modes are computed for "
                          "beams")

@@ -51,7 +51,9 @@ class SceneView:
     (kg/m; None when unknown), so forces × rho_S are in N (per length: N/m) and energies
     × rho_S in J; ``EI`` = k2·rho_S (N·m², the first segment's for a stepped beam).
     ``lift``: the lifting (:class:`Lifting`) when the support moves, whatever its kind;
-    the physical displacement is u + lift.h(x)·φ(t).
+    the physical displacement is u + lift.h(x)·φ(t).  ``observed_x``: where the default
+    series (``tip_displacement``) observes the beam when its end at L is held (None:
+    x = L, the tip), see :func:`observed_node`.
     """
     kind: str = "beam"
     L: float | None = None
@@ -61,6 +63,7 @@ class SceneView:
     rho_S: float | None = None
     EI: float | None = None
     lift: Lifting | None = None
+    observed_x: float | None = None     # the default observed point (None: the tip, x = L)
 
 
 @dataclass
@@ -246,7 +249,10 @@ def beam_system(problem: BeamProblem, samples_per_element: int = 20) -> SemiDisc
     damp = problem.damping
     B = None if damp.none else (damp.alpha * space.M + damp.alpha_K * K).tocsr()
 
-    observe = {"tip_displacement": np.asarray(space.C[-1].toarray()).ravel()}
+    node = observed_node(problem, space)
+    row = space.C[-1] if node is None else space.nodal[node]
+    observe = {"tip_displacement": np.asarray(row.toarray()).ravel()}
+    x_obs = None if node is None else float(space.nodes[node])
     return SemiDiscrete(
         M=space.M, K=K, C=sp.csr_matrix(C), lo=lo, hi=hi,
         x_contact=x_c, loads=loads, load_time=times, u0=u0, v0=v0,
@@ -256,8 +262,20 @@ def beam_system(problem: BeamProblem, samples_per_element: int = 20) -> SemiDisc
         meta={"kind": "beam", "L": L, "k2": k2, "rho_S": beam.rho_S,
               "element": problem.element, "J": problem.J, "problem": problem},
         view=SceneView("beam", L, k2, sup if problem.lifting == "paper" else None,
-                       problem.obstacles, beam.rho_S, beam.EI, lift),
+                       problem.obstacles, beam.rho_S, beam.EI, lift, x_obs),
         bound_motion=motion, bound_shift=shift, sample_shift=s_shift)
+
+
+def observed_node(problem: BeamProblem, space) -> int | None:
+    """The node the default series observes where the end at L is held (pinned,
+    clamped: its value is prescribed, so its series would be identically zero): the node
+    of largest first-mode amplitude (a uniform pinned–pinned beam: mid-span).  None: the
+    tip x = L, whose value is free."""
+    if space.nodes.size - 1 in space.value_nodes:
+        return None
+    from .modes import modes       # here: modes builds on this module's space
+    values = np.abs(space.nodal @ modes(problem, 1).vectors[:, 0])
+    return int(np.argmax(values))
 
 
 def add_probes(system: SemiDiscrete, xs) -> list[dict]:

@@ -343,3 +343,83 @@ def test_law_and_mass_keys_are_the_case_flags(tmp_path, scene, sets, flags):
 def test_bad_law_and_mass_keys_are_refused(tmp_path, capsys, sets, word):
     assert_refused(run_main, [str(example("point_stops")), "--out", str(tmp_path / "run"),
                               *[x for s in sets for x in ("--set", s)]], word, capsys, tmp_path)
+
+
+def test_modes_need_no_time_step(tmp_path):
+    """`modes` on a scene without [time] gives the frequencies and shapes of the same
+    scene with [time] (which it ignores, with [contact] and [output])."""
+    text = example("heat_exchanger_tube").read_text()
+    lines, skip = [], False
+    for line in text.splitlines():
+        skip = line.startswith("[time]") or (skip and not line.startswith("["))
+        if not skip:
+            lines.append(line)
+    bare = write(tmp_path, "\n".join(lines) + "\n", "bare.toml")
+    assert "[time]" not in bare.read_text()
+    a, b = tmp_path / "a", tmp_path / "b"
+    assert exit_code(modes_main, [str(bare), "--n", "3", "--out", str(a)]) == 0
+    assert exit_code(modes_main, [str(example("heat_exchanger_tube")), "--n", "3",
+                                  "--out", str(b)]) == 0
+    assert (a / "modes.csv").read_text() == (b / "modes.csv").read_text()
+
+
+BAR = """kind = "bar"
+[geometry]
+L = 1.0
+[material]
+E = 1.0
+rho = 1.0
+[[obstacles]]
+x = 0
+[initial]
+v0 = -1.0
+[time]
+dt = 1e-3
+T = 1.5
+"""
+
+
+def test_a_bar_section_is_its_area(tmp_path, capsys):
+    """[section] A = 2 (no I: a bar does not bend) runs, its forces A times the
+    per-section ones; a bar's section with I is refused in one line."""
+    per, area = tmp_path / "per", tmp_path / "area"
+    assert exit_code(run_main, [str(write(tmp_path, BAR, "per.toml")), "--out", str(per),
+                                "--format", "none"]) == 0
+    assert exit_code(run_main, [str(write(tmp_path, BAR + "[section]\nA = 2.0\n", "a.toml")),
+                                "--out", str(area), "--format", "none"]) == 0
+    f1 = np.genfromtxt(per / "timeseries.csv", delimiter=",", names=True)["contact_force"]
+    f2 = np.genfromtxt(area / "timeseries.csv", delimiter=",", names=True)["contact_force"]
+    assert np.nanmax(np.abs(f1)) > 0.5
+    np.testing.assert_allclose(f2, 2.0 * f1, rtol=1e-12, atol=1e-12)
+    assert json.loads((area / "summary.json").read_text())["units"]["contact_force"] == "N"
+    bad = tmp_path / "bad"
+    bad.mkdir()
+    assert_refused(run_main, [str(write(tmp_path, BAR + "[section]\nI = 1e-8\nA = 2.0\n",
+                                        "i.toml")), "--out", str(bad / "run")],
+                   "a bar has no I", capsys, bad)
+
+
+def test_a_held_beam_observes_its_largest_first_mode_amplitude(tmp_path):
+    """A pinned–pinned tube's default series is not identically zero: it observes the
+    node of largest first-mode amplitude (mid-span, by symmetry of the shipped tube), and
+    summary.json says where and why."""
+    out = tmp_path / "hx"
+    assert exit_code(run_main, [str(example("heat_exchanger_tube")), "--set", "time.T=0.05",
+                                "--out", str(out), "--format", "none"]) == 0
+    s = json.loads((out / "summary.json").read_text())
+    pb = load(example("heat_exchanger_tube")).problem
+    m = modes(pb, 1)
+    nodes = pb.nodes
+    x_peak = nodes[np.argmax(np.abs(np.interp(nodes, m.x, m.shapes[:, 0])))]
+    assert s["observed_x"] == pytest.approx(x_peak) == pytest.approx(pb.beam.L / 2)
+    assert "the end at L is held" in s["units"]["tip_displacement"]
+    tip = np.genfromtxt(out / "timeseries.csv", delimiter=",", names=True)["tip_displacement"]
+    assert np.abs(tip).max() > 1e-4
+
+
+def test_a_free_tip_is_still_observed_at_the_tip(tmp_path):
+    out = tmp_path / "ps"
+    assert exit_code(run_main, [str(example("point_stops")), "--set", "time.T=0.01",
+                                "--out", str(out), "--format", "none"]) == 0
+    s = json.loads((out / "summary.json").read_text())
+    assert s["observed_x"] == pytest.approx(1.501) and "held" not in s["units"]["tip_displacement"]

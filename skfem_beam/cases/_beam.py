@@ -38,6 +38,7 @@ def run_beam_case(case: str, problem, spec: RunSpec, stops=(), extra=None) -> in
         "theta": run.theta,
         "element": problem.element, "method": "penalty" if penalty else "contact",
         "kappa_h": kh, "linear_stability_limit_dt": limit,
+        "observed_x": system.view.observed_x or problem.beam.L,
         "units": {**units(rho_S, system), "probes": probe_units(system)},
         "penalty_stiffness_N_per_m": spec.method.stiffness if penalty else None,
         "config": spec.config,
@@ -48,7 +49,7 @@ def run_beam_case(case: str, problem, spec: RunSpec, stops=(), extra=None) -> in
 
     series = Series(beam_columns(system.view, rho_S), events=events)
     return execute(run, spec.options, summary, series,
-                   beam_charts(case, problem, rho_S, stops, extra))
+                   beam_charts(case, problem, rho_S, stops, extra, system.view.observed_x))
 
 
 def stability_warning(system, stepping):
@@ -85,13 +86,19 @@ def beam_columns(view, rho_S):
     return columns
 
 
-def beam_charts(case, problem, rho_S, stops, extra):
-    """The charts of a beam run (and the case's ``extra`` files), from the rows in memory."""
+def beam_charts(case, problem, rho_S, stops, extra, observed_x=None):
+    """The charts of a beam run (and the case's ``extra`` files), from the rows in memory;
+    ``observed_x``: where the default series observes a beam whose end at L is held."""
+    where = "L" if observed_x is None else f"{observed_x:g} m"
+    what = "tip displacement" if observed_x is None else f"displacement at x = {where}"
+
     def finish(folder: Path, data: dict, run):
         t = data["t"]
         about = f"{run.label}, Δt={run.dt:g} s, J={problem.J}, {problem.element}"
-        trajectory_chart(folder / "tip_displacement.png", t, {"ũ(L, t)": data["tip_displacement"]},
-                         stops=stops, title=f"{case}: tip displacement ({about})")
+        trajectory_chart(folder / "tip_displacement.png", t,
+                         {f"ũ({where}, t)": data["tip_displacement"]},
+                         stops=stops if observed_x is None else (),
+                         title=f"{case}: {what} ({about})")
         joules = "energy_J" in data         # in J when the mass per length ρS is known
         energy_chart(folder / "energy.png", t, data["energy_J" if joules else "energy"],
                      title=f"{case}: discrete energy ½E_β ({about})",
@@ -118,8 +125,12 @@ def units(rho_S, system) -> dict:
     frame = ("ũ(L) = u(L) + h(L)φ(t): the physical displacement in the fixed frame, "
              "support motion included" if lift is not None else "u(L): the support is at rest")
     per_mass = "per unit mass per length (the equation is divided by ρS)"
+    x = system.view.observed_x if system.view is not None else None
+    held = "" if x is None else (f"at x = {x:g} m, not at L: the end at L is held, so the "
+                                 "default series observes the node of largest first-mode "
+                                 "amplitude (add --probe X for others); ")
     out = {"t": "s", "displacement": "m",
-           "tip_displacement": f"m, {frame}",
+           "tip_displacement": f"m, {held}{frame}",
            "tip_velocity": "m/s, backward difference of u(L)"
                            + (" plus h(L)φ'(t)" if lift is not None else ""),
            "energy": f"½E_β, m³/s² {per_mass}; of u, relative to the lifted support motion",

@@ -48,12 +48,14 @@ FORMATS = ("xdmf", "vtu", "both", "none")
 
 
 def physical_tip(view, t, u_tip, v_tip):
-    """(ũ(L, t), ũ_t(L, t)) from the lifted tip values u(L), v(L) at times t:
-    u + h(L)φ(t) and v + h(L)φ'(t) for any lifting (``view.lift``).  h(L) within 1e-9 of
-    0 is 0 (the paper's h(L) is −5.6e-17 in floating point), and then u, v are returned
-    as they are: the papers' columns stay bit for bit."""
+    """(ũ(X, t), ũ_t(X, t)) from the lifted observed values u(X), v(X) at times t, X the
+    tip L (or ``view.observed_x`` where the end at L is held): u + h(X)φ(t) and
+    v + h(X)φ'(t) for any lifting (``view.lift``).  h(X) within 1e-9 of 0 is 0 (the
+    paper's h(L) is −5.6e-17 in floating point), and then u, v are returned as they are:
+    the papers' columns stay bit for bit."""
     lift = None if view is None else view.lift
-    hL = 0.0 if lift is None else float(lift.h(np.array([view.L]))[0])
+    X = view.L if view is None or view.observed_x is None else view.observed_x
+    hL = 0.0 if lift is None else float(lift.h(np.array([X]))[0])
     if abs(hL) <= 1e-9:
         return u_tip, v_tip
     t = np.asarray(t, dtype=float)

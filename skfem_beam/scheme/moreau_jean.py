@@ -313,13 +313,12 @@ class MoreauJean(Run):
 
 
 def moreau_jean(system, dt: float, T: float, theta: float = 0.5, restitution: float = 0.0,
-                save_every: int = 1, frames: int = 200, progress: bool | None = None,
-                chunk: int = 20000) -> Result:
+                save_every: int = 1, frames: int = 200, progress: bool | None = None) -> Result:
     """Integrate ``system`` over [0, T] with Moreau–Jean (θ-scheme, Newton impact law
-    with coefficient ``restitution``); the :class:`Result` of :func:`solve`, with
-    ``beta`` holding θ and ``solver`` the method's name."""
+    with coefficient ``restitution``): ``solve(..., method=methods.MoreauJean(theta,
+    restitution))``, whose :class:`Result` has ``theta`` and ``beta`` None."""
     from .solve import solve
     from ..methods import MoreauJean as Method
     return solve(system, dt, T, method=Method(theta, restitution), save_every=save_every,
-                 frames=frames, progress=progress, chunk=chunk)
+                 frames=frames, progress=progress)
 

@@ -15,8 +15,7 @@ MAX_VALUES = 2 * 10**8    # saved values a Result may hold (1.6 GB)
 def solve(system, dt: float, T: float, beta: float | None = None,
           solver: str | ContactLaw = "auto", stiffness: float | None = None,
           save_every: int = 1, frames: int = 200, progress: bool | None = None,
-          chunk: int = 20000, load_window: str = "forward", growth_limit: float = 10.0,
-          method=None) -> Result:
+          load_window: str = "forward", growth_limit: float = 10.0, method=None) -> Result:
     """Integrate ``system`` over [0, T] with step ``dt``, in the style of ``solve_ivp``.
 
     ``method``: a :mod:`skfem_beam.methods` object, which reaches every class
@@ -49,7 +48,7 @@ def solve(system, dt: float, T: float, beta: float | None = None,
                          f"least {math.ceil(stepping.save_every * values / MAX_VALUES)}, or "
                          f"run it from the command line, which streams them to disk")
     run = method.build(system, stepping)
-    drive(run, chunk, progress)
+    drive(run, progress=progress)
     return run.result()
 
 

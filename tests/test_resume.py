@@ -123,3 +123,53 @@ def test_a_run_killed_after_its_last_checkpoint_resumes_at_once(tmp_path):
     for name in ("timeseries.csv", "impacts.csv"):
         assert (out / name).read_bytes() == (ref / name).read_bytes(), name
     assert json.loads(path.read_text())["status"] == "success"
+
+
+def test_a_failed_resume_of_a_moved_folder_leaves_it_resumable(tmp_path, monkeypatch, capsys):
+    """A stopped run copied to another folder (its config names the old one), resumed
+    there, the resume failing before its first checkpoint (a full disk): the folder still
+    resumes, to the files of the uninterrupted run.  The checkpoint is the one truth and
+    the output path is no part of a run's identity."""
+    ref, a = tmp_path / "ref", tmp_path / "a"
+    base = ["--T", "0.1", "--format", "none", "--flush-every", "500"]
+    assert exit_code(point_stops.main, base + ["--out", str(ref)]) == 0
+    subprocess.run(CASE + base + ["--out", str(a), "--checkpoint-every", "0"], check=True,
+                   capture_output=True)
+    path = a / "summary.json"
+    path.write_text(json.dumps({**json.loads(path.read_text()), "status": "running"}))
+    b = tmp_path / "moved" / "b"
+    b.parent.mkdir()
+    os.rename(a, b)
+
+    def full_disk(run, *args, **kw):
+        raise OSError(errno.ENOSPC, "No space left on device")
+    monkeypatch.setattr(runner, "drive", full_disk)
+    assert exit_code(point_stops.main, ["--resume", str(b)]) == 3
+    s = json.loads((b / "summary.json").read_text())
+    assert s["status"] == "failed" and s["checkpoint_step"] == 2000
+    monkeypatch.undo()
+    capsys.readouterr()
+    assert exit_code(point_stops.main, ["--resume", f"{b}/"]) == 0, capsys.readouterr().err
+    for name in ("timeseries.csv", "impacts.csv"):
+        assert (b / name).read_bytes() == (ref / name).read_bytes(), name
+
+
+@pytest.mark.parametrize("sig, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
+def test_a_signal_during_the_charts_gives_its_exit_code(tmp_path, monkeypatch, capsys, sig,
+                                                        code):
+    """SIGTERM/SIGINT while the charts are drawn (after the last step): the files are
+    complete (status "success"), and the exit code is the signal's, with one line."""
+    from skfem_beam.cases import _beam
+    chart = _beam.trajectory_chart
+
+    def signalled(*args, **kw):
+        os.kill(os.getpid(), sig)
+        return chart(*args, **kw)
+    monkeypatch.setattr(_beam, "trajectory_chart", signalled)
+    out = tmp_path / "run"
+    capsys.readouterr()
+    assert exit_code(point_stops.main, ["--T", "0.05", "--format", "none", "--out",
+                                        str(out)]) == code
+    err = [e for e in capsys.readouterr().err.splitlines() if not e.startswith("compiling")]
+    assert len(err) == 1 and "results are complete" in err[0], err
+    assert json.loads((out / "summary.json").read_text())["status"] == "success"

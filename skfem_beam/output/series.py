@@ -357,11 +357,15 @@ def read_summary(folder: Path) -> dict:
     return summary
 
 
+NOT_IDENTITY = {"out", "overwrite"}   # a folder moved, copied or spelled another way resumes
+
+
 def check_resumable(folder: Path, summary: dict, ck: dict, extend: bool) -> None:
     """Refuse a resume whose summary, checkpoint and rows on disk do not agree."""
     name = f"{Path(folder) / SUMMARY}"
     mine, theirs = _plain(summary["config"]), ck["config"]
-    diff = sorted(k for k in set(mine) | set(theirs) if mine.get(k) != theirs.get(k)
+    diff = sorted(k for k in (set(mine) | set(theirs)) - NOT_IDENTITY
+                  if mine.get(k) != theirs.get(k)
                   # an extension (--T longer) stopped before its first checkpoint
                   and not (k == "T" and _longer(mine.get(k), theirs.get(k))))
     if diff:
@@ -507,6 +511,9 @@ def execute(run: Run, options: OutputOptions, summary: dict, series, finish) -> 
     if resume:
         ck = read_checkpoint(out)       # checked again: the lock is held since the parse
         used = _restore(run, ck)
+        # the checkpoint is the one truth: a resume that stops before its first new
+        # checkpoint leaves a summary that still names it
+        summary = {**summary, "checkpoint_step": int(ck["n"])}
     with _Signals() as stop:
         folder = Folder.open(out, summary, overwrite=options.overwrite, resume=resume)
         try:
@@ -531,7 +538,13 @@ def _stream(run, folder, options, series, finish, stop, used, ck, can_checkpoint
     except OSError as e:
         return s.failed_write(e)
     final = folder.close(**entries)
-    return report(final, folder.path)
+    code = report(final, folder.path)
+    if stop.signum is not None:     # during the charts or the summary: nothing is missing
+        name = signal.Signals(stop.signum).name
+        print(f"interrupted by {name} after the run's last step: its results are complete "
+              f"(status {final['status']})", file=sys.stderr)
+        return 128 + stop.signum
+    return code
 
 
 class _Stream:

@@ -15,7 +15,7 @@ from . import __version__
 from . import methods
 from .contact import SOLVERS
 from .checks import check_choice, check_positive
-from .errors import InputError, SolverError
+from .errors import Deferred, InputError, SolverError
 from .output.folder import (EXIT_INPUT, EXIT_SOLVER, EXIT_UNSTABLE, OPENED,  # noqa: F401
                             Interrupted, release, report, stamp)
 from .output.options import OutputOptions
@@ -153,6 +153,9 @@ def mesh_nodes(args):
 
 
 def _terminate(signum, frame):
+    if Deferred.holding:        # the kernels are loading: raised after (errors.Deferred)
+        Deferred.pending.append(signum)
+        return
     raise Interrupted(signum)
 
 
@@ -163,8 +166,8 @@ def main_guard(main) -> None:
     (a run in progress handles both itself: it stops at a chunk and keeps its files);
     the exit code is 128 + the signal.  Folder locks are released on any exit."""
     opened = len(OPENED)
-    old = signal.signal(signal.SIGTERM, _terminate) \
-        if threading.current_thread() is threading.main_thread() else None
+    old = {sig: signal.signal(sig, _terminate) for sig in (signal.SIGINT, signal.SIGTERM)} \
+        if threading.current_thread() is threading.main_thread() else {}
     try:
         code = main()
     except InputError as e:
@@ -184,8 +187,9 @@ def main_guard(main) -> None:
         sys.exit(getattr(e, "code", 130))
     finally:
         release()
-        if old is not None:
-            signal.signal(signal.SIGTERM, old)
+        Deferred.pending.clear()
+        for sig, handler in old.items():
+            signal.signal(sig, handler)
     sys.exit(code or 0)
 
 

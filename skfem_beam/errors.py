@@ -1,4 +1,5 @@
 """The project's own error types: every bad input or failed run ends in one of them."""
+import signal
 
 
 class InputError(ValueError):
@@ -7,3 +8,34 @@ class InputError(ValueError):
 
 class SolverError(RuntimeError):
     """A contact solver failed on a step (the message names the step and time)."""
+
+
+class Interrupted(KeyboardInterrupt):
+    """SIGINT or SIGTERM; ``signum`` says which (exit code 128 + signum)."""
+
+    def __init__(self, signum: int = signal.SIGINT):
+        super().__init__(signal.Signals(signum).name)
+        self.signum = int(signum)
+
+    @property
+    def code(self) -> int:
+        return 128 + self.signum
+
+
+class Deferred:
+    """While the numerical kernels compile or load, a signal is kept, not raised: raised
+    inside one of numba's ctypes callbacks it would be printed and lost ("Exception
+    ignored"), and the run would go on.  The command line's handler asks ``holding``;
+    leaving the block raises the signal kept, if any."""
+    holding = False
+    pending: list = []
+
+    def __enter__(self):
+        Deferred.holding = True
+        return self
+
+    def __exit__(self, *exc):
+        Deferred.holding = False
+        if Deferred.pending and exc[0] is None:
+            raise Interrupted(Deferred.pending.pop())
+        return False

@@ -31,11 +31,11 @@ def _run_case(module, main, monkeypatch, argv):
     kept = {}
     real = module.execute
 
-    def execute(run, out, args, summary, series, finish):
+    def execute(run, options, summary, series, finish):
         def keep(folder, data, run_):
             kept.update(data=data, run=run_)
             return finish(folder, data, run_)
-        return real(run, out, args, summary, series, keep)
+        return real(run, options, summary, series, keep)
 
     monkeypatch.setattr(module, "execute", execute)
     assert exit_code(main, argv) == 0

@@ -18,7 +18,6 @@ import fcntl
 import json
 import os
 import shutil
-import signal
 import sys
 import tempfile
 import time
@@ -28,25 +27,13 @@ import numpy as np
 import orjson
 
 from .. import __version__
-from ..errors import InputError, SolverError
+from ..errors import InputError, Interrupted, SolverError  # noqa: F401 (Interrupted: here too)
 
 EXIT_INPUT, EXIT_SOLVER, EXIT_UNSTABLE = 2, 3, 4
 SUMMARY = "summary.json"
 LOCK = ".lock"          # flock'ed by the one process writing the folder
 RESERVE = ".reserve"    # a little disk kept back, freed to write the final summary
 OURS = (LOCK, RESERVE)
-
-
-class Interrupted(KeyboardInterrupt):
-    """SIGINT or SIGTERM; ``signum`` says which (exit code 128 + signum)."""
-
-    def __init__(self, signum: int = signal.SIGINT):
-        super().__init__(signal.Signals(signum).name)
-        self.signum = int(signum)
-
-    @property
-    def code(self) -> int:
-        return 128 + self.signum
 
 
 _HELD: dict[Path, int] = {}     # folder → descriptor of its locked .lock, in this process

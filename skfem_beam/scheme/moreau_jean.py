@@ -45,7 +45,7 @@ from ..checks import check_finite
 from ..contact.active_set import box_qp
 from ..contact.base import ContactLaw
 from ..contact.restitution import Restitution
-from ..errors import InputError
+from ..errors import Deferred, InputError
 from ..linalg import Banded, band_solve, rows_dot, rows_matvec
 from .beta import observers, penetration_samples
 from .kernels import (FAILED, ITERATIONS, ROW0, STOPPED_AT, UNSTABLE, Inputs, Series,
@@ -309,7 +309,8 @@ class MoreauJean(Run):
 
     def __init__(self, system, stepping: Stepping, theta: float = 0.5,
                  restitution: float = 0.0):
-        self._drive(MoreauJeanScheme(system, stepping, theta, restitution))
+        with Deferred():           # signals wait while the kernels compile or load
+            self._drive(MoreauJeanScheme(system, stepping, theta, restitution))
 
 
 def moreau_jean(system, dt: float, T: float, theta: float = 0.5, restitution: float = 0.0,

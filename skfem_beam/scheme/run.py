@@ -9,7 +9,7 @@ import time
 import numpy as np
 
 from ..contact import ContactLaw
-from ..errors import InputError, SolverError
+from ..errors import Deferred, InputError, SolverError
 from ..stability import kappa_h, linear_limit
 from .beta import BetaScheme
 from .kernels import (EVENTS_FULL, EVENTS_WRITTEN, FAILED, ROW0, STOPPED_AT, UNSTABLE,
@@ -67,7 +67,8 @@ class Run:
     _next = ((-1, -1), None)   # the next chunk's (n0, n1) and inputs, computed ahead (advance)
 
     def __init__(self, system, stepping: Stepping, law: str | ContactLaw = "auto"):
-        self._drive(BetaScheme(system, stepping, law))
+        with Deferred():           # signals wait while the kernels compile or load
+            self._drive(BetaScheme(system, stepping, law))
 
     def _drive(self, scheme) -> None:
         """Take ``scheme`` (a one-step integrator: BetaScheme, MoreauJeanScheme) from its

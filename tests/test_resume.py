@@ -173,3 +173,36 @@ def test_a_signal_during_the_charts_gives_its_exit_code(tmp_path, monkeypatch, c
     err = [e for e in capsys.readouterr().err.splitlines() if not e.startswith("compiling")]
     assert len(err) == 1 and "results are complete" in err[0], err
     assert json.loads((out / "summary.json").read_text())["status"] == "success"
+
+
+@pytest.mark.parametrize("phase", runner.PHASES)
+def test_killed_at_each_phase_of_its_end_a_run_resumes_to_the_same_files(tmp_path, phase):
+    """SIGKILL at every boundary of a run's end (after the last chunk, after the final
+    checkpoint, after the charts, after impacts.csv, before the final summary), then
+    --resume: the uninterrupted run's timeseries.csv and impacts.csv, byte for byte, and
+    "success", each resume under a timeout (no loop)."""
+    base = CASE + ["--T", "0.1", "--format", "xdmf", "--frames", "5", "--flush-every", "300",
+                   "--checkpoint-every", "0"]
+    ref, out = tmp_path / "ref", tmp_path / "out"
+    subprocess.run(base + ["--out", str(ref)], check=True, capture_output=True)
+    killed = subprocess.run(base + ["--out", str(out)], capture_output=True,
+                            env={**os.environ, "SKFEM_BEAM_KILL_AT": phase})
+    assert killed.returncode == -signal.SIGKILL
+    assert json.loads((out / "summary.json").read_text())["status"] == "running"
+    p = subprocess.run(CASE + ["--resume", str(out)], capture_output=True, text=True,
+                       timeout=120)
+    assert p.returncode == 0, p.stderr
+    for name in ("timeseries.csv", "impacts.csv"):
+        assert (out / name).read_bytes() == (ref / name).read_bytes(), name
+    assert json.loads((out / "summary.json").read_text())["status"] == "success"
+    assert h5_datasets(out / "fields.h5") == h5_datasets(ref / "fields.h5")
+
+
+def h5_datasets(path):
+    """Every dataset of an HDF5 file, name → bytes of its values."""
+    import h5py
+    found = {}
+    with h5py.File(path, "r") as f:
+        f.visititems(lambda name, obj: found.update({name: obj[()].tobytes()})
+                     if isinstance(obj, h5py.Dataset) else None)
+    return found

@@ -523,6 +523,17 @@ def execute(run: Run, options: OutputOptions, summary: dict, series, finish) -> 
             folder.release()
 
 
+PHASES = ("last-chunk", "final-checkpoint", "charts", "impacts", "summary")
+
+
+def phase(name: str) -> None:
+    """A test hook: the environment variable SKFEM_BEAM_KILL_AT=<name> (one of PHASES, the
+    boundaries of a run's end) makes the process SIGKILL itself there, as a scheduler or a
+    power cut would (tests/test_resume.py resumes each to the uninterrupted files)."""
+    if os.environ.get("SKFEM_BEAM_KILL_AT") == name:
+        os.kill(os.getpid(), signal.SIGKILL)
+
+
 def _stream(run, folder, options, series, finish, stop, used, ck, can_checkpoint) -> int:
     """The body of :func:`execute`, in the open ``folder``: the run to its end, or what a
     stop (signal, failed solver, failed write) leaves and says."""
@@ -537,6 +548,7 @@ def _stream(run, folder, options, series, finish, stop, used, ck, can_checkpoint
         raise
     except OSError as e:
         return s.failed_write(e)
+    phase("summary")
     final = folder.close(**entries)
     code = report(final, folder.path)
     if stop.signum is not None:     # during the charts or the summary: nothing is missing
@@ -592,8 +604,10 @@ class _Stream:
             self.fields = _Fields(self.folder.path, run, fmt, series) if fmt != "none" else None
             self.on_chunk(run)              # state 1 (and, on resume, the frames so far)
             drive(run, chunk=self.options.flush_every, on_chunk=self.on_chunk)
+            phase("last-chunk")
             if self.can_checkpoint and run.status == "success":
                 self.save_checkpoint()      # so that --resume DIR --T longer extends it
+                phase("final-checkpoint")
         finally:
             if self.rows is not None:
                 self.rows.close()
@@ -602,7 +616,9 @@ class _Stream:
         data = self.rows.data()
         entries = outcome(run.result(), data)
         entries.update(finish(self.folder.path, data, run) or {})
+        phase("charts")
         entries.update(self.write_events(run.n, quiet=False))
+        phase("impacts")
         return entries
 
     def write_events(self, last: int, quiet: bool = True) -> dict:

@@ -151,16 +151,8 @@ def make(law: str = "position", solver: str = "auto", restitution: float = 0.0,
             raise InputError(f"{words.massless}{massless} applies to the β-scheme "
                              f"({words.law}position); {words.law}{law} does not take it")
         return MoreauJean(0.5, e)
-    if law == "penalty":
-        if e > 0:
-            raise InputError(f"restitution={e:g} is a law of its own (exact contact with a "
-                             f"coefficient of restitution): it cannot be combined with "
-                             f"stiffness=")
-        if solver not in ("auto", "penalty"):
-            raise InputError(f"solver={solver!r} cannot be combined with stiffness= (the "
-                             f"penalty law): pass one of them")
-        if stiffness is None:
-            raise InputError("solver='penalty' needs stiffness= (the spring stiffness 1/ε)")
+    if law == "penalty":     # the registry's checks: no solver, no restitution with springs
+        resolve("penalty" if solver == "auto" else solver, stiffness, e)
         return Penalty(stiffness, massless=massless or "beta")
     check_choice(_name(words.solver), solver, SOLVERS)
     return PositionLevel(solver, e, massless or "beta")

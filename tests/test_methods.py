@@ -114,3 +114,23 @@ def test_python_laws_take_moving_bounds(solver):
     shift = np.outer(s.bound_motion(r.t), s.bound_shift)
     assert np.maximum(s.lo + shift - y, y - s.hi - shift).max() <= 1e-12
     assert np.abs(r.observed["y0"] - ref.observed["y0"]).max() <= 1e-10
+
+
+@pytest.mark.parametrize("solver", ["osqp", "daqp"])
+def test_python_laws_killed_after_a_checkpoint_resume_byte_for_byte(tmp_path, solver):
+    """SIGKILL after the last chunk (test hook SKFEM_BEAM_KILL_AT), so the resume starts
+    from the last periodic checkpoint, mid-run: the timeseries.csv and impacts.csv of an
+    uninterrupted run of the same solver."""
+    import os
+    import signal
+    args = PS + ["--solver", solver, "--T", "0.15", "--checkpoint-every", "0"]
+    ref, out = tmp_path / "ref", tmp_path / "out"
+    subprocess.run(args + ["--out", str(ref)], check=True, capture_output=True)
+    killed = subprocess.run(args + ["--out", str(out)], capture_output=True,
+                            env={**os.environ, "SKFEM_BEAM_KILL_AT": "last-chunk"})
+    assert killed.returncode == -signal.SIGKILL
+    with np.load(out / "checkpoint.npz") as ck:
+        assert 0 < int(ck["n"]) < 1500 and "solver_active" in ck.files
+    subprocess.run(PS + ["--resume", str(out)], check=True, capture_output=True, timeout=120)
+    for name in ("timeseries.csv", "impacts.csv"):
+        assert (out / name).read_bytes() == (ref / name).read_bytes(), name

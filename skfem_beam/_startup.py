@@ -1,8 +1,19 @@
-"""A command's first second: the imports (numpy, scipy, matplotlib, ...) run before its
-own signal handlers exist, and a Ctrl-C there would end in an ImportError traceback."""
+"""A command's first and last moments, when its own signal handlers do not exist.
+
+First: the imports (numpy, scipy, matplotlib, ...) run before ``cli.main_guard``
+installs its handlers, and a Ctrl-C there would end in an ImportError traceback.
+Last: Python's finalisation resets the signal handlers to the default before it tears
+the modules down (~0.2 s with numba and matplotlib loaded), so a SIGTERM then killed
+the finished command silently; a command process therefore runs its exit handlers
+itself and ends with ``os._exit`` (`end`)."""
+import atexit
 import os
 import signal
+import sys
 import threading
+
+SIGNALS = (signal.SIGINT, signal.SIGTERM)
+COMMAND = False     # this process is a ``python -m skfem_beam...`` command
 
 
 def _leave(signum, frame):
@@ -14,6 +25,38 @@ def _leave(signum, frame):
 def exit_on_signals() -> None:
     """SIGINT and SIGTERM end the process with one line and 128 + the signal, until
     ``cli.main_guard`` installs the command's handlers."""
+    global COMMAND
     if threading.current_thread() is threading.main_thread():
-        for sig in (signal.SIGINT, signal.SIGTERM):
+        COMMAND = True
+        for sig in SIGNALS:
             signal.signal(sig, _leave)
+
+
+def _ending(signum, frame):
+    name = signal.Signals(signum).name
+    os.write(2, f"interrupted by {name} while exiting: the command had finished\n".encode())
+    os._exit(128 + signum)
+
+
+def end(code: int) -> None:
+    """The command's exit with ``code`` (sys.exit outside a command process, e.g. in
+    tests).  What Python's finalisation does first runs here, with a handler (a signal
+    meanwhile: one line, 128 + the signal): its threads are joined and its exit handlers
+    run; the streams are flushed, then the signals are blocked and a pending one still
+    honoured.  The module teardown, which would run with default handlers, is skipped."""
+    if not COMMAND or threading.current_thread() is not threading.main_thread():
+        sys.exit(code)
+    for sig in SIGNALS:
+        signal.signal(sig, _ending)
+    threading._shutdown()       # what finalisation does first: threads' exit hooks, joins
+    atexit._run_exitfuncs()
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):
+            pass
+    signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
+    pending = sorted(set(signal.sigpending()) & set(SIGNALS))
+    if pending:
+        _ending(pending[0], None)
+    os._exit(code)

@@ -11,7 +11,7 @@ import sys
 import threading
 from pathlib import Path
 
-from . import __version__
+from . import __version__, _startup
 from . import methods
 from .contact import SOLVERS
 from .checks import check_choice, check_positive
@@ -169,28 +169,29 @@ def main_guard(main) -> None:
     old = {sig: signal.signal(sig, _terminate) for sig in (signal.SIGINT, signal.SIGTERM)} \
         if threading.current_thread() is threading.main_thread() else {}
     try:
-        code = main()
-    except InputError as e:
+        code = main() or 0
+    except SystemExit as e:     # argparse's own exits (--help, a bad flag)
+        code = e.code if isinstance(e.code, int) else (0 if e.code is None else 1)
+        if isinstance(e.code, str):
+            print(e.code, file=sys.stderr)
+    except (InputError, SolverError) as e:
         print(f"error: {e}", file=sys.stderr)
-        sys.exit(EXIT_INPUT)
-    except SolverError as e:
-        print(f"error: {e}", file=sys.stderr)
-        sys.exit(EXIT_SOLVER)
+        code = EXIT_INPUT if isinstance(e, InputError) else EXIT_SOLVER
     except OSError as e:   # disk full, folder removed under us, ...
         print(f"error: could not write the results: {e}", file=sys.stderr)
-        sys.exit(EXIT_SOLVER)
+        code = EXIT_SOLVER
     except KeyboardInterrupt as e:
         name = signal.Signals(getattr(e, "signum", signal.SIGINT)).name
         where = f"see {OPENED[-1] / 'summary.json'}" if len(OPENED) > opened \
             else "no output written"
         print(f"interrupted by {name}: {where}", file=sys.stderr)
-        sys.exit(getattr(e, "code", 130))
+        code = getattr(e, "code", 130)
     finally:
         release()
         Deferred.pending.clear()
         for sig, handler in old.items():
             signal.signal(sig, handler)
-    sys.exit(code or 0)
+    _startup.end(code)
 
 
 def warn(message: str) -> None:

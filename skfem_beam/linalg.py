@@ -1,4 +1,4 @@
-"""Banded symmetric algebra for the compiled time loop.
+"""Banded symmetric (and CSR) algebra for the compiled time loop.
 
 Matrices of the schemes are symmetric and banded (half bandwidth kd = 3 for cubic
 Hermite and cubic B-splines, 1 for P1).  They are kept in LAPACK's upper band format,
@@ -125,3 +125,13 @@ def rows_dot(P, x, z):
     for j in range(max(kd, n - kd), n):
         s += x[j] * _edge_row(P, z, j)
     return s
+
+
+@njit(cache=True)
+def csr_product(Rp, Ri, Rx, u, y):
+    """y ← R u for R given as CSR arrays."""
+    for r in range(y.size):
+        s = 0.0
+        for p in range(Rp[r], Rp[r + 1]):
+            s += Rx[p] * u[Ri[p]]
+        y[r] = s

@@ -275,14 +275,15 @@ def _matlab_value(value):
     return value
 
 
-def variables(run: SavedRun) -> dict:
+def variables(run: SavedRun, matlab: bool = True) -> dict:
     """The run as flat named arrays: series columns under their own names, field arrays
     as ``fields_<name>`` (frames × points) with ``fields_t`` and ``fields_x``, impacts as
-    ``impacts_<column>``, other tables as ``<stem>_<column>``; every name MATLAB-valid."""
+    ``impacts_<column>``, other tables as ``<stem>_<column>``; with ``matlab`` every name
+    made MATLAB-valid (``probe_0.6_displacement`` → ``probe_0_6_displacement``)."""
     out: dict = {}
 
     def put(name, value):
-        out[matlab_name(name, out)] = value
+        out[matlab_name(name, out) if matlab else name] = value
 
     for k, v in run.series.items():
         put(k, v)
@@ -311,7 +312,7 @@ def export(folder, to: str, out=None) -> Path:
     if not out.parent.is_dir():
         raise InputError(f"--out {out}: folder {out.parent} does not exist")
     run = read_run(folder)
-    data = variables(run)
+    data = variables(run, matlab=to == "mat")
     tmp = out.with_name(f".{out.stem}.{os.getpid()}.tmp{out.suffix}")
     try:
         if to == "npz":

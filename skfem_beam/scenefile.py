@@ -694,7 +694,7 @@ def modes_main(argv) -> int:
         out.mkdir(parents=True, exist_ok=True)
         with open(out / "modes.csv", "w", newline="") as fh:
             w = csv.writer(fh)
-            w.writerow(["mode", "f_Hz", "omega_rad_s"] + [f"u({float(x)!r})" for x in m.x])
+            w.writerow(["mode", "f_Hz", "omega_rad_s"] + [f"u({float(x):.12g})" for x in m.x])
             for i in range(m.f.size):
                 w.writerow([i + 1, f"{m.f[i]:.17g}", f"{m.omega[i]:.17g}"]
                            + [f"{u:.17g}" for u in m.shapes[:, i]])

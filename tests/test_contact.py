@@ -239,8 +239,8 @@ def test_engines_agree_on_random_step_sequences(m, kind):
 def test_grazing_contacts_are_decided_exactly():
     """Bounds moved onto (or within 1e-13..1e-9 of) the free values' solution: the
     degenerate case where an ε-accurate engine cannot tell active from inactive.
-    box_qp and daqp stay exact; OSQP is exact or raises SolverError (its polishing
-    can fail there, ~1 % of such problems), never silently wrong."""
+    box_qp and daqp stay exact; OSQP is exact (its set repaired by the exact finish) or
+    raises SolverError, never silently wrong."""
     rng = np.random.default_rng(21)
     worst, osqp_ok, n = 0.0, 0, 0
     for _ in range(30):
@@ -278,7 +278,8 @@ def test_grazing_contacts_are_decided_exactly():
 
 
 def test_osqp_is_quiet_and_free_steps_are_exact(capfd):
-    """No "Polishing not needed" on the terminal; a step without contact gives μ = 0."""
+    """Nothing on the terminal (OSQP 1.x prints "Polishing not needed" with polishing on);
+    a step without contact gives μ = 0."""
     rng = np.random.default_rng(5)
     A, C, lo, hi, D, W = step_problem(rng, 10, one_sided=0.0)
     s = OSQPSolver(A, C, lo, hi, D)
@@ -304,6 +305,32 @@ def test_engine_failures_raise_solver_error():
 
 
 # ---------------------------------------------------------------- a run, every solver
+@pytest.mark.parametrize("solver", ["osqp", "daqp"])
+def test_python_engines_are_called_only_on_steps_in_contact(solver):
+    """A free step inside its bounds has μ = 0 exactly, so the compiled loop does not call
+    the engine: its calls after the start step (solved when the run is built) are the
+    steps in contact, and the run equals the active set's (flat obstacles, J = 40)."""
+    from skfem_beam import methods
+    from skfem_beam.scheme.kernels import CONTACT_STEPS
+    from skfem_beam.scheme.solve import drive
+    from skfem_beam.scheme.stepping import Stepping
+    system = beam_system(scenes.flat_obstacles(J=40))
+    runs = {}
+    for name in (solver, "active-set"):
+        runs[name] = methods.of(name).build(system, Stepping(1e-3, 0.3, 0.5, frames=300))
+    engine, calls = runs[solver].pysolver, []
+    engine_solve = engine.solve
+    engine.solve = lambda *a: calls.append(1) or engine_solve(*a)
+    for run in runs.values():
+        drive(run, progress=False)
+    in_contact = int(runs[solver].st.counters[CONTACT_STEPS])
+    assert 30 < in_contact < 200
+    assert len(calls) == in_contact
+    a, b = runs[solver].result(), runs["active-set"].result()
+    assert a.impacts == b.impacts > 0
+    assert np.abs(a.frames_u - b.frames_u).max() <= 1e-10 * np.abs(b.frames_u).max()
+
+
 @pytest.mark.parametrize("element", ["hermite", "bspline"])
 def test_all_solvers_give_the_same_run(element):
     """200 steps of the convex-obstacle scene: every solver, every step, to 1e-8."""

@@ -7,6 +7,7 @@ rows and resumes once there is room; every output flag checked.
 """
 import json
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -137,7 +138,8 @@ def test_kill_interrupt_terminate_then_resume_is_identical(reference, tmp_path):
 
 
 class GivesUp(ContactLaw):
-    """Lemma 4.1's projection solved in Python, failing at its ``calls``-th step."""
+    """Lemma 4.1's projection solved in Python, failing at its ``calls``-th call (the
+    loop calls it on the start step and on the steps in contact)."""
     name = "gives-up"
 
     def __init__(self, calls):
@@ -157,25 +159,26 @@ class GivesUp(ContactLaw):
 
 
 def test_failed_solver_keeps_the_impacts_so_far(tmp_path, monkeypatch, capsys):
-    """A solver failing at step 6000 of 10,000: exit 3, status "failed", and impacts.csv
-    holds the events up to the state before the failed step, their rows those of the same
-    run with the compiled projection."""
+    """A solver failing at its 430th call (a step in contact, 6 tenths into the run):
+    exit 3, status "failed", and impacts.csv holds the events up to the state before the
+    failed step, their rows those of the same run with the compiled projection."""
     argv = ["--dt", "1e-4", "--T", "1", "--flush-every", "200", "--format", "none"]
     ref = tmp_path / "ref"
     assert exit_code(point_stops.main, argv + ["--out", str(ref)]) == 0
     monkeypatch.setattr(PositionLevel, "build", lambda self, system, stepping:
-                        Run(system, stepping, GivesUp(6001)))   # call 1: the start step
+                        Run(system, stepping, GivesUp(430)))
     out = tmp_path / "run"
     capsys.readouterr()
     assert exit_code(point_stops.main, argv + ["--out", str(out)]) == 3
     err = [e for e in capsys.readouterr().err.splitlines() if not e.startswith("compiling")]
     assert len(err) == 1 and "gave up on purpose" in err[0], err
     s = summary(out)
-    assert s["status"] == "failed" and s["steps"] < 6000
+    t_fail = int(re.search(r"failed at step (\d+)", s["message"])[1]) * 1e-4
+    assert s["status"] == "failed" and s["steps"] * 1e-4 < t_fail and 0.4 < t_fail < 0.8
     imp = read_run(out).impacts
-    assert imp["t_start"].size > 10 and imp["t_end"].max() == pytest.approx(0.6) \
+    assert imp["t_start"].size > 10 and imp["t_end"].max() == pytest.approx(t_fail - 1e-4) \
         or imp["open"].sum() == 0
-    assert impacts_so_far(out, ref, 0.6) >= imp["t_start"].size - 1
+    assert impacts_so_far(out, ref, t_fail) >= imp["t_start"].size - 1
 
 
 HOLD = ("import fcntl, os, sys, time; fd = os.open(sys.argv[1], os.O_RDWR | os.O_CREAT); "
@@ -357,6 +360,33 @@ def test_full_disk_keeps_whole_rows_and_resumes_once_there_is_room(small_disk, t
     subprocess.run(["mount", "-o", "remount,size=16m", str(small_disk)], check=True)
     assert exit_code(point_stops.main, ["--resume", str(out)]) == 0
     assert (out / "timeseries.csv").read_bytes() == (ref / "timeseries.csv").read_bytes()
+    assert summary(out)["status"] == "success"
+
+
+def test_immutable_checkpoint_fails_in_one_line_and_resumes_once_writable(tmp_path, capsys):
+    """A resume that cannot replace its checkpoint (``chattr +i checkpoint.npz``) exits 3
+    with one line naming the cause, not "once there is room", and leaves the folder as it
+    was: once the file is writable the resume gives the uninterrupted run's files."""
+    argv = ["--dt", "5e-5", "--checkpoint-every", "0.02", "--format", "none"]
+    ref, out = tmp_path / "ref", tmp_path / "run"
+    assert exit_code(point_stops.main, argv + ["--T", "0.2", "--out", str(ref)]) == 0
+    assert exit_code(point_stops.main, argv + ["--T", "0.1", "--out", str(out)]) == 0
+    capsys.readouterr()
+    ck = out / "checkpoint.npz"
+    p = subprocess.run(["chattr", "+i", str(ck)], capture_output=True, text=True)
+    if p.returncode:
+        pytest.skip(f"chattr +i needs root and an ext4/xfs folder: {p.stderr.strip()}")
+    try:
+        assert exit_code(point_stops.main, ["--resume", str(out), "--T", "0.2"]) == 3
+        err = capsys.readouterr().err.splitlines()
+        assert len(err) == 1 and "Operation not permitted" in err[0], err
+        assert "chattr -i" in err[0] and "room" not in err[0]
+        assert summary(out)["checkpoint_step"] == 2000
+    finally:
+        subprocess.run(["chattr", "-i", str(ck)], check=True)
+    assert exit_code(point_stops.main, ["--resume", str(out), "--T", "0.2"]) == 0
+    for name in ("timeseries.csv", "impacts.csv"):
+        assert (out / name).read_bytes() == (ref / name).read_bytes()
     assert summary(out)["status"] == "success"
 
 

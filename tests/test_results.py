@@ -86,9 +86,9 @@ def test_beam_run_reads_back_exactly(case, tmp_path, monkeypatch):
         assert np.array_equal(saved.impacts[k], ev[k]), k
     if case == "point_stops":        # rows every step; ũ(L) touches the stops exactly
         assert saved.t.size == 6001 and np.abs(saved["tip_displacement"]).max() == 0.1
-        # the stability limit (inf for β = 1/2) comes back a float, not the string JSON had
-        assert saved.summary["linear_stability_limit_dt"] == np.inf
-        assert "inf" in (out / "summary.json").read_text()
+        # no stability limit at β = 1/2: JSON's null, not the string "inf"
+        assert saved.summary["linear_stability_limit_dt"] is None
+        assert '"linear_stability_limit_dt": null' in (out / "summary.json").read_text()
 
 
 def test_xdmf_and_vtu_give_the_same_frames(tmp_path):
@@ -121,7 +121,8 @@ def test_bar_reads_back_exactly(tmp_path, monkeypatch):
 @pytest.fixture(scope="module")
 def folder(tmp_path_factory):
     out = tmp_path_factory.mktemp("runs") / "pipe"
-    assert exit_code(point_stops.main, ["--T", "0.1", "--frames", "8", "--out", str(out)]) == 0
+    assert exit_code(point_stops.main, ["--T", "0.1", "--frames", "8", "--probe", "0.6",
+                                        "--out", str(out)]) == 0
     return out
 
 
@@ -167,6 +168,7 @@ def test_npz_export_reads_back(folder, tmp_path):
     path = export(folder, "npz", tmp_path / "pipe.npz")
     with np.load(path) as z:
         assert json.loads(str(z["summary_json"])) == json.loads(json.dumps(saved.summary))
+        assert "probe_0.6_displacement" in saved.series   # under its own name, dots and all
         for k, v in saved.series.items():
             assert np.array_equal(z[k], v)
         assert np.array_equal(z["fields_t"], saved.fields.t)
@@ -183,13 +185,14 @@ def test_mat_export_reads_back_with_names_matlab_accepts(folder, tmp_path):
     names = [k for k in m if not k.startswith("__")]
     assert all(MATLAB.match(k) for k in names), names
     for k, v in saved.series.items():        # column vectors, as MATLAB users expect
+        k = k.replace(".", "_")                # probe_0.6_... is probe_0_6_... in MATLAB
         assert m[k].shape == (v.size, 1) and np.array_equal(m[k][:, 0], v)
     assert np.array_equal(m["fields_displacement"], saved.fields["displacement"])
     assert m["fields_displacement_vector"].shape == saved.fields["displacement_vector"].shape
     s = m["summary"][0, 0]
     assert all(MATLAB.match(k) for k in s.dtype.names)
     assert s["impacts"][0, 0] == saved.summary["impacts"]
-    assert str(s["case"][0]) == "point_stops" and s["linear_stability_limit_dt"][0, 0] == np.inf
+    assert str(s["case"][0]) == "point_stops" and s["linear_stability_limit_dt"].size == 0
     config = s["config"][0, 0]
     assert config["J"][0, 0] == 19 and config["mesh"].size == 0      # None: empty matrix
     # default file: inside the run folder, named after it

@@ -8,7 +8,8 @@ import subprocess
 import sys
 import time
 
-CASE = [sys.executable, "-m", "skfem_beam.cases.point_stops", "--T", "1", "--dt", "1e-5",
+# ~2 s: the signals' random instants (≤ 1.6 s) all land before its end
+CASE = [sys.executable, "-m", "skfem_beam.cases.point_stops", "--T", "4", "--dt", "1e-5",
         "--format", "none"]
 
 
@@ -16,6 +17,7 @@ def signalled(out, sig, delay):
     p = subprocess.Popen(CASE + ["--out", str(out)], stdout=subprocess.DEVNULL,
                          stderr=subprocess.PIPE, text=True)
     time.sleep(delay)
+    assert p.poll() is None, f"the command ended before its signal at {delay:.3f} s"
     p.send_signal(sig)
     err = p.communicate(timeout=120)[1].strip().splitlines()
     summary = out / "summary.json"
@@ -38,3 +40,35 @@ def test_sigint_while_importing_is_one_line_and_130(tmp_path):
         code, err, status = signalled(tmp_path / f"i{i}", signal.SIGINT, delay)
         assert code == 130 and len(err) == 1 and "SIGINT" in err[0], (delay, code, err)
         assert status is None
+
+
+END = """
+import atexit, os, signal, sys
+from skfem_beam import _startup
+_startup.COMMAND = True
+print("printed, not yet flushed", end="")
+how = sys.argv[1]
+if how == "during":      # a SIGTERM while the exit handlers run
+    atexit.register(lambda: os.kill(os.getpid(), signal.SIGTERM))
+elif how == "pending":   # one that arrives blocked, just before the end
+    atexit.register(lambda: (signal.pthread_sigmask(signal.SIG_BLOCK, [signal.SIGINT]),
+                             os.kill(os.getpid(), signal.SIGINT)))
+atexit.register(lambda: open(sys.argv[2], "w").close())
+_startup.end(3)
+"""
+
+
+def test_a_signal_while_the_command_exits_is_one_line_and_its_code(tmp_path):
+    """Python's finalisation resets the handlers before its ~0.2 s of module teardown, where
+    a SIGTERM killed a finished command silently; `_startup.end` runs the exit handlers
+    with its own handler, flushes, and honours a signal left pending."""
+    for how, code, line in (("none", 3, None), ("during", 143, "SIGTERM"),
+                            ("pending", 130, "SIGINT")):
+        mark = tmp_path / how
+        p = subprocess.run([sys.executable, "-c", END, how, str(mark)], capture_output=True,
+                           text=True, timeout=60)
+        assert p.returncode == code and p.stdout == "printed, not yet flushed", (how, p)
+        err = p.stderr.strip().splitlines()
+        assert err == ([] if line is None else
+                       [f"interrupted by {line} while exiting: the command had finished"])
+        assert mark.exists() or how == "during"

@@ -1,16 +1,19 @@
 """Soak: runs killed at random instants, resumed until done, checked against an
 uninterrupted run.
 
-    python -m skfem_beam.bench.soak --cycles 1000 [--out DIR] [--seed 0]
+    python -m skfem_beam.bench.soak --cycles 1000 [--out DIR] [--seed 0] [--only KIND]
 
 Each cycle starts `point_stops` (Δt = 2e-6, T = 0.4, saved every 10th step, XDMF
 fields, a checkpoint every 0.2 s) and stops it one way: SIGKILL, SIGINT or SIGTERM at a
-random instant, or SIGKILL at a named boundary of the run's end (the test hook
-``SKFEM_BEAM_KILL_AT``, output.series.PHASES).  Then `--resume` until the folder says
-"success"; each resume runs under a timeout (a hang is counted, never waited for) and is
+random instant, SIGKILL at a named boundary of the run's end (the test hook
+``SKFEM_BEAM_KILL_AT``, output.series.PHASES), or a nearly full filesystem (as root: a
+tmpfs holding 55–100 % of what the run writes; the run must exit 3, then a resume with a
+little more room, which may fill it again, then room enough).  Then `--resume` until
+the folder says "success"; each resume runs under a timeout (a hang is counted, never waited for) and is
 itself killed at a random instant with probability 1/3.  The finished folder's
 timeseries.csv and impacts.csv must equal the uninterrupted run's byte for byte, and its
-fields.h5 datasets value for value.  A folder a resume refuses (exit 2) is "stuck".
+fields.h5 datasets value for value.  A folder a resume refuses (exit 2) is "stuck"; a
+run or resume that ends any other way than ENDINGS or by SIGKILL has "crashed".
 Prints one table row per kind of stop and the totals; exits 1 on any hang, stuck folder
 or difference.
 """
@@ -32,8 +35,13 @@ from pathlib import Path
 RUN = ["-m", "skfem_beam.cases.point_stops", "--dt", "2e-6", "--T", "0.4", "--save-every",
        "10", "--format", "xdmf", "--frames", "20", "--flush-every", "20000",
        "--checkpoint-every", "0.2"]
+# the full-disk cycles checkpoint every chunk (20,000 steps): the whole run takes less than
+# the 0.2 s of wall time between checkpoints, and a full disk stops it before its end
+FULL_DISK_RUN = RUN[:-1] + ["0"]
 PHASES = ("last-chunk", "final-checkpoint", "charts", "impacts", "summary")
-KINDS = ("SIGKILL", "SIGINT", "SIGTERM", "phase")
+KINDS = ("SIGKILL", "SIGINT", "SIGTERM", "phase", "full disk")
+BAD = ("hang", "stuck", "different", "crashed")
+ENDINGS = (0, 3, 130, 143)  # success, a failed write, SIGINT, SIGTERM (README's exit codes)
 TIMEOUT = 120.0          # s: a resume longer than this is a hang
 
 
@@ -91,15 +99,74 @@ def resume_until_done(folder: Path, rng: random.Random, tally: Counter) -> str:
             return "hang"
         if p.returncode == 2:
             return "stuck"
+        if p.returncode not in ENDINGS and p.returncode >= 0:
+            return "crashed"
         tally["resumes"] += 1
     return "hang"
 
 
-def cycle(ref: Path, work: Path, rng: random.Random, tally: Counter) -> tuple[str, str]:
+def mount(disk: Path, kb: int, remount: bool = False) -> bool:
+    opts = (f"remount,size={kb}k" if remount else f"size={kb}k")
+    args = ["mount", "-o", opts, str(disk)] if remount else \
+        ["mount", "-t", "tmpfs", "-o", opts, "tmpfs", str(disk)]
+    return subprocess.run(args, capture_output=True).returncode == 0
+
+
+def can_mount(work: Path) -> bool:
+    """Root with tmpfs: the full-disk cycles can run."""
+    disk = work / "probe"
+    disk.mkdir(exist_ok=True)
+    ok = os.geteuid() == 0 and mount(disk, 64)
+    if ok:
+        subprocess.run(["umount", "-l", str(disk)], capture_output=True)
+    return ok
+
+
+def full_disk_cycle(ref: Path, work: Path, rng: random.Random, tally: Counter) -> str:
+    """The run on a tmpfs too small for it (exit 3 expected), one resume with a little more
+    room (it may fill it again), then room enough and `resume_until_done`."""
+    need = sum(f.stat().st_size for f in ref.iterdir()) // 1024 \
+        + 2 * (ref / "checkpoint.npz").stat().st_size // 1024 + 512
+    disk = work / "disk"
+    disk.mkdir(exist_ok=True)
+    kb = int(need * rng.uniform(0.55, 1.0))
+    if not mount(disk, kb):
+        raise RuntimeError(f"cannot mount a tmpfs at {disk}")
+    try:
+        folder = disk / "run"
+        p = start(FULL_DISK_RUN + ["--out", str(folder)])
+        p.wait(timeout=TIMEOUT)
+        if p.returncode not in (0, 3):
+            return "crashed"
+        tally["disk full" if p.returncode == 3 else "fitted"] += 1
+        if not (folder / "checkpoint.npz").exists():
+            return "no checkpoint"
+        mount(disk, kb + int((need - kb) * rng.uniform(0.0, 0.5)), remount=True)
+        p = start(RUN[:2] + ["--resume", str(folder)])
+        p.wait(timeout=TIMEOUT)
+        if p.returncode == 2:
+            return "stuck"
+        if p.returncode not in (0, 3):
+            return "crashed"
+        mount(disk, 2 * need, remount=True)
+        outcome = resume_until_done(folder, rng, tally)
+        if outcome == "done" and not same_files(folder, ref):
+            outcome = "different"
+        return outcome
+    except subprocess.TimeoutExpired:
+        return "hang"
+    finally:
+        subprocess.run(["umount", "-l", str(disk)], capture_output=True)
+
+
+def cycle(ref: Path, work: Path, rng: random.Random, tally: Counter,
+          kinds=KINDS) -> tuple[str, str]:
     """One run stopped one way and resumed to the end: (kind, outcome)."""
     folder = work / "run"
     shutil.rmtree(folder, ignore_errors=True)
-    kind = rng.choice(KINDS)
+    kind = rng.choice(kinds)
+    if kind == "full disk":
+        return kind, full_disk_cycle(ref, work, rng, tally)
     args = RUN + ["--out", str(folder)]
     if kind == "phase":
         env = {**os.environ, "SKFEM_BEAM_KILL_AT": rng.choice(PHASES)}
@@ -119,6 +186,7 @@ def main(argv=None) -> int:
     ap.add_argument("--cycles", type=int, default=20)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", default=None, help="write the table as DIR/soak.json too")
+    ap.add_argument("--only", choices=KINDS, default=None, help="one kind of stop only")
     args = ap.parse_args(argv)
     rng, tally, rows = random.Random(args.seed), Counter(), Counter()
     t0 = time.monotonic()
@@ -126,17 +194,25 @@ def main(argv=None) -> int:
         ref = Path(tmp) / "ref"
         subprocess.run([sys.executable, *RUN, "--out", str(ref)], check=True,
                        capture_output=True)
+        kinds = KINDS if can_mount(Path(tmp)) else KINDS[:-1]
+        if len(kinds) < len(KINDS):
+            print("not root (or no tmpfs): no full-disk cycles", file=sys.stderr)
+        if args.only is not None:
+            if args.only not in kinds:
+                print(f"--only {args.only!r}: not possible here", file=sys.stderr)
+                return 2
+            kinds = (args.only,)
         for i in range(args.cycles):
-            rows[cycle(ref, Path(tmp), rng, tally)] += 1
+            rows[cycle(ref, Path(tmp), rng, tally, kinds)] += 1
             if (i + 1) % 50 == 0:      # a long soak shows where it is
                 print(f"{i + 1} cycles: {dict(rows)}", file=sys.stderr, flush=True)
-    bad = sum(n for (kind, outcome), n in rows.items()
-              if outcome in ("hang", "stuck", "different"))
-    print(f"{'stop':8s} {'outcome':14s} {'cycles':>7s}")
+    bad = sum(n for (kind, outcome), n in rows.items() if outcome in BAD)
+    print(f"{'stop':10s} {'outcome':14s} {'cycles':>7s}")
     for (kind, outcome), n in sorted(rows.items()):
-        print(f"{kind:8s} {outcome:14s} {n:7d}")
+        print(f"{kind:10s} {outcome:14s} {n:7d}")
     print(f"{args.cycles} cycles in {time.monotonic() - t0:.0f} s, {tally['resumes']} resumes "
-          f"({tally['resume killed']} of them killed); hangs, stuck folders, differences: "
+          f"({tally['resume killed']} of them killed); full-disk runs: {tally['disk full']} "
+          f"exited 3, {tally['fitted']} fitted; hangs, stuck folders, differences, crashes: "
           f"{bad}")
     if args.out:
         Path(args.out).mkdir(parents=True, exist_ok=True)

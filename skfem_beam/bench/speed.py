@@ -29,12 +29,17 @@ CONFIGS = [
     ("convex J=160 bspline dt=1e-3 T=1", "convex", dict(J=160, dt=1e-3, T=1.0, element="bspline"), 0.5),
     ("convex J=40 hermite dt=1e-4 T=1", "convex", dict(J=40, dt=1e-4, T=1.0), 0.5),
     ("flat J=40 hermite dt=1e-3 T=1", "flat", dict(J=40, dt=1e-3, T=1.0), None),
+    ("flat J=160 hermite dt=1e-3 T=1", "flat", dict(J=160, dt=1e-3, T=1.0), None),
     ("bar rigid N=100 dt=1e-3 T=3 (β=1/4)", "bar", dict(N=100, dt=1e-3, T=3.0, beta=0.25), 0.03),
 ]
 SOLVERS = {"point_stops": ["projection", "active-set", "daqp", "osqp"],
            "convex": ["active-set", "daqp", "osqp"], "flat": ["active-set", "daqp", "osqp"],
            "bar": ["projection", "daqp", "osqp"]}
 SLOW = {"osqp", "daqp"}   # Python-level engines: only on the short configurations
+# OSQP against the compiled active set, per step: the four rows of issue #22 (≤ 5×)
+OSQP_ROWS = ["flat J=40 hermite dt=1e-3 T=1", "flat J=160 hermite dt=1e-3 T=1",
+             "convex J=40 hermite dt=1e-3 T=1", "convex J=160 hermite dt=1e-3 T=1"]
+OSQP_LIMIT = 5.0
 
 
 def build(scene: str, p: dict):
@@ -49,24 +54,31 @@ def build(scene: str, p: dict):
 
 def child(scene: str, p: dict, solver: str, repeat: int) -> dict:
     """Runs in the child process: the timings of one configuration."""
-    from ..scheme import solve
+    from .. import methods
+    from ..scheme.kernels import CONTACT_STEPS
+    from ..scheme.solve import drive
+    from ..scheme.stepping import Stepping
     from ..semidiscrete import beam_system
     from ._floor import banded_solve_floor
     system = build(scene, p)
     system = beam_system(system) if scene != "bar" else system
     beta = p.get("beta", 0.5)
-    kw = dict(dt=p["dt"], T=p["T"], beta=beta, solver=solver,
-              save_every=p.get("save_every", 1), frames=50, progress=False)
-    best = None
+    stepping = Stepping(p["dt"], p["T"], beta, save_every=p.get("save_every", 1), frames=50)
+    best = repairs = None
     for _ in range(repeat):
-        r = solve(system, **kw)
-        best = r if best is None or r.wall_time_s < best.wall_time_s else best
+        run = methods.of(solver).build(system, stepping)
+        drive(run, progress=False)
+        r = run.result()
+        if best is None or r.wall_time_s < best.wall_time_s:
+            best, repairs = r, getattr(run.pysolver, "repairs", None)
+            contact_steps = int(run.st.counters[CONTACT_STEPS])
     A = system.M + p["dt"] ** 2 * beta * system.K
     floor = banded_solve_floor(A, best.steps)
     return {"solver": best.solver, "steps": best.steps, "wall_time_s": best.wall_time_s,
             "us_per_step": 1e6 * best.wall_time_s / best.steps,
             "floor_s": floor, "floor_us_per_step": 1e6 * floor / best.steps,
             "impacts": best.impacts, "max_nodal_violation": best.max_nodal_violation,
+            "contact_steps": contact_steps, "repairs": repairs,
             "peak_rss_MB": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}
 
 
@@ -94,6 +106,25 @@ def command_row(label: str, args: list[str], target, folder: str, fresh=True) ->
     return {"configuration": label, "command_s": wall, "wall_time_s": loop,
             "budget_s": 2 * (loop + 2.0), "peak_rss_MB": summary["peak_rss_MB"],
             "steps": summary["steps"], "target_s": target}
+
+
+def osqp_table(rows: list[dict]) -> None:
+    """OSQP against the compiled active set on OSQP_ROWS: µs per step, their ratio, the
+    steps OSQP was called (those in contact: the others' μ = 0 is exact without it) and
+    the steps whose active set the exact finish had to repair (grazing contact)."""
+    by = {(r["configuration"], r["solver"]): r for r in rows if "solver" in r}
+    table = [(c, by[c, "osqp"], by[c, "active-set"]) for c in OSQP_ROWS
+             if (c, "osqp") in by and (c, "active-set") in by]
+    if not table:
+        return
+    print(f"\n{'OSQP against the active set':48s} {'osqp µs':>8s} {'a-set µs':>8s} "
+          f"{'ratio':>6s} {'≤ 5×':>5s} {'OSQP ran':>9s} {'repaired':>8s}")
+    for c, o, a in table:
+        ratio = o["us_per_step"] / a["us_per_step"]
+        o["ratio_to_active_set"] = ratio
+        print(f"{c:48s} {o['us_per_step']:8.2f} {a['us_per_step']:8.2f} {ratio:6.2f} "
+              f"{'yes' if ratio <= OSQP_LIMIT else 'NO':>5s} "
+              f"{o['contact_steps']:5d}/{o['steps']:<5d} {o['repairs']:8d}", flush=True)
 
 
 def main(argv=None) -> int:
@@ -130,6 +161,7 @@ def main(argv=None) -> int:
             print(f"{label:48s} {res['solver']:11s} {res['steps']:8d} {res['wall_time_s']:8.4f} "
                   f"{res['us_per_step']:8.2f} {res['floor_us_per_step']:8.2f} {t:>8s} "
                   f"{res['peak_rss_MB']:6.0f}", flush=True)
+    osqp_table(rows)
     print(f"\n{'whole command':56s} {'command s':>9s} {'loop s':>7s} {'2(loop+2) s':>11s} "
           f"{'peak MB':>8s}")
     with tempfile.TemporaryDirectory() as tmp:

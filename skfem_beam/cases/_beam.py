@@ -1,6 +1,8 @@
 """The part every beam scene shares: checks, stability warning, run, output contract."""
 from __future__ import annotations
 
+import math
+
 from pathlib import Path
 
 import numpy as np
@@ -37,7 +39,8 @@ def run_beam_case(case: str, problem, spec: RunSpec, stops=(), extra=None) -> in
         "case": case, "J": problem.J, "dt": run.dt, "T": run.n_steps * run.dt, "beta": run.beta,
         "theta": run.theta,
         "element": problem.element, "method": "penalty" if penalty else "contact",
-        "kappa_h": kh, "linear_stability_limit_dt": limit,
+        "kappa_h": kh,
+        "linear_stability_limit_dt": limit if math.isfinite(limit) else None,
         "observed_x": system.view.observed_x or problem.beam.L,
         "units": {**units(rho_S, system), "probes": probe_units(system)},
         "penalty_stiffness_N_per_m": spec.method.stiffness if penalty else None,
@@ -140,7 +143,8 @@ def units(rho_S, system) -> dict:
                                         "work of the loads (the support's motion included)",
                                         "work of the contact forces (≤ 0 for exact contact)"))},
            "energy_balance": "energy − energy[0] + work_damping = work_input + work_contact "
-                             "(to round-off)"}
+                             "(to round-off)",
+           "linear_stability_limit_dt": "s, 2/√(κ_h(1−4β)); null: no limit (β ≥ 1/4)"}
     if rho_S:
         out.update({"contact_force_N": "N (contact_force × rho_S)",
                     "energy_J": "J (energy × rho_S)",

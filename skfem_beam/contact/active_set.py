@@ -320,7 +320,7 @@ def bound_scale(lo, hi) -> float:
     return s if s > 0 else 1.0
 
 
-def exact_finish(D, yf, lo, hi, duals, state, mu, scale, engine) -> int:
+def exact_finish(D, yf, lo, hi, duals, state, mu, scale, engine, tol=REPAIR_TOL) -> int:
     """μ exactly on the active set of an engine's multipliers ``duals``.
 
     An engine accurate to ε cannot classify a constraint whose multiplier or gap is
@@ -328,11 +328,12 @@ def exact_finish(D, yf, lo, hi, duals, state, mu, scale, engine) -> int:
     box or a multiplier with the wrong sign by that much.  Any such residual is
     handed to `box_qp`, warm-started from the engine's set, which decides those
     constraints exactly.  Returns the number of such repairs (0 or 1); a residual
-    above REPAIR_TOL·scale means the engine's answer was wrong: SolverError."""
+    above tol·scale (REPAIR_TOL unless the engine says) means the engine's answer was
+    wrong: SolverError."""
     res = finish_on_duals(D, yf, lo, hi, duals, state, mu)
     if res <= 0.0:
         return 0
-    if res > REPAIR_TOL * scale:
+    if res > tol * scale:
         raise SolverError(f"{engine}'s active set violates the KKT conditions by "
                           f"{res:.3g} (scale {scale:.3g}): not a solution")
     if box_qp(D, yf, lo, hi, state, mu) < 0:

@@ -50,10 +50,10 @@ def impact_table(events: dict, lo: np.ndarray, hi: np.ndarray, scale: float = 1.
     lower = np.isfinite(lo[j]) & (~np.isfinite(hi[j]) | (impulse > 0)
                                   | ((impulse == 0) & (events["velocity"] < 0)))
     return {"t_start": events["t_start"], "t_end": events["t_end"], "x": events["x"],
-            "bound": np.where(lower, 1.0, 2.0), "velocity": events["velocity"],
+            "bound": np.where(lower, 1, 2), "velocity": events["velocity"],
             "peak_force": scale * np.asarray(events["peak_force"], dtype=float),
             "impulse": sign * scale * impulse, "max_violation": events["max_violation"],
-            "open": np.asarray(events["open"], dtype=float)}
+            "open": np.asarray(events["open"], dtype=int)}
 
 
 def _union_length(start: np.ndarray, end: np.ndarray) -> float:
@@ -131,7 +131,8 @@ def write_impacts(folder: Path, run, units: dict, scale: float = 1.0, sign: floa
     table = impact_table(events, np.asarray(s.lo), np.asarray(s.hi), scale, sign)
     path = Path(folder) / IMPACTS
     atomic_write(path, lambda fh: fh.write(",".join(COLUMNS) + "\n"
-                                           + (csv_rows(table, list(COLUMNS)) if table["x"].size
+                                           + (csv_rows(table, list(COLUMNS), ("bound", "open"))
+                                              if table["x"].size
                                               else "")))
     # the share of the states 1..n, as the run's own contact_fraction counts it
     duration = max(0, last - 1) * run.dt

@@ -163,9 +163,10 @@ def write_summary(folder: Path, summary: dict) -> None:
     write_json(Path(folder) / SUMMARY, summary)
 
 
-def csv_rows(columns: dict, names: list[str]) -> str:
+def csv_rows(columns: dict, names: list[str], integers: tuple[str, ...] = ()) -> str:
     """Rows of equal-length columns as CSV text, every value in the shortest digits that
-    read back to the same double (exact round trip).
+    read back to the same double (exact round trip); the columns named in ``integers``
+    as integers (a short table's flags: through Python lists, not one float array).
 
     orjson formats floats with Ryu, ten times faster than Python's "%.17g" (0.10 s against
     0.97 s for 200,000 rows of 13 values, measured): formatting, not computing, set the
@@ -174,6 +175,11 @@ def csv_rows(columns: dict, names: list[str]) -> str:
     data = np.column_stack([np.asarray(columns[k], dtype=float) for k in names])
     if not data.size:
         return ""
+    if integers and np.isfinite(data).all():
+        cols = [np.asarray(columns[k]).astype(int).tolist() if k in integers
+                else data[:, i].tolist() for i, k in enumerate(names)]
+        text = orjson.dumps([list(row) for row in zip(*cols)])
+        return text[2:-2].replace(b"],[", b"\n").decode() + "\n"
     if np.isinf(data).any():
         row = ",".join(["%r"] * len(names)) + "\n"
         return (row * data.shape[0]) % tuple(data.ravel().tolist())

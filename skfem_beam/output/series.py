@@ -16,6 +16,7 @@ buffers, and which field frames to write.
 """
 from __future__ import annotations
 
+import errno
 import hashlib
 import io
 import json
@@ -559,6 +560,18 @@ def _stream(run, folder, options, series, finish, stop, used, ck, can_checkpoint
     return code
 
 
+def _once_fixed(e: OSError) -> str:
+    """When a failed write can be retried, by its cause."""
+    if e.errno in (errno.ENOSPC, errno.EDQUOT):
+        return "once there is room"
+    if e.errno in (errno.EPERM, errno.EACCES):
+        return ("once its files can be written again (permissions, or an immutable file: "
+                "lsattr, chattr -i)")
+    if e.errno == errno.EROFS:
+        return "once its filesystem is writable again"
+    return "once that is fixed"
+
+
 class _Stream:
     """A run streaming into its folder: rows and frames written after every chunk, the
     checkpoints, and the words of what is kept when it stops."""
@@ -666,7 +679,7 @@ class _Stream:
         """A write refused (full disk, ...): status "failed", what is kept, exit 3."""
         run, folder = self.run, self.folder
         folder.fail(e, steps=run.n, kept=self.what_is_kept(), **self.write_events(run.n))
-        resume = (f"once there is room, continue with: {_command(folder.summary)} --resume "
+        resume = (f"{_once_fixed(e)}, continue with: {_command(folder.summary)} --resume "
                   f"{folder.path}" if self.kept is not None else
                   "without a checkpoint (--checkpoint-every) it cannot be resumed")
         print(f"error: could not write the results: {e}; {self.what_is_kept()}; {resume}",

@@ -24,7 +24,7 @@ from collections import namedtuple
 import numpy as np
 from numba import njit, objmode
 
-from ..linalg import band_solve, rows_dot, rows_matvec
+from ..linalg import band_solve, csr_product, rows_dot, rows_matvec
 
 Ops = namedtuple("Ops", [
     "dt", "beta", "save_every", "frame_every",
@@ -65,16 +65,6 @@ EVENT_COLUMNS = ("value", "start_step", "end_step", "velocity", "peak_force", "i
 FAILED, UNSTABLE, EVENTS_FULL = 1, 2, 3
 # State.counters by name (the compiled loops index them by these numbers)
 IMPACTS, CONTACT_STEPS, ITERATIONS, STOPPED_AT, EVENTS_WRITTEN, ROW0 = range(6)
-
-
-@njit(cache=True)
-def csr_product(Rp, Ri, Rx, u, y):
-    """y ← R u for R given as CSR arrays."""
-    for r in range(y.size):
-        s = 0.0
-        for p in range(Rp[r], Rp[r + 1]):
-            s += Rx[p] * u[Ri[p]]
-        y[r] = s
 
 
 # Called from compiled code only, and out of line: branches that most runs never take (or
@@ -373,6 +363,15 @@ def run_steps(law, explicit, ops, st, out, n0, n1, inputs, Ebound):
     return 0
 
 
+@njit(cache=True)
+def inside(y, lo, hi) -> bool:
+    """lo ≤ y ≤ hi everywhere."""
+    for i in range(y.size):
+        if not lo[i] <= y[i] <= hi[i]:
+            return False
+    return True
+
+
 class PythonLaw:
     """The law solved in Python that `run_steps_python` calls (one run at a time per
     process), the state's arrays it reads and writes (the same memory as the compiled
@@ -396,13 +395,20 @@ def _solve_in_python() -> int:
 @njit(cache=True)
 def run_steps_python(ops, st, out, n0, n1, inputs, Ebound):
     """The same steps as `run_steps` with the law solved in Python (`PythonLaw.solver`,
-    e.g. OSQP or daqp, given the step's bounds): the compiled loop calls it for μ."""
+    e.g. OSQP or daqp, given the step's bounds): the compiled loop calls it for μ when
+    the free step leaves its bounds.  When it does not, μ = 0 is the step's exact
+    solution (the unconstrained minimiser is feasible) and the engine is not called:
+    its calls are then exactly the steps in contact (counters[CONTACT_STEPS])."""
     for step in range(n0, n1):
         Gn = inputs.G[step - n0]
         move_bounds(ops, st, inputs.phi[step - n0])
         free_step(ops, st, Gn, inputs.H, step - n0)
-        with objmode(its="int64"):
-            its = _solve_in_python()
+        if inside(st.yf, st.lo, st.hi):
+            its = 0
+            st.mu[:] = 0.0
+        else:
+            with objmode(its="int64"):
+                its = _solve_in_python()
         if its < 0:
             st.counters[3] = step + 1
             return FAILED

@@ -108,6 +108,19 @@ class Beam:
         EI, rhoA = material.E * section.I, material.rho * section.A
         return cls(L, EI / rhoA, rhoA)
 
+    def with_added_mass(self, added: float) -> "Beam":
+        """The beam carrying ``added`` kg/m more along its whole length (the fluid inside
+        and around a tube: its hydrodynamic mass): ρA → ρA + added, EI unchanged, so k2
+        = EI/(ρA + added) and forces in N are (ρA + added)·λ."""
+        added = check_nonnegative("[mass] added", added)
+        if self.rho_S is None:
+            raise InputError("[mass] added needs the beam's own mass per length: give "
+                             "[material] and [section], or rho_S")
+        if self.segments:
+            segs = tuple((x, EI, rhoA + added) for x, EI, rhoA in self.segments)
+            return Beam(self.L, segs[0][1] / segs[0][2], segs[0][2], segs)
+        return Beam(self.L, self.k2 * self.rho_S / (self.rho_S + added), self.rho_S + added)
+
     @classmethod
     def stepped(cls, parts) -> "Beam":
         """Piecewise-uniform beam from ``parts`` = [(length, Material, Section), ...], left
@@ -381,22 +394,26 @@ class Load:
 
 @dataclass(frozen=True)
 class Damping:
-    """Rayleigh damping B = alpha·M + alpha_K·K (alpha in 1/s, alpha_K in s).
+    """Rayleigh damping B = alpha·M + alpha_K·K (alpha in 1/s, alpha_K in s), plus modal
+    damping: the ratio ``modal`` = ζ in every mode (B += M Φ diag(2ζω) Φᵀ M, Φ the
+    mass-normalised modes; a dense B, as every mode couples every node).
 
-    The modal damping ratio at ω is ζ(ω) = alpha/(2ω) + alpha_K·ω/2; :meth:`ratio`
-    gives the pair with ζ at two frequencies.
+    The Rayleigh ratio at ω is ζ(ω) = alpha/(2ω) + alpha_K·ω/2; :meth:`ratio` gives the
+    pair with ζ at two frequencies.
     """
     alpha: float = 0.0
     alpha_K: float = 0.0
+    modal: float = 0.0
 
     def __post_init__(self):
         object.__setattr__(self, "alpha", check_nonnegative("alpha", self.alpha))
         object.__setattr__(self, "alpha_K", check_nonnegative("alpha_K", self.alpha_K))
+        object.__setattr__(self, "modal", check_ratio("modal", self.modal))
 
     @classmethod
     def ratio(cls, zeta: float, f1: float, f2: float) -> "Damping":
         """ζ(2πf1) = ζ(2πf2) = zeta (f in Hz, f1 ≠ f2); between them ζ is a little lower."""
-        zeta = check_nonnegative("zeta", zeta)
+        zeta = check_ratio("zeta", zeta)
         w1, w2 = 2 * math.pi * check_positive("f1", f1), 2 * math.pi * check_positive("f2", f2)
         if f1 == f2:
             raise InputError(f"f1={f1:g} and f2={f2:g} must differ (two frequencies fix "
@@ -406,7 +423,16 @@ class Damping:
 
     @property
     def none(self) -> bool:
-        return self.alpha == 0.0 and self.alpha_K == 0.0
+        return self.alpha == 0.0 and self.alpha_K == 0.0 and self.modal == 0.0
+
+
+def check_ratio(name: str, zeta) -> float:
+    """A damping ratio: 0 ≤ ζ < 1."""
+    zeta = check_nonnegative(name, zeta)
+    if zeta >= 1:
+        raise InputError(f"{name}={zeta:g} must be below 1: it is a ratio of critical damping "
+                         "(0.02 for 2 %)")
+    return zeta
 
 
 @dataclass(frozen=True)
@@ -556,8 +582,9 @@ class BeamProblem:
             for end, at in ((0, 0.0), (1, L)):
                 if abs(xs - at) <= 1e-9 * L:
                     e = self.ends[end]
+                    fix = "clamped" if e == "sliding" else "pinned"
                     hint = "already fixed there" if END_CONDITIONS[e][0] else \
-                        f"use ends[{end}]={'clamped' if e == 'sliding' else 'pinned'!r} instead"
+                        f"use ends.{('left', 'right')[end]}={fix!r} instead"
                     raise InputError(f"support x={xs:g} is at the {e} end x={at:g} ({hint}); "
                                      f"supports must lie strictly inside (0, L={L:g})")
             if any(abs(xs - o) <= 1e-9 * L for o in out):

@@ -47,7 +47,7 @@ from .contact import SOLVERS
 from .output.options import OutputOptions
 from .scheme import Stepping
 from .spec import RunSpec
-from .timefunctions import Constant, Sine, SumOfSines, Table, band_limited
+from .timefunctions import Constant, Sine, SumOfSines, Table, band_limited, psd_from_csv
 
 BEAM_MASSES = ("consistent", "redistributed")        # [mesh] mass of a beam
 SCENE_WORDS = methods.Words(solver="[contact] law = ", massless="[mesh] massless = ",
@@ -56,42 +56,59 @@ SCENE_WORDS = methods.Words(solver="[contact] law = ", massless="[mesh] massless
 V = None          # a value (checked by the object it builds)
 
 
+class Number:
+    """In a schema: a number (TOML integer or float, inf included; not a string such as
+    "0.25mm", not a boolean), checked where the file is read."""
+
+
+N = Number()
+
+
 class Either(dict):
     """In a schema: a value, or a table of these keys."""
 
 
-TIME = {"amplitude": V, "omega": V, "phase": V, "value": V, "sines": V, "table": V,
-        "random": {"rms": V, "f_low": V, "f_high": V, "seed": V, "count": V}}
-SECTION = {"I": V, "A": V, "tube": {"outer_diameter": V, "wall": V},
-           "rod": {"diameter": V}, "rect": {"b": V, "h": V}}
-MATERIAL = {"E": V, "rho": V}
+class NumberOr(dict):
+    """In a schema: a number, or a table of these keys (an obstacle's g)."""
+
+
+TIME = {"amplitude": N, "omega": N, "phase": N, "value": N, "sines": V, "table": V,
+        "random": {"rms": N, "f_low": N, "f_high": N, "seed": N, "count": N},
+        "psd": Either({"table": V, "seed": N, "df": N})}
+SECTION = {"I": N, "A": N, "tube": {"outer_diameter": N, "wall": N},
+           "rod": {"diameter": N}, "rect": {"b": N, "h": N}}
+MATERIAL = {"E": N, "rho": N}
 U0, V0 = {"x": V, "u": V}, {"x": V, "v": V}
-TIME_KEYS = {"dt": V, "T": V, "beta": V}
-OUTPUT = {"format": V, "save_every": V, "frames": V, "flush_every": V, "checkpoint_every": V,
+TIME_KEYS = {"dt": N, "T": N, "beta": N, "load_window": V}
+OUTPUT = {"format": V, "save_every": N, "frames": N, "flush_every": N, "checkpoint_every": N,
           "probes": V}
-CONTACT = {"law": V, "stiffness": V, "restitution": V}
+CONTACT = {"law": V, "stiffness": N, "restitution": N}
+G = NumberOr({"poly": V, "about": V, "x": V, "g": V})     # checked by _g
 
 BEAM_KEYS = {
     "kind": V, "material": MATERIAL, "section": SECTION,
-    "mass_normalised": {"k2": V, "rho_S": V},
-    "geometry": {"L": V},
-    "segments": [{"length": V, "material": MATERIAL, "section": SECTION}],
+    "mass_normalised": {"k2": N, "rho_S": N},
+    "mass": {"added": N},
+    "geometry": {"L": N},
+    "segments": [{"length": N, "material": MATERIAL, "section": SECTION}],
     "ends": {"left": V, "right": V},
-    "supports": [{"x": V}],
-    "motion": {"end": V, "at": V, "lifting": V, **TIME},
-    "obstacles": [{"x": V, "x_from": V, "x_to": V, "g1": V, "g2": V, "carried": V}],
-    "damping": {"zeta": V, "f1": V, "f2": V, "alpha": V, "alpha_K": V},
-    "loads": [{"x": V, "distributed": V, "per_mass": V, "gravity": V, **TIME}],
-    "initial": {"mode": V, "amplitude": V, "u0": U0, "v0": V0, "fixed_frame": V},
-    "mesh": {"J": V, "element": V, "nodes": V, "mass": V, "massless": V},
+    "supports": [{"x": N}],
+    "motion": {"end": V, "at": N, "lifting": V, **TIME},
+    "obstacles": [{"x": N, "x_from": N, "x_to": N, "g1": G, "g2": G, "carried": V,
+                   "stiffness": N}],
+    "damping": {"zeta": N, "f1": N, "f2": N, "alpha": N, "alpha_K": N, "modal": N},
+    "loads": [{"x": N, "distributed": V, "per_mass": V, "gravity": N, "x_from": N, "x_to": N,
+               **TIME}],
+    "initial": {"mode": V, "amplitude": N, "u0": U0, "v0": V0, "fixed_frame": V},
+    "mesh": {"J": N, "element": V, "nodes": V, "mass": V, "massless": V},
     "time": TIME_KEYS, "contact": CONTACT, "output": OUTPUT,
 }
 BAR_KEYS = {
-    "kind": V, "material": MATERIAL, "section": SECTION, "geometry": {"L": V},
+    "kind": V, "material": MATERIAL, "section": SECTION, "geometry": {"L": N},
     "ends": {"left": V, "right": V},
-    "obstacles": [{"x": V, "stiffness": V}],
-    "damping": {"viscosity": V},
-    "loads": [{"value": V}],
+    "obstacles": [{"x": V, "stiffness": N}],
+    "damping": {"viscosity": N},
+    "loads": [{"value": N}],
     "initial": {"u0": Either(U0), "v0": Either(V0)},
     "mesh": {"J": V, "mass": V, "massless": V},
     "time": TIME_KEYS, "contact": CONTACT, "output": OUTPUT,
@@ -141,27 +158,43 @@ def _where(path: tuple) -> str:
     return ".".join(str(p) for p in path)
 
 
-def _check_keys(data, schema, path=()) -> None:
-    """Refuse a key ``schema`` does not allow, naming it and the allowed ones."""
+def _is_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _check_keys(data, schema, path=(), sets=None) -> None:
+    """Refuse a key ``schema`` does not allow, naming it and the allowed ones, and a value
+    that must be a number and is not, naming its key (``sets``: the keys ``--set`` gave,
+    dotted, as written there)."""
     for key, value in data.items():
         if key not in schema:
             where = f"[{_where(path)}]" if path else "the top level"
             raise InputError(f"unknown key {_where(path + (key,))!r}; {where} allows: "
                              f"{', '.join(schema)}")
         sub = schema[key]
-        if isinstance(sub, Either) and not isinstance(value, dict):
+        if sub is N or isinstance(sub, NumberOr) and not isinstance(value, dict):
+            if not _is_number(value):
+                name = _where(path + (key,))
+                given = f"--set {name}={sets[name]}" if sets and name in sets \
+                    else f"{name} = {value!r}"
+                tables = " or a table ({ poly = [...] } or { x = [...], g = [...] })" \
+                    if isinstance(sub, NumberOr) else ""
+                raise InputError(f"{given}: must be a number{tables}, in SI units (m, s, kg, N, "
+                                 "Pa; e.g. 0.25 mm is 0.00025)")
+            continue
+        if isinstance(sub, (Either, NumberOr)) and not isinstance(value, dict):
             continue
         if isinstance(sub, dict):
             if not isinstance(value, dict):
                 raise InputError(f"{_where(path + (key,))} must be a table of "
                                  f"{', '.join(sub)} (got {value!r})")
-            _check_keys(value, sub, path + (key,))
+            _check_keys(value, sub, path + (key,), sets)
         elif isinstance(sub, list):
             if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
                 raise InputError(f"{_where(path + (key,))} must be an array of tables "
                                  f"[[{_where(path + (key,))}]] of {', '.join(sub[0])}")
             for i, item in enumerate(value):
-                _check_keys(item, sub[0], path + (key, i))
+                _check_keys(item, sub[0], path + (key, i), sets)
 
 
 def _toml_value(text: str):
@@ -173,9 +206,10 @@ def _toml_value(text: str):
         return text
 
 
-def apply_set(data: dict, assignment: str) -> None:
+def apply_set(data: dict, assignment: str) -> tuple[str, str]:
     """``KEY=VALUE`` (KEY dotted, array items by index: ``obstacles.0.g1``) into
-    ``data``; a key the scene's kind does not allow is refused by name."""
+    ``data``; a key the scene's kind does not allow is refused by name.  Returns (KEY,
+    VALUE) as written."""
     key, eq, text = assignment.partition("=")
     if not eq or not key.strip():
         raise InputError(f"--set {assignment!r}: expected KEY=VALUE, e.g. time.dt=1e-5")
@@ -203,7 +237,7 @@ def apply_set(data: dict, assignment: str) -> None:
                              f"allows: {allowed}")
         if last:
             node[part] = _toml_value(text.strip())
-            return
+            return ".".join(parts), text.strip()
         child = sub[part]
         if isinstance(child, list):
             node = node.setdefault(part, [])
@@ -235,22 +269,46 @@ def load(path, overrides=(), files: dict | None = None, text: str | None = None,
     kind = data.get("kind", "beam")
     if kind not in KINDS:
         raise InputError(f"{path}: kind={kind!r} must be one of: {', '.join(KINDS)}")
-    for assignment in overrides:
-        apply_set(data, assignment)
-    _check_keys(data, KINDS[data.get("kind", "beam")])
+    sets = dict(apply_set(data, assignment) for assignment in overrides)
     kind = data.get("kind", "beam")
     reader = _Reader(path.parent, dict(files or {}))
-    with tempfile.TemporaryDirectory() as tmp:
-        reader.tmp = Path(tmp)
-        problem = (_beam_problem if kind == "beam" else _bar)(data, reader)
-    if not dynamic:
-        return Scene(kind, problem, None, text=text, files=reader.read, data=data)
-    return _scene(kind, problem, data, text, reader.read)
+    try:    # every error line names the file
+        _check_keys(data, KINDS[kind], sets=sets)
+        with tempfile.TemporaryDirectory() as tmp:
+            reader.tmp = Path(tmp)
+            problem = (_beam_problem if kind == "beam" else _bar)(data, reader)
+        if not dynamic:
+            return Scene(kind, problem, None, text=text, files=reader.read, data=data)
+        return _scene(kind, problem, data, text, reader.read)
+    except InputError as e:
+        raise InputError(f"{path.name}: {e}") from None
+
+
+def _support_stiffness(data: dict) -> float | None:
+    """A beam's [[obstacles]] stiffness (N/m): the supports' own compliance, one value for
+    all of them (the penalty law's spring; its deflection is the support's)."""
+    if data.get("kind", "beam") != "beam":
+        return None
+    ks = [o.get("stiffness") for o in data.get("obstacles", [])]
+    given = {k for k in ks if k is not None}
+    if not given:
+        return None
+    if len(given) > 1 or None in ks:
+        raise InputError("[[obstacles]] stiffness: give every obstacle the same stiffness "
+                         f"(got {', '.join('none' if k is None else f'{k:g}' for k in ks)})")
+    if "stiffness" in data.get("contact", {}) or \
+            data.get("contact", {}).get("law", "penalty") not in ("penalty", "auto"):
+        raise InputError("[[obstacles]] stiffness makes the supports springs (the penalty "
+                         "law): leave out [contact] law and stiffness")
+    return given.pop()
 
 
 def _scene(kind, problem, data, text, files) -> Scene:
     contact = data.get("contact", {})
     law, k = contact.get("law", "auto"), contact.get("stiffness")
+    support_k = _support_stiffness(data)
+    if support_k is not None:
+        law, k = "penalty", support_k
     if k is not None and law == "auto":
         law = "penalty"
     check_choice("[contact] law", law, (*methods.LAWS, *SOLVERS))
@@ -270,7 +328,7 @@ def _scene(kind, problem, data, text, files) -> Scene:
     method = scene.method          # the method's own checks (law, stiffness, restitution)
     beta = t.get("beta", methods.default_beta(method, kind))
     stepping = Stepping(t["dt"], t["T"], beta, out["save_every"], out["frames"],
-                        massless=rows or "beta")
+                        t.get("load_window", "forward"), massless=rows or "beta")
     return replace(scene, stepping=stepping)
 
 
@@ -299,12 +357,12 @@ class _Reader:
 
 def _time_function(d: dict, where: str, reader: _Reader):
     """A time function from the keys of TIME (one form), or None when none is given."""
-    forms = [k for k in ("amplitude", "value", "sines", "table", "random") if k in d]
+    forms = [k for k in ("amplitude", "value", "sines", "table", "random", "psd") if k in d]
     if "omega" in d and "amplitude" not in d:
         forms.append("omega")
     if len(forms) > 1:
         raise InputError(f"[{where}] give one of amplitude/omega, value, sines, table, "
-                         f"random (got {', '.join(forms)})")
+                         f"random, psd (got {', '.join(forms)})")
     if not forms:
         return None
     form = forms[0]
@@ -321,6 +379,11 @@ def _time_function(d: dict, where: str, reader: _Reader):
                           tuple(r[2] if len(r) == 3 else 0.0 for r in rows))
     if form == "table":
         return Table.from_csv(reader.path(d["table"]))
+    if form == "psd":   # a one-sided PSD table f (Hz), S (unit²/Hz), synthesised with a seed
+        psd = d["psd"] if isinstance(d["psd"], dict) else {"table": d["psd"]}
+        if "table" not in psd:
+            raise InputError(f"[{where}] psd = {{ table = \"file.csv\", seed, df }} needs table")
+        return psd_from_csv(reader.path(psd["table"]), psd.get("seed", 0), psd.get("df"))
     return band_limited(**d["random"])
 
 
@@ -360,11 +423,33 @@ def _need(d: dict, keys, where: str) -> dict:
     return {k: d[k] for k in keys}
 
 
-def _material(d: dict, where: str) -> Material:
-    return Material(**_need(d, ("E", "rho"), where))
+# beyond these a value is more likely in the wrong unit than a material (rubber to
+# diamond; aerogel-free foams to osmium): one warning line, the run goes on
+PLAUSIBLE = {"E": (1e6, 1.2e12, "Pa"), "rho": (10.0, 23000.0, "kg/m³")}
+
+
+def _material(d: dict, where: str, plausible: bool = True) -> Material:
+    """[material] E, rho; a beam's outside PLAUSIBLE warns (a bar's may be the papers'
+    dimensionless a = ρ = 1)."""
+    from .cli import warn
+    material = Material(**_need(d, ("E", "rho"), where))
+    for key, (low, high, unit) in PLAUSIBLE.items():
+        value = d[key]
+        if plausible and not low <= value <= high:
+            warn(f"[{where}] {key} = {value:g} {unit} is outside engineering materials "
+                 f"({low:g}–{high:g} {unit}): is it in {unit}?")
+    return material
 
 
 def _beam(data: dict) -> Beam:
+    """The beam of [material] + [section], [mass_normalised] or [[segments]], with its
+    [mass] added (kg/m, e.g. the fluid's hydrodynamic mass)."""
+    beam = _structure(data)
+    added = data.get("mass", {}).get("added")
+    return beam if added is None else beam.with_added_mass(added)
+
+
+def _structure(data: dict) -> Beam:
     mn, segs = data.get("mass_normalised"), data.get("segments")
     forms = [k for k in ("mass_normalised", "segments") if k in data] + \
         (["material/section"] if "material" in data or "section" in data else [])
@@ -446,7 +531,7 @@ def _support(data: dict, L: float, reader: _Reader) -> Support:
         at = ends[m["end"]]
     lifting = m.get("lifting", "auto")
     if set(m) & {"amplitude", "omega"} and not set(m) & {"phase", "value", "sines", "table",
-                                                          "random"}:
+                                                          "random", "psd"}:
         return Support(m.get("amplitude", 0.0), m.get("omega", 0.0), at=at, lifting=lifting)
     return Support(motion=_time_function(m, "motion", reader), at=at, lifting=lifting)
 
@@ -465,11 +550,20 @@ def _loads(data: dict, reader: _Reader) -> Load:
             raise InputError(f"[{where}] needs a time function: amplitude/omega, value, "
                              "sines, table or random")
         kinds = [k for k in ("x", "distributed", "per_mass") if d.get(k, False) is not False]
+        span = [k for k in ("x_from", "x_to") if k in d]
+        if span and kinds != ["distributed"]:
+            raise InputError(f"[{where}] x_from, x_to bound a distributed load (distributed = "
+                             "true)")
         if len(kinds) != 1:
             raise InputError(f"[{where}] needs one of x (a point force, N), distributed = "
                              "true (N/m) or per_mass = true (m/s²)")
         if kinds[0] == "x":
             total = total + Load(points=((d["x"], time),))
+        elif kinds[0] == "distributed" and span:
+            a, b = _need(d, ("x_from", "x_to"), where).values()
+            if not a < b:
+                raise InputError(f"[{where}] x_from={a:g} must be below x_to={b:g}")
+            total = total + Load.distributed(_span(a, b), time)
         elif kinds[0] == "distributed":
             total = total + Load.distributed(1.0, time)
         else:
@@ -477,10 +571,21 @@ def _loads(data: dict, reader: _Reader) -> Load:
     return total
 
 
+def _span(a: float, b: float):
+    """1 N/m on [a, b], 0 elsewhere (exact when a and b are mesh nodes; else the load
+    quadrature cuts the element there)."""
+    return lambda x: ((np.asarray(x) >= a) & (np.asarray(x) <= b)).astype(float)
+
+
 def _damping(data: dict) -> Damping:
     d = data.get("damping")
     if d is None:
         return Damping()
+    if "modal" in d:
+        if len(d) > 1:
+            raise InputError("[damping] modal = ζ (every mode) stands alone: not with "
+                             f"{', '.join(k for k in d if k != 'modal')}")
+        return Damping(modal=d["modal"])
     if set(d) & {"zeta", "f1", "f2"}:
         if set(d) & {"alpha", "alpha_K"}:
             raise InputError("[damping] give zeta, f1, f2 or alpha, alpha_K, not both")
@@ -554,7 +659,7 @@ def _bar_profile(d, name: str, value: str):
 
 def _bar(data: dict, reader: _Reader) -> Bar:
     L = _need(data.get("geometry", {}), ("L",), "geometry")["L"]
-    mat = _material(data.get("material", {}), "material")
+    mat = _material(data.get("material", {}), "material", plausible=False)
     A = _bar_area(data["section"]) if "section" in data else None
     obstacles = data.get("obstacles", [])
     if len(obstacles) != 1 or "x" not in obstacles[0]:
@@ -597,6 +702,9 @@ def _run_parser() -> argparse.ArgumentParser:
         p.add_argument(f"--{flag}", default=None,
                        type=str if flag == "format" else float if flag == "checkpoint-every"
                        else int, help=f"[output] {flag.replace('-', '_')}")
+    p.add_argument("--probe", action="append", type=float, default=None, metavar="X",
+                   help="also record u, velocity, moment and shear at x = X (m), with "
+                        "[output] probes (repeatable)")
     p.add_argument("--resume", metavar="DIR", default=None,
                    help="continue the stopped run in DIR from its last checkpoint")
     return p
@@ -634,6 +742,7 @@ def _scene_of(path, sets, resume) -> Scene:
 def _spec(scene: Scene, flags: dict, resume) -> RunSpec:
     """The scene and the command line's flags (which override its [output] and [time] T)
     as one RunSpec; summary.json's config records both, in the flags' names."""
+    given = flags.pop("probe", None) or []
     for key, value in scene.output.items():
         if key != "probes" and flags[key] is None:
             flags[key] = value
@@ -647,7 +756,8 @@ def _spec(scene: Scene, flags: dict, resume) -> RunSpec:
     law, restitution = scene.law, scene.restitution
     mass = scene.data.get("mesh", {}).get("mass", "consistent") if scene.kind == "beam" \
         else scene.problem.mass
-    probes = [float(x) for x in np.atleast_1d(scene.output.get("probes", []))]
+    probes = [float(x) for x in np.atleast_1d(scene.output.get("probes", []))] + \
+        [x for x in given if x not in scene.output.get("probes", [])]
     config = {"command": "python -m skfem_beam run", "scene_text": scene.text,
               "scene_files": scene.files, **flags, "dt": stepping.dt, "beta": stepping.beta,
               "method": "penalty" if law == "penalty" else "contact",

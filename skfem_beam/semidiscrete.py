@@ -248,6 +248,8 @@ def beam_system(problem: BeamProblem, samples_per_element: int = 20) -> SemiDisc
         raise InputError(f"k2={k2:g} on this mesh gives a stiffness outside floating-point range")
     damp = problem.damping
     B = None if damp.none else (damp.alpha * space.M + damp.alpha_K * K).tocsr()
+    if damp.modal:
+        B = B + modal_damping(space.M, K, damp.modal)
 
     node = observed_node(problem, space)
     row = space.C[-1] if node is None else space.nodal[node]
@@ -264,6 +266,21 @@ def beam_system(problem: BeamProblem, samples_per_element: int = 20) -> SemiDisc
         view=SceneView("beam", L, k2, sup if problem.lifting == "paper" else None,
                        problem.obstacles, beam.rho_S, beam.EI, lift, x_obs),
         bound_motion=motion, bound_shift=shift, sample_shift=s_shift)
+
+
+def modal_damping(M, K, zeta: float) -> sp.csr_matrix:
+    """M Φ diag(2ζω) Φᵀ M: the damping matrix giving every mode of K φ = ω²Mφ the ratio
+    ζ (Φ mass-normalised, ΦᵀMΦ = I).  Dense.  The modes come from the inverted pencil
+    M v = μ(K + sM)v, μ = 1/(ω² + s), whose error is relative to the lowest modes (see
+    modes.py); the small shift s makes K + sM definite when the beam has rigid motions,
+    which then get ω = 0 and no damping."""
+    import scipy.linalg as sla
+    Md, Kd = M.toarray(), K.toarray()
+    s = 1e-8 * np.trace(Kd) / np.trace(Md)
+    mu, V = sla.eigh(Md, Kd + s * Md)
+    omega = np.sqrt(np.maximum(1.0 / mu - s, 0.0))
+    MPhi = Md @ (V / np.sqrt(mu))
+    return sp.csr_matrix((MPhi * (2.0 * zeta * omega)) @ MPhi.T)
 
 
 def observed_node(problem: BeamProblem, space) -> int | None:

@@ -36,10 +36,12 @@ def written(run, tmp_path_factory):
 
 
 def _observed_at(run, t):
-    """The tip displacement the integrator saved at time t (saved every step)."""
+    """The tip displacement the integrator saved at time t (saved every step) and the
+    contact force there in N (the fields' unit: ρS λ, the series' contact_force_N)."""
     k = int(round(t / run.dt))
     assert abs(run.t[k] - t) < 1e-12
-    return run.observed["tip_displacement"][k], run.contact_force[k, 0]
+    rho_S = run.system.meta["problem"].beam.rho_S
+    return run.observed["tip_displacement"][k], rho_S * run.contact_force[k, 0]
 
 
 def _contact_frame(run):
@@ -144,7 +146,8 @@ PVPYTHON = textwrap.dedent("""
         pd = g.GetPointData()
         out[name] = {"reader": r.GetXMLName(), "times": times, "blocks": blocks,
                      "arrays": sorted(pd.GetArrayName(i) for i in range(pd.GetNumberOfArrays())),
-                     "tip": float(vtk_to_numpy(pd.GetArray("displacement"))[-1])}
+                     "tip": float(vtk_to_numpy(pd.GetArray("displacement"))[-1]),
+                     "force": float(vtk_to_numpy(pd.GetArray("contact_force"))[-1])}
     print("RESULT" + json.dumps(out))
 """)
 
@@ -167,12 +170,14 @@ def test_paraview_reads_both(run, written, tmp_path):
     line = [s for s in proc.stdout.splitlines() if s.startswith("RESULT")][-1]
     out = json.loads(line[len("RESULT"):])
     assert out["default_xdmf"]["reader"] == "Xdmf3ReaderS"   # the reader that aborted
-    tip, _ = _observed_at(run, run.frames_t[k])
+    tip, force = _observed_at(run, run.frames_t[k])      # force: ρS λ, in N
+    assert force != 0
     for name, got in out.items():
         np.testing.assert_allclose(got["times"], run.frames_t, rtol=1e-12, err_msg=name)
         assert set(got["arrays"]) == ARRAYS, name
         assert got["blocks"] <= 1, f"{name}: {got['blocks']} blocks (a stale mesh block?)"
         assert got["tip"] == pytest.approx(tip, rel=1e-12), name
+        assert got["force"] == pytest.approx(force, rel=1e-12), name
 
 
 def test_sub_points_follow_the_cubic(run):
@@ -194,7 +199,7 @@ def test_sub_points_follow_the_cubic(run):
     np.testing.assert_allclose(f["velocity"][:-1], smp.E0 @ v + lifting(x, pb.beam.L) * dphi,
                                rtol=1e-8, atol=1e-12)
     inner = np.arange(x.size) % S != 0               # u'' jumps at nodes: compare inside
-    want = pb.beam.k2 * (smp.E2 @ u + lifting_dd(x, pb.beam.L) * phi)
+    want = pb.beam.rho_S * pb.beam.k2 * (smp.E2 @ u + lifting_dd(x, pb.beam.L) * phi)  # N·m
     np.testing.assert_allclose(f["bending_moment"][:-1][inner], want[inner], rtol=1e-10)
     assert f["displacement"][0] == pytest.approx(phi, abs=1e-15)   # the clamp moves with φ
     # a cubic, not its chord: mid-element values differ from the nodal average
@@ -379,3 +384,26 @@ def test_unreadable_meshes(tmp_path, capsys):
         load_mesh(tri, 1.0)
     with pytest.raises(InputError, match="L=-1 must be > 0"):
         load_mesh(tri, -1.0)
+
+
+def test_field_forces_are_the_series_newtons(tmp_path):
+    """A scene file's run (the heat-exchanger tube, two baffles): at every frame, the
+    field contact_force summed over the tube equals timeseries.csv's contact_force_N
+    (the net force, N) at that time."""
+    from conftest import exit_code
+    from skfem_beam.scenefile import example, run_main
+    out = tmp_path / "hx"
+    assert exit_code(run_main, [str(example("heat_exchanger_tube")), "--set", "time.T=0.1",
+                                "--format", "xdmf", "--frames", "100", "--out", str(out)]) == 0
+    series = np.genfromtxt(out / "timeseries.csv", delimiter=",", names=True)
+    hits = 0
+    with meshio.xdmf.TimeSeriesReader(out / "fields.xdmf") as rd:
+        rd.read_points_cells()
+        for i in range(rd.num_steps):
+            t, pd, _ = rd.read_data(i)
+            k = int(np.argmin(np.abs(series["t"] - t)))
+            assert abs(series["t"][k] - t) < 1e-12
+            assert pd["contact_force"].sum() == pytest.approx(series["contact_force_N"][k],
+                                                              rel=1e-12, abs=1e-12)
+            hits += series["contact_force_N"][k] != 0
+    assert hits >= 2

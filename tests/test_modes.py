@@ -201,14 +201,14 @@ def test_free_vibration_of_a_pinned_beam_follows_its_first_mode():
 # --- refusals --------------------------------------------------------------------------
 
 @pytest.mark.parametrize("kw, words", [
-    (dict(ends=("clamped", "hinged")), ["ends[1]='hinged'", "clamped, pinned, sliding, free"]),
+    (dict(ends=("clamped", "hinged")), ["ends.right='hinged'", "clamped, pinned, sliding, free"]),
     (dict(ends="clamped"), ["ends='clamped'", "pair"]),
     (dict(ends=("free",)), ["ends=('free',)", "pair"]),
     (dict(supports=(2.0,)), ["support x=2", "outside [0, L=1.501]"]),
     (dict(supports=(float("nan"),)), ["supports[0]=nan"]),
     (dict(supports=(0.6004, 0.6004)), ["two supports at x=0.6004"]),
     (dict(supports=(0.0,)), ["support x=0 is at the clamped end", "already fixed"]),
-    (dict(supports=(L,)), ["support x=1.501 is at the free end", "ends[1]='pinned'"]),
+    (dict(supports=(L,)), ["support x=1.501 is at the free end", "ends.right='pinned'"]),
     (dict(supports=(0.5,)), ["no node at the support x=0.5"]),
     (dict(support=Support(0.01, 30.0), ends=("sliding", "free")),
      ["moving at x=0 is a sliding end", "only clamped or pinned ends"]),

@@ -43,8 +43,8 @@ def test_static_lifting_fields_show_the_physical_displacement():
         np.testing.assert_allclose(f["displacement"], line.E0 @ u + phi, rtol=0, atol=1e-14)
         np.testing.assert_allclose(f["velocity"], line.E0 @ v + dphi, rtol=0, atol=1e-12)
         assert f["displacement"][0] == pytest.approx(phi, abs=1e-14)
-        # h'' = 0 up to the solve's round-off: the moment is the relative u's
-        np.testing.assert_allclose(f["bending_moment"], line.k2 * (line.E2 @ u),
+        # h'' = 0 up to the solve's round-off: the moment is the relative u's (N·m: × ρS)
+        np.testing.assert_allclose(f["bending_moment"], line.rho_S * line.k2 * (line.E2 @ u),
                                    rtol=0, atol=1e-9 * np.abs(f["bending_moment"]).max())
 
 
@@ -102,15 +102,15 @@ def _stepped(ends=("clamped", "free"), **kw):
 
 def test_stepped_beam_bending_moment_is_EI_u_second_derivative():
     """A stepped cantilever under a static tip force P: the exact u is cubic on every
-    element, so the moment field EI(x)u''/ρA_ref is P(L − x)/ρA_ref to round-off, on both
-    segments and at the step (k²u'' alone is off by EI₂/EI₁ beyond it)."""
+    element, so the moment field EI(x)u'' is P(L − x) N·m to round-off, on both segments
+    and at the step (k²u'' alone is off by EI₂/EI₁ beyond it)."""
     P = 3.0
     pb = _stepped(load=Load.point(1.5, P))
     s = beam_system(pb)
     u = spla.spsolve(s.K.tocsc(), s.loads[:, 0] * float(s.load_time[0](np.array([0.0]))[0]))
     line = sample_line(s)
     f = line.fields(0.0, u, np.zeros_like(u), np.zeros(s.C.shape[0]))
-    want = P * (1.5 - line.x) / pb.beam.rho_S
+    want = P * (1.5 - line.x)
     np.testing.assert_allclose(f["bending_moment"], want, rtol=0, atol=1e-9 * want.max())
 
 

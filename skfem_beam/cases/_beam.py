@@ -2,12 +2,12 @@
 from __future__ import annotations
 
 import math
-
 from pathlib import Path
 
 import numpy as np
 
 from .. import cli
+from ..scheme.kernels import CONTACT_STEPS
 from ..output.charts import energy_chart, shape_chart, trajectory_chart
 from ..output.events import beam_impacts
 from ..output.fields import physical_tip
@@ -51,8 +51,26 @@ def run_beam_case(case: str, problem, spec: RunSpec, stops=(), extra=None) -> in
         return beam_impacts(folder, run, problem, last)
 
     series = Series(beam_columns(system.view, rho_S), events=events)
-    return execute(run, spec.options, summary, series,
+    code = execute(run, spec.options, summary, series,
                    beam_charts(case, problem, rho_S, stops, extra, system.view.observed_x))
+    if code == 0:
+        warn_no_contact(run, system)
+    return code
+
+
+def warn_no_contact(run, system) -> None:
+    """One warning line when a scene with obstacles never touched them and its clearance
+    is over 100 times the largest displacement there (in the saved frames): a clearance
+    in millimetres written as metres looks exactly like this."""
+    lo, hi = np.asarray(system.lo, dtype=float), np.asarray(system.hi, dtype=float)
+    gaps = np.abs(np.concatenate([lo[np.isfinite(lo)], hi[np.isfinite(hi)]]))
+    if not gaps.size or run.n < 2 or int(run.st.counters[CONTACT_STEPS]) > 0:
+        return
+    reach = float(np.abs(system.C @ run.result().frames_u.T).max())
+    if gaps.min() > 100 * reach:
+        cli.warn(f"no contact in {run.n} steps: the largest displacement at the obstacles "
+                 f"was {reach:.3g} m, their smallest clearance {gaps.min():.4g} m; g1, g2 "
+                 "and x are in metres")
 
 
 def stability_warning(system, stepping):
@@ -144,7 +162,9 @@ def units(rho_S, system) -> dict:
                                         "work of the contact forces (≤ 0 for exact contact)"))},
            "energy_balance": "energy − energy[0] + work_damping = work_input + work_contact "
                              "(to round-off)",
-           "linear_stability_limit_dt": "s, 2/√(κ_h(1−4β)); null: no limit (β ≥ 1/4)"}
+           "linear_stability_limit_dt": "s, 2/√(κ_h(1−4β)); null: no limit (β ≥ 1/4)",
+           "max_support_deflection": "m: the largest compression of the supports' springs "
+                                     "(a stiffness: the penalty law), null for rigid ones"}
     if rho_S:
         out.update({"contact_force_N": "N (contact_force × rho_S)",
                     "energy_J": "J (energy × rho_S)",

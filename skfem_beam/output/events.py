@@ -138,6 +138,9 @@ def write_impacts(folder: Path, run, units: dict, scale: float = 1.0, sign: floa
     duration = max(0, last - 1) * run.dt
     stats = impact_statistics(table, duration, obstacles)
     f, i = units["force"], units["impulse"]
+    if run.solver != "penalty":     # exact contact: the force of one step, impulse/Δt
+        f += ("; rigid (exact) contact: the largest one-step force, which grows as dt "
+              "shrinks: quote the impulse, or give the supports a stiffness")
     stats["units"] = {"t_start": "s", "t_end": "s", "x": "m", "bound": "1 = g1 (lower), "
                       "2 = g2 (upper)", "velocity": "m/s", "peak_force": f, "impulse": i,
                       "max_violation": "m", "open": "1 = not over at the last state",

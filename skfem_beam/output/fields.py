@@ -19,13 +19,14 @@ the cubic of a Hermite or B-spline field instead of its chord.  Arrays, per poin
   none (±∞)**: an obstacle fixed to the ground stays at g, one carried by the moving
   support is drawn at g + φ(t), where it is at the frame's time; always present, so
   every time step of every scene has the same arrays;
-- ``contact_force``: the nodal contact force λ at the constrained nodes, 0 elsewhere
-  (m²/s² for the beam: force per unit mass per length, × ρS for N; positive upwards);
-  for the bar the obstacle's push R ≥ 0 at either end (Pa, or N with a cross-section A),
-  as in timeseries.csv;
-- ``bending_moment``: EI(x)ũ''/ρA_ref = k²(EI(x)/EI_ref)(u'' + h''φ) (m³/s², per unit
-  mass per length; × ρS for N·m), beams only (spaces whose ``sampler`` gives no second
-  derivatives, e.g. P1, omit it).  Hermite u'' jumps at the nodes (and EI at a step): a
+- ``contact_force``: the nodal contact force at the constrained nodes, 0 elsewhere, in N
+  for a beam whose ρS is known (ρS·λ: the ``contact_force_N`` of timeseries.csv; λ in
+  m²/s², force per unit mass per length, when it is not); positive upwards; for the bar
+  the obstacle's push R ≥ 0 at either end (Pa, or N with a cross-section A), as in
+  timeseries.csv;
+- ``bending_moment``: EI(x)ũ'' = ρS·k²(EI(x)/EI_ref)(u'' + h''φ) in N·m when ρS is known
+  (per unit mass per length, m³/s², when not), beams only (spaces whose ``sampler``
+  gives no second derivatives, e.g. P1, omit it).  Hermite u'' jumps at the nodes (and EI at a step): a
   node shared by two elements gets the mean of both sides.
 """
 from __future__ import annotations
@@ -86,6 +87,7 @@ class LineSamples:
     fixed: tuple | None = None    # rest and of those fixed to the ground (±inf: none);
     #                               None when nothing is carried
     push: np.ndarray | None = None   # (m,) sign: the field's contact force is push·λ
+    rho_S: float = 1.0            # forces and moments × this: N and N·m for a beam with ρS
 
     @property
     def points(self) -> np.ndarray:
@@ -114,7 +116,7 @@ class LineSamples:
             if moment is not None:
                 moment = moment + self.h_dd * phi
         lam = np.zeros(self.x.size)
-        lam[self.contact] = np.asarray(force, dtype=float) * \
+        lam[self.contact] = self.rho_S * np.asarray(force, dtype=float) * \
             (1.0 if self.push is None else self.push)
         g1, g2 = self.obstacles_at(t)
         out = {"displacement": disp,
@@ -122,7 +124,7 @@ class LineSamples:
                                                        np.zeros_like(disp)]),
                "velocity": vel, "g1": g1, "g2": g2, "contact_force": lam}
         if moment is not None:
-            out["bending_moment"] = self.k2 * moment
+            out["bending_moment"] = self.rho_S * self.k2 * moment
         return out
 
 
@@ -207,7 +209,9 @@ def sample_line(system, samples_per_element: int = 8) -> LineSamples:
                        g2=_nan_outside(g2), contact=contact,
                        k2=view.k2 if beam else None, L=L,
                        motion=None if lift is None else lift.motion, h=h, h_dd=h_dd,
-                       carried=carried, fixed=fixed, push=push)
+                       carried=carried, fixed=fixed, push=push,
+                       rho_S=float(problem.beam.rho_S or 1.0) if beam and problem is not None
+                       else 1.0)
 
 
 def _obstacle_lines(system, view, x, L):

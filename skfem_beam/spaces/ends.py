@@ -39,7 +39,7 @@ def check_ends(ends) -> tuple[str, str]:
                          f"each one of: {allowed}")
     for i, e in enumerate(ends):
         if not isinstance(e, str) or e not in END_CONDITIONS:
-            raise InputError(f"ends[{i}]={e!r} is not one of: {allowed}")
+            raise InputError(f"ends.{('left', 'right')[i]}={e!r} is not one of: {allowed}")
     return (ends[0], ends[1])
 
 

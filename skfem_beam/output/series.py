@@ -373,13 +373,11 @@ def check_resumable(folder: Path, summary: dict, ck: dict, extend: bool) -> None
         k = diff[0]
         raise InputError(f"{name}: {k}={mine.get(k)!r} differs from the checkpoint's "
                          f"{k}={theirs.get(k)!r}; cannot resume, nothing was changed")
-    status, n = summary.get("status"), int(ck["n"])
+    status = summary.get("status")
     if status == "unstable":
         raise InputError(f"{name}: the run went unstable; there is nothing to resume")
-    step = summary.get("checkpoint_step")
-    if status != "running" and step != n or status == "running" and (step or 0) > n:
-        raise InputError(f"{name} says the checkpoint is at step {step}, "
-                         f"{CHECKPOINT} holds step {n}; cannot resume, nothing was changed")
+    # the summary's checkpoint_step is not checked against n: the checkpoint is the one
+    # truth (a full disk can refuse the summary's write after the checkpoint's went in)
     if status == "success" and not extend:
         raise InputError(f"{folder} holds a finished run (status success): nothing to "
                          f"resume; give a longer --T to extend it")

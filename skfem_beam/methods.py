@@ -21,7 +21,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 from typing import ClassVar, Union
 
-from .checks import check_choice, check_positive, check_restitution
+from .checks import check_choice, check_nonnegative, check_positive, check_restitution
 from .contact import SOLVERS, ContactLaw, resolve
 from .contact.penalty import Penalty as PenaltyLaw
 from .contact.restitution import Restitution
@@ -72,22 +72,25 @@ class Penalty:
     """The β-scheme with one-sided springs of ``stiffness`` at the obstacles: N/m for a
     beam whose mass per length is known and for a bar with a cross-section, Pa/m for a bar
     per unit cross-section; ``equation_units``: the number is already in the units of the
-    semi-discrete equation (per unit mass for a beam), as ``solve(stiffness=)`` takes it."""
+    semi-discrete equation (per unit mass for a beam), as ``solve(stiffness=)`` takes it.
+    ``damping``: a dashpot beside each spring (Kelvin–Voigt, N·s/m in the same units as
+    ``stiffness``), the supports' own damping."""
     stiffness: float
     equation_units: bool = False
     massless: str = "beta"
+    damping: float = 0.0
     name: ClassVar[str] = "penalty"
     default_beta: ClassVar[float] = 0.25
     theta: ClassVar[None] = None
 
     def __post_init__(self):
         object.__setattr__(self, "stiffness", check_positive("stiffness", self.stiffness))
+        object.__setattr__(self, "damping", check_nonnegative("damping", self.damping))
         check_choice("massless", self.massless, MASSLESS)
 
     def law(self, system) -> ContactLaw:
-        k = self.stiffness if self.equation_units or system is None \
-            else self.stiffness / mass_scale(system)     # the one conversion of N/m
-        return PenaltyLaw(k)
+        scale = 1.0 if self.equation_units or system is None else mass_scale(system)
+        return PenaltyLaw(self.stiffness / scale, self.damping / scale)  # the one conversion
 
     def build(self, system, stepping):
         from .scheme import Run     # the quasi-static massless rows refuse springs there

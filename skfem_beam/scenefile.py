@@ -95,7 +95,7 @@ BEAM_KEYS = {
     "supports": [{"x": N}],
     "motion": {"end": V, "at": N, "lifting": V, **TIME},
     "obstacles": [{"x": N, "x_from": N, "x_to": N, "g1": G, "g2": G, "carried": V,
-                   "stiffness": N}],
+                   "stiffness": N, "damping": N}],
     "damping": {"zeta": N, "f1": N, "f2": N, "alpha": N, "alpha_K": N, "modal": N},
     "loads": [{"x": N, "distributed": V, "per_mass": V, "gravity": N, "x_from": N, "x_to": N,
                **TIME}],
@@ -148,8 +148,10 @@ class Scene:
         if law == "penalty" and self.stiffness is None:
             raise InputError("[contact] law='penalty' needs stiffness (N/m)")
         massless = self.data.get("mesh", {}).get("massless")    # as written: None if not
-        return methods.make(law, solver, self.restitution or 0.0, self.stiffness, massless,
-                            words=SCENE_WORDS)
+        method = methods.make(law, solver, self.restitution or 0.0, self.stiffness, massless,
+                              words=SCENE_WORDS)
+        supports = _supports(self.data)
+        return method if supports is None else replace(method, damping=supports[1])
 
 
 # ---------------------------------------------------------------- the file's shape
@@ -284,31 +286,33 @@ def load(path, overrides=(), files: dict | None = None, text: str | None = None,
         raise InputError(f"{path.name}: {e}") from None
 
 
-def _support_stiffness(data: dict) -> float | None:
-    """A beam's [[obstacles]] stiffness (N/m): the supports' own compliance, one value for
-    all of them (the penalty law's spring; its deflection is the support's)."""
+def _supports(data: dict) -> tuple[float, float] | None:
+    """A beam's [[obstacles]] stiffness (N/m) and damping (N·s/m, default 0): the supports'
+    own compliance, one pair for all of them (the penalty law's springs and dashpots;
+    their deflection is the support's).  None: rigid supports."""
     if data.get("kind", "beam") != "beam":
         return None
-    ks = [o.get("stiffness") for o in data.get("obstacles", [])]
-    given = {k for k in ks if k is not None}
-    if not given:
+    obstacles = data.get("obstacles", [])
+    pairs = {(o.get("stiffness"), o.get("damping")) for o in obstacles}
+    if pairs <= {(None, None)}:
         return None
-    if len(given) > 1 or None in ks:
-        raise InputError("[[obstacles]] stiffness: give every obstacle the same stiffness "
-                         f"(got {', '.join('none' if k is None else f'{k:g}' for k in ks)})")
+    if len(pairs) > 1 or None in {k for k, _ in pairs}:
+        raise InputError("[[obstacles]] stiffness, damping: give every obstacle the same "
+                         f"(got {', '.join(f'{k}, {c}' for k, c in sorted(pairs, key=str))})")
     if "stiffness" in data.get("contact", {}) or \
             data.get("contact", {}).get("law", "penalty") not in ("penalty", "auto"):
         raise InputError("[[obstacles]] stiffness makes the supports springs (the penalty "
                          "law): leave out [contact] law and stiffness")
-    return given.pop()
+    (k, c), = pairs
+    return k, 0.0 if c is None else c
 
 
 def _scene(kind, problem, data, text, files) -> Scene:
     contact = data.get("contact", {})
     law, k = contact.get("law", "auto"), contact.get("stiffness")
-    support_k = _support_stiffness(data)
-    if support_k is not None:
-        law, k = "penalty", support_k
+    supports = _supports(data)
+    if supports is not None:
+        law, k = "penalty", supports[0]
     if k is not None and law == "auto":
         law = "penalty"
     check_choice("[contact] law", law, (*methods.LAWS, *SOLVERS))

@@ -331,6 +331,27 @@ def test_python_engines_are_called_only_on_steps_in_contact(solver):
     assert np.abs(a.frames_u - b.frames_u).max() <= 1e-10 * np.abs(b.frames_u).max()
 
 
+
+def test_a_python_law_with_a_force_inside_its_bounds_is_called_every_step():
+    """``free_inside = False`` (a law whose force does not vanish between the bounds): the
+    loop calls its solver on every step, in contact or not."""
+    from skfem_beam.contact.daqp_solver import DAQP
+    from skfem_beam.scheme import Run
+    from skfem_beam.scheme.solve import drive
+    from skfem_beam.scheme.stepping import Stepping
+
+    class Everywhere(DAQP):
+        name = "daqp-everywhere"
+        free_inside = False
+    run = Run(beam_system(scenes.flat_obstacles(J=40)), Stepping(1e-3, 0.3, 0.5),
+              Everywhere())
+    engine, calls = run.pysolver, []
+    engine_solve = engine.solve
+    engine.solve = lambda *a: calls.append(1) or engine_solve(*a)
+    drive(run, progress=False)
+    assert len(calls) == run.n - 1 == 299
+
+
 @pytest.mark.parametrize("element", ["hermite", "bspline"])
 def test_all_solvers_give_the_same_run(element):
     """200 steps of the convex-obstacle scene: every solver, every step, to 1e-8."""

@@ -589,3 +589,39 @@ def test_elastic_supports_give_peak_forces_that_converge_with_dt(tmp_path):
                                 "--format", "none", "--out", str(rigid)]) == 0
     units = json.loads((rigid / "summary.json").read_text())["impact_statistics"]["units"]
     assert "grows as dt shrinks: quote the impulse" in units["peak_force"]
+
+
+def test_damped_supports_dissipate_what_their_dashpots_do(tmp_path):
+    """Baffles of 1e6 N/m and 30 N·s/m ([[obstacles]] stiffness, damping: Kelvin–Voigt).
+    Over the first impact the contact work equals −Σ c ẏ² Δt, the dashpot's dissipation
+    summed from the probes' displacement series at the baffles (ẏ central, on the steps
+    compressed at tₙ), up to the springs' own defect where they switch on and off, which
+    falls at second order: 5.5 % at Δt = 5e-5 s, 1.3 % at 2.5e-5 s.  The energy identity
+    holds to round-off and the peak force moves by under 1 % between the two."""
+    from skfem_beam import read_run
+    text = example("heat_exchanger_tube").read_text().replace(
+        "g2 = 0.0004", "g2 = 0.0004\nstiffness = 1e6\ndamping = 30.0").replace(
+        "T = 1.0", 'T = 0.04\nload_window = "centered"')
+    src = write(tmp_path, text, "hx.toml")
+    errors, peaks = [], []
+    for dt in (5e-5, 2.5e-5):
+        out = tmp_path / f"dt{dt:g}"
+        assert exit_code(run_main, [str(src), "--set", f"time.dt={dt}", "--probe", "0.5",
+                                    "--probe", "1.0", "--format", "none",
+                                    "--out", str(out)]) == 0
+        run = read_run(out)
+        s, imp = run.series, run.impacts
+        assert run.summary["penalty_damping_N_s_per_m"] == 30.0
+        end = int(round(imp["t_end"][0] / dt)) + 2       # the first impact is over
+        dissipated = 0.0
+        for x in ("0.5", "1"):
+            y = s[f"probe_{x}_displacement"][:end + 1]
+            n = np.flatnonzero(np.abs(y[1:-1]) > 0.0004) + 1     # compressed at tₙ
+            dissipated += 30.0 * np.sum((y[n + 1] - y[n - 1]) ** 2) / (4 * dt)
+        errors.append(abs(s["work_contact_J"][end] / -dissipated - 1))
+        peaks.append(imp["peak_force"][0])
+        balance = s["energy_J"] - s["energy_J"][0] + s["work_damping_J"] \
+            - s["work_input_J"] - s["work_contact_J"]
+        assert np.abs(balance).max() < 1e-11 * np.abs(s["energy_J"]).max()
+    assert errors[1] < 0.02 and errors[0] / errors[1] > 3, errors
+    assert abs(peaks[1] / peaks[0] - 1) < 0.01

@@ -44,6 +44,7 @@ def run_beam_case(case: str, problem, spec: RunSpec, stops=(), extra=None) -> in
         "observed_x": system.view.observed_x or problem.beam.L,
         "units": {**units(rho_S, system), "probes": probe_units(system)},
         "penalty_stiffness_N_per_m": spec.method.stiffness if penalty else None,
+        "penalty_damping_N_s_per_m": spec.method.damping if penalty else None,
         "config": spec.config,
     }
 

@@ -21,7 +21,9 @@ A law is an object with
   has ``solver(step)`` returning an object with ``solve(x_free, y_free, lo, hi) ->
   (μ, its)`` (lo, hi: the step's bounds, which move with a support) and, so that its
   runs checkpoint and resume bit for bit, ``checkpoint() -> dict`` of arrays and
-  ``restore(dict)`` (its warm start);
+  ``restore(dict)`` (its warm start); the loop calls ``solve`` only on steps whose free
+  values leave their bounds, unless the law sets ``free_inside = False`` (a force
+  inside the bounds too);
 - ``explicit`` (optional): a compiled part of the contact force known before the step,
 
       explicit(y_cur, y_prev, lo, hi, params, r) -> 0
@@ -154,6 +156,8 @@ class ContactLaw:
     name = "law"
     kernel = None
     explicit = None
+    free_inside = True   # μ = 0 whenever y_free lies within [lo, hi] (a Python law's
+    #                      solver is then not called: every position-level law)
 
     def setup(self, step: StepData, first: bool = False) -> np.ndarray:
         return np.zeros(0)

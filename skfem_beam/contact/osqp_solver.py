@@ -2,27 +2,24 @@
 
 The step QP  min ½xᵀAx − Fᵀx,  lo ≤ Cx ≤ hi  is set up ONCE per run (A, C, lo, hi are
 constant); each step only updates q = −F = −A x_free and warm-starts from the last
-solution.  What makes OSQP's answer trustworthy here (see docs/design.md, "Known traps"):
+solution.  The compiled loop calls it only when the free step leaves its bounds (μ = 0
+is exact otherwise).  What makes OSQP's answer exact (docs/design.md §4 and "Known traps"):
 
 - Scaling.  OSQP's tolerances are absolute.  Unknowns are measured in units of
   s = the largest finite |bound| (x = s·x̂) and the objective is divided by s²·ā
-  (ā = mean diagonal of A), so the bounds, P and q are O(1) and eps = 1e-10 means
-  "1e-10 of the obstacle scale".  OSQP's own Ruiz scaling comes on top.
-- Polishing on; ``status_val`` and ``status_polish`` are checked every step.
-- Exact finish (`active_set.exact_finish`, shared with daqp).  ADMM is only accurate
-  to eps; polishing identifies the active set.  μ is then recomputed exactly on that
-  set (D_WW μ_W = b_W − y_free,W, compiled), so y = y_free + Dμ sits on its bounds to
-  round-off.  A constraint whose multiplier or gap is below OSQP's accuracy (grazing
-  contact) can be misclassified; the exact KKT check catches it and the compiled
-  active-set method, warm-started from OSQP's set, decides it (counted in
-  ``self.repairs``).  A set wrong by more than grazing (KKT residual > 1e-6 of the
-  scale) is a failure: SolverError.
-- OSQP 1.x prints "Polishing not needed ..." whenever no constraint is active, even
-  with verbose=False.  Its Python module routes C-level printing through
-  PySys_WriteStdout, i.e. Python's ``sys.stdout`` (redirecting file descriptor 1
-  does nothing); ``sys.stdout`` is swapped for a null sink around solve(), which
-  costs ~0.3 µs (measured; the GIL is held throughout, so no other thread prints
-  meanwhile).
+  (ā = mean diagonal of A), so the bounds, P and q are O(1) and EPS means "EPS of the
+  obstacle scale".  OSQP's own Ruiz scaling comes on top.
+- ADMM finds the active set, the exact finish solves on it.  ADMM runs to EPS = 1e-6
+  (``status_val`` must be SOLVED); the set is read from its iterate by the rule of OSQP's
+  own polishing (`guess_active`), and μ is computed exactly on it (D_WW μ_W = b_W −
+  y_free,W, compiled: `active_set.exact_finish`, shared with daqp), so y = y_free + Dμ
+  sits on its bounds to round-off.  Polishing itself is off: it would factorise a
+  reduced KKT system every step to do the same less exactly (and OSQP 1.x then prints
+  "Polishing not needed" from C whenever no constraint is active).
+- A constraint whose multiplier or gap is below OSQP's accuracy (near grazing) can be
+  misclassified; the exact KKT check catches it and the compiled active set,
+  warm-started from OSQP's set, decides it (``self.repairs``).  A residual above
+  REPAIR_TOL of the scale means OSQP's set was wrong: SolverError.
 """
 from __future__ import annotations
 
@@ -38,8 +35,6 @@ from .base import ContactLaw
 EPS = 1e-6         # OSQP's eps_abs = eps_rel, in scaled units: enough to find the set
 CHECK_EVERY = 10   # ADMM iterations between termination checks (OSQP's default: 25)
 REPAIR_TOL = 1e4 * EPS   # a KKT residual above this (× the scale): OSQP's set is wrong
-
-
 
 
 class OSQPSolver:

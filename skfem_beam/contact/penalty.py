@@ -8,12 +8,20 @@ y = y_free + D μ,  μ = Δt² β r(y),  solved exactly by a semi-smooth Newton 
 (finite for piecewise-linear monotone maps; one step when m = 1).  The contact force
 recorded is the whole β-weighted spring force.
 
+A support's damping c (``damping``, Kelvin–Voigt: a dashpot beside the spring) adds
+−c ẏ on the values whose spring is compressed at tₙ, with ẏ = (y^{n+1} − y^{n−1})/(2Δt)
+as the scheme takes B's (so μ gains −(cΔt/2)(y^{n+1} − y^{n−1}) there).  Its activity
+is that of tₙ, known before the step: the equation stays piecewise linear, continuous
+and monotone (with the activity of t_{n+1} the dashpot would switch on with a jump
+c·ẏ and Newton could cycle).  Like every linear Kelvin–Voigt contact, it also pulls
+while the support unloads.
+
 The start step weights the spring at u⁰ by ½(1−2β) instead (see scheme.run).
 """
 import numpy as np
 from numba import njit
 
-from ..checks import check_positive
+from ..checks import check_nonnegative, check_positive
 from .base import ContactLaw, compiled_explicit, compiled_law
 
 
@@ -24,8 +32,9 @@ def spring(y, lo, hi, stiffness):
 
 
 @njit(cache=True)
-def compliance_solve(D, yf, lo, hi, c, state, mu):
-    """Solve y = yf − c·D·[(y − hi)⁺ − (lo − y)⁺] (c = Δt²βκ ≥ 0) for μ = (y − yf) in
+def compliance_solve(D, yf, lo, hi, c, state, mu, d, damped, y_prev):
+    """Solve y = yf − c·D·[(y − hi)⁺ − (lo − y)⁺] − d·D·δ(y − y_prev) (c = Δt²βκ ≥ 0; the
+    dashpot d = cΔt/2 on the values ``damped``, δ their indicator) for μ = (y − yf) in
     D-scaled form; ``state`` (−1/0/+1) is the warm start.  Returns iterations (< 0: failed)."""
     m = yf.size
     if c == 0.0:
@@ -33,7 +42,7 @@ def compliance_solve(D, yf, lo, hi, c, state, mu):
         return 0
     y = yf.copy()
     for it in range(1, 60 + 4 * m):
-        # Newton system on the current pattern: y + c D P (y − b) = yf
+        # Newton system on the current pattern: y + c D P (y − b) + d D δ (y − y_prev) = yf
         Amat = np.eye(m)
         rhs = yf.copy()
         for j in range(m):
@@ -42,6 +51,10 @@ def compliance_solve(D, yf, lo, hi, c, state, mu):
                 for i in range(m):
                     Amat[i, j] += c * D[i, j]
                     rhs[i] += c * D[i, j] * b
+            if d != 0.0 and damped[j]:
+                for i in range(m):
+                    Amat[i, j] += d * D[i, j]
+                    rhs[i] += d * D[i, j] * y_prev[j]
         y = np.linalg.solve(Amat, rhs)
         changed = False
         for j in range(m):
@@ -53,9 +66,11 @@ def compliance_solve(D, yf, lo, hi, c, state, mu):
             break
     else:
         return -1
-    # μ with y = yf + D μ: μ = −c·[(y − hi)⁺ − (lo − y)⁺]
+    # μ with y = yf + D μ: μ = −c·[(y − hi)⁺ − (lo − y)⁺] − d·δ(y − y_prev)
     for j in range(m):
         mu[j] = -c * (max(y[j] - hi[j], 0.0) - max(lo[j] - y[j], 0.0))
+        if d != 0.0 and damped[j]:
+            mu[j] -= d * (y[j] - y_prev[j])
     return it
 
 
@@ -71,9 +86,13 @@ def penalty_explicit(y_cur, y_prev, lo, hi, params, r):
 
 @compiled_law
 def penalty_kernel(D, yf, y_cur, y_prev, lo, hi, params, state, mu, active):
-    """The implicit springs: y = yf + Dμ, μ = Δt²βκ·r(y)/κ (params[1] = Δt²βκ)."""
-    its = compliance_solve(D, yf, lo, hi, params[1], state, mu)
+    """The implicit springs (params[1] = Δt²βκ) and dashpots (params[4] = cΔt/2, on the
+    values compressed at tₙ): y = yf + Dμ."""
     m = yf.size
+    damped = np.zeros(m, dtype=np.bool_)
+    for j in range(m):
+        damped[j] = y_cur[j] > hi[j] or y_cur[j] < lo[j]
+    its = compliance_solve(D, yf, lo, hi, params[1], state, mu, params[4], damped, y_prev)
     for i in range(m):   # in contact: the spring is compressed at y^{n+1}
         y = yf[i]
         for j in range(m):
@@ -89,13 +108,15 @@ class Penalty(ContactLaw):
     kernel = penalty_kernel
     explicit = penalty_explicit
 
-    def __init__(self, stiffness: float):
+    def __init__(self, stiffness: float, damping: float = 0.0):
         self.stiffness = check_positive("stiffness", stiffness)
+        self.damping = check_nonnegative("damping", damping)
 
     def setup(self, step, first=False):
         beta, k = step.beta, self.stiffness
         w_cur, w_prev = (0.5 * (1 - 2 * beta), 0.0) if first else (1 - 2 * beta, beta)
-        return np.array([k, step.dt ** 2 * beta * k, w_cur, w_prev])
+        return np.array([k, step.dt ** 2 * beta * k, w_cur, w_prev,
+                         0.5 * step.dt * self.damping])
 
     def __repr__(self) -> str:
-        return f"Penalty(stiffness={self.stiffness:g})"
+        return f"Penalty(stiffness={self.stiffness:g}, damping={self.damping:g})"

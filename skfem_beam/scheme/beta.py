@@ -299,7 +299,8 @@ class BetaScheme:
                 raise
         PythonLaw.solver, PythonLaw.state, PythonLaw.error = self.pysolver, self.st, None
         try:
-            return run_steps_python(self.ops, self.st, out, n0, n1, inputs, Ebound)
+            return run_steps_python(self.ops, self.st, out, n0, n1, inputs, Ebound,
+                                    bool(getattr(self.law, "free_inside", True)))
         finally:
             PythonLaw.solver = PythonLaw.state = None
 

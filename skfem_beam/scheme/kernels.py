@@ -393,17 +393,18 @@ def _solve_in_python() -> int:
 
 
 @njit(cache=True)
-def run_steps_python(ops, st, out, n0, n1, inputs, Ebound):
+def run_steps_python(ops, st, out, n0, n1, inputs, Ebound, free_inside):
     """The same steps as `run_steps` with the law solved in Python (`PythonLaw.solver`,
     e.g. OSQP or daqp, given the step's bounds): the compiled loop calls it for μ when
-    the free step leaves its bounds.  When it does not, μ = 0 is the step's exact
-    solution (the unconstrained minimiser is feasible) and the engine is not called:
-    its calls are then exactly the steps in contact (counters[CONTACT_STEPS])."""
+    the free step leaves its bounds.  When it does not and ``free_inside`` (the law's:
+    ContactLaw.free_inside), μ = 0 is the step's exact solution (the unconstrained
+    minimiser is feasible) and the engine is not called: its calls are then exactly the
+    steps in contact (counters[CONTACT_STEPS])."""
     for step in range(n0, n1):
         Gn = inputs.G[step - n0]
         move_bounds(ops, st, inputs.phi[step - n0])
         free_step(ops, st, Gn, inputs.H, step - n0)
-        if inside(st.yf, st.lo, st.hi):
+        if free_inside and inside(st.yf, st.lo, st.hi):
             its = 0
             st.mu[:] = 0.0
         else:

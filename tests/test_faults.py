@@ -296,8 +296,7 @@ def test_a_summary_the_disk_refused_after_the_checkpoint_resumes_from_the_checkp
     """The disk fills between the checkpoint (renamed into place) and the summary's
     checkpoint_step: exit 3, the summary names an older checkpoint (here none) than
     checkpoint.npz holds.  The checkpoint is the one truth: the resume continues from it
-    to the uninterrupted run's files (it was refused for good before: a stuck folder, 2
-    of 93 full-disk cycles of the soak)."""
+    to the uninterrupted run's files (it was refused for good before: a stuck folder)."""
     argv = ["--dt", "5e-5", "--T", "0.4", "--flush-every", "1000", "--checkpoint-every", "0",
             "--format", "none"]
     ref, out = tmp_path / "ref", tmp_path / "run"

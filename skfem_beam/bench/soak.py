@@ -139,6 +139,8 @@ def full_disk_cycle(ref: Path, work: Path, rng: random.Random, tally: Counter) -
         if p.returncode not in (0, 3):
             return "crashed"
         tally["disk full" if p.returncode == 3 else "fitted"] += 1
+        if p.returncode == 0:           # it fitted: finished, nothing to resume
+            return "done" if same_files(folder, ref) else "different"
         if not (folder / "checkpoint.npz").exists():
             return "no checkpoint"
         mount(disk, kb + int((need - kb) * rng.uniform(0.0, 0.5)), remount=True)

@@ -43,7 +43,10 @@ def end(code: int) -> None:
     tests).  What Python's finalisation does first runs here, with a handler (a signal
     meanwhile: one line, 128 + the signal): its threads are joined and its exit handlers
     run; the streams are flushed, then the signals are blocked and a pending one still
-    honoured.  The module teardown, which would run with default handlers, is skipped."""
+    honoured.  The module teardown, which would run with default handlers, is skipped.
+    Left open: a signal the kernel hands to another thread (BLAS's) in the microseconds
+    between the last check and ``os._exit`` trips Python's flag too late to be acted on;
+    the command had finished and exits with ``code``."""
     if not COMMAND or threading.current_thread() is not threading.main_thread():
         sys.exit(code)
     for sig in SIGNALS:

@@ -50,9 +50,11 @@ print("printed, not yet flushed", end="")
 how = sys.argv[1]
 if how == "during":      # a SIGTERM while the exit handlers run
     atexit.register(lambda: os.kill(os.getpid(), signal.SIGTERM))
-elif how == "pending":   # one that arrives blocked, just before the end
+elif how == "pending":   # one that arrives blocked, just before the end (sent to this
+    import threading     # thread: os.kill may hand it to another thread, e.g. BLAS's)
     atexit.register(lambda: (signal.pthread_sigmask(signal.SIG_BLOCK, [signal.SIGINT]),
-                             os.kill(os.getpid(), signal.SIGINT)))
+                             signal.pthread_kill(threading.main_thread().ident,
+                                                 signal.SIGINT)))
 atexit.register(lambda: open(sys.argv[2], "w").close())
 _startup.end(3)
 """

@@ -33,6 +33,15 @@ def check_nonnegative(name: str, value) -> float:
     return value
 
 
+def check_ratio(name: str, zeta) -> float:
+    """A damping ratio: 0 ≤ ζ < 1."""
+    zeta = check_nonnegative(name, zeta)
+    if zeta >= 1:
+        raise InputError(f"{name}={zeta:g} must be below 1: it is a ratio of critical damping "
+                         "(0.02 for 2 %)")
+    return zeta
+
+
 def check_beta(beta) -> float:
     beta = check_finite("beta", beta)
     if not 0.0 <= beta <= 0.5:

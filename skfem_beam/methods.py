@@ -140,10 +140,11 @@ def _name(word: str) -> str:
 
 def make(law: str = "position", solver: str = "auto", restitution: float = 0.0,
          stiffness: float | None = None, massless: str | None = None,
-         words: Words = FLAGS) -> Method:
+         words: Words = FLAGS, damping: float = 0.0) -> Method:
     """The method the words name: ``law`` one of LAWS, ``solver`` the position-level
-    QP solver, ``stiffness`` the penalty springs (N/m, see :class:`Penalty`),
-    ``massless`` the massless rows' stepping (None: the default)."""
+    QP solver, ``stiffness`` and ``damping`` the penalty springs and their dashpots (N/m,
+    N·s/m, see :class:`Penalty`), ``massless`` the massless rows' stepping (None: the
+    default)."""
     check_choice(_name(words.law), law, LAWS)
     e = check_restitution(restitution, words.restitution)
     if law == MOREAU_JEAN:
@@ -156,7 +157,7 @@ def make(law: str = "position", solver: str = "auto", restitution: float = 0.0,
         return MoreauJean(0.5, e)
     if law == "penalty":     # the registry's checks: no solver, no restitution with springs
         resolve("penalty" if solver == "auto" else solver, stiffness, e)
-        return Penalty(stiffness, massless=massless or "beta")
+        return Penalty(stiffness, massless=massless or "beta", damping=damping)
     check_choice(_name(words.solver), solver, SOLVERS)
     return PositionLevel(solver, e, massless or "beta")
 

@@ -13,7 +13,7 @@ from typing import Callable
 import numpy as np
 
 from .checks import (check_beta, check_choice, check_count, check_finite,  # noqa: F401
-                     check_nonnegative, check_positive)
+                     check_nonnegative, check_positive, check_ratio)
 from .errors import InputError
 from .timefunctions import Constant, derivative
 from .spaces.ends import DEFAULT_ENDS, END_CONDITIONS, check_ends, fixed_dofs, support_nodes
@@ -424,15 +424,6 @@ class Damping:
     @property
     def none(self) -> bool:
         return self.alpha == 0.0 and self.alpha_K == 0.0 and self.modal == 0.0
-
-
-def check_ratio(name: str, zeta) -> float:
-    """A damping ratio: 0 ≤ ζ < 1."""
-    zeta = check_nonnegative(name, zeta)
-    if zeta >= 1:
-        raise InputError(f"{name}={zeta:g} must be below 1: it is a ratio of critical damping "
-                         "(0.02 for 2 %)")
-    return zeta
 
 
 @dataclass(frozen=True)

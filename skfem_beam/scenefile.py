@@ -123,8 +123,9 @@ class Scene:
     """A scene file read into the Python API's objects.
 
     ``problem``: a BeamProblem or a Bar; ``stepping``: the time grid; ``law``,
-    ``stiffness`` (N/m), ``restitution``: the [contact] keys (``method`` builds the run's
-    method from them);
+    ``stiffness`` (N/m), ``restitution``: the [contact] keys, ``damping`` (N·s/m): the
+    supports' dashpots ([[obstacles]] damping) (``method`` builds the run's method from
+    them);
     ``output``: format, save_every, frames, flush_every, checkpoint_every; ``text``: the
     file as read and ``files`` the tables it read (path as written → text), so that a run
     can be rebuilt from its summary.json; ``data``: the parsed TOML with the overrides.
@@ -139,6 +140,7 @@ class Scene:
     text: str = ""
     files: dict = field(default_factory=dict)
     data: dict = field(default_factory=dict)
+    damping: float = 0.0
 
     @property
     def method(self) -> methods.Method:
@@ -148,10 +150,8 @@ class Scene:
         if law == "penalty" and self.stiffness is None:
             raise InputError("[contact] law='penalty' needs stiffness (N/m)")
         massless = self.data.get("mesh", {}).get("massless")    # as written: None if not
-        method = methods.make(law, solver, self.restitution or 0.0, self.stiffness, massless,
-                              words=SCENE_WORDS)
-        supports = _supports(self.data)
-        return method if supports is None else replace(method, damping=supports[1])
+        return methods.make(law, solver, self.restitution or 0.0, self.stiffness, massless,
+                            words=SCENE_WORDS, damping=self.damping)
 
 
 # ---------------------------------------------------------------- the file's shape
@@ -309,10 +309,10 @@ def _supports(data: dict) -> tuple[float, float] | None:
 
 def _scene(kind, problem, data, text, files) -> Scene:
     contact = data.get("contact", {})
-    law, k = contact.get("law", "auto"), contact.get("stiffness")
+    law, k, c = contact.get("law", "auto"), contact.get("stiffness"), 0.0
     supports = _supports(data)
     if supports is not None:
-        law, k = "penalty", supports[0]
+        law, (k, c) = "penalty", supports
     if k is not None and law == "auto":
         law = "penalty"
     check_choice("[contact] law", law, (*methods.LAWS, *SOLVERS))
@@ -328,7 +328,7 @@ def _scene(kind, problem, data, text, files) -> Scene:
     rows = mesh.get("massless")
     methods.check_massless(rows, mesh.get("mass", "consistent"), "[mesh] massless")
     scene = Scene(kind, problem, Stepping(t["dt"], t["T"], 0.5, massless=rows or "beta"), law, k,
-                  contact.get("restitution", 0.0), out, text, files, data)
+                  contact.get("restitution", 0.0), out, text, files, data, c)
     method = scene.method          # the method's own checks (law, stiffness, restitution)
     beta = t.get("beta", methods.default_beta(method, kind))
     stepping = Stepping(t["dt"], t["T"], beta, out["save_every"], out["frames"],

@@ -32,10 +32,17 @@ def spring(y, lo, hi, stiffness):
 
 
 @njit(cache=True)
-def compliance_solve(D, yf, lo, hi, c, state, mu, d, damped, y_prev):
+def damped(y, lo, hi):
+    """The dashpot acts: the spring is compressed (y beyond its bound) at tₙ."""
+    return y > hi or y < lo
+
+
+@njit(cache=True)
+def compliance_solve(D, yf, lo, hi, c, state, mu, d, y_cur, y_prev):
     """Solve y = yf − c·D·[(y − hi)⁺ − (lo − y)⁺] − d·D·δ(y − y_prev) (c = Δt²βκ ≥ 0; the
-    dashpot d = cΔt/2 on the values ``damped``, δ their indicator) for μ = (y − yf) in
-    D-scaled form; ``state`` (−1/0/+1) is the warm start.  Returns iterations (< 0: failed)."""
+    dashpot d = cΔt/2 on the values compressed at tₙ, δ their indicator: `damped`) for
+    μ = (y − yf) in D-scaled form; ``state`` (−1/0/+1) is the warm start.  Returns
+    iterations (< 0: failed)."""
     m = yf.size
     if c == 0.0:
         mu[:] = 0.0
@@ -51,7 +58,7 @@ def compliance_solve(D, yf, lo, hi, c, state, mu, d, damped, y_prev):
                 for i in range(m):
                     Amat[i, j] += c * D[i, j]
                     rhs[i] += c * D[i, j] * b
-            if d != 0.0 and damped[j]:
+            if d != 0.0 and damped(y_cur[j], lo[j], hi[j]):
                 for i in range(m):
                     Amat[i, j] += d * D[i, j]
                     rhs[i] += d * D[i, j] * y_prev[j]
@@ -69,7 +76,7 @@ def compliance_solve(D, yf, lo, hi, c, state, mu, d, damped, y_prev):
     # μ with y = yf + D μ: μ = −c·[(y − hi)⁺ − (lo − y)⁺] − d·δ(y − y_prev)
     for j in range(m):
         mu[j] = -c * (max(y[j] - hi[j], 0.0) - max(lo[j] - y[j], 0.0))
-        if d != 0.0 and damped[j]:
+        if d != 0.0 and damped(y_cur[j], lo[j], hi[j]):
             mu[j] -= d * (y[j] - y_prev[j])
     return it
 
@@ -88,11 +95,8 @@ def penalty_explicit(y_cur, y_prev, lo, hi, params, r):
 def penalty_kernel(D, yf, y_cur, y_prev, lo, hi, params, state, mu, active):
     """The implicit springs (params[1] = Δt²βκ) and dashpots (params[4] = cΔt/2, on the
     values compressed at tₙ): y = yf + Dμ."""
+    its = compliance_solve(D, yf, lo, hi, params[1], state, mu, params[4], y_cur, y_prev)
     m = yf.size
-    damped = np.zeros(m, dtype=np.bool_)
-    for j in range(m):
-        damped[j] = y_cur[j] > hi[j] or y_cur[j] < lo[j]
-    its = compliance_solve(D, yf, lo, hi, params[1], state, mu, params[4], damped, y_prev)
     for i in range(m):   # in contact: the spring is compressed at y^{n+1}
         y = yf[i]
         for j in range(m):

@@ -210,8 +210,7 @@ def sample_line(system, samples_per_element: int = 8) -> LineSamples:
                        k2=view.k2 if beam else None, L=L,
                        motion=None if lift is None else lift.motion, h=h, h_dd=h_dd,
                        carried=carried, fixed=fixed, push=push,
-                       rho_S=float(problem.beam.rho_S or 1.0) if beam and problem is not None
-                       else 1.0)
+                       rho_S=float(view.rho_S or 1.0) if beam else 1.0)
 
 
 def _obstacle_lines(system, view, x, L):

@@ -42,13 +42,18 @@ class Material:
 
 @dataclass(frozen=True)
 class Section:
-    """Second moment of area ``I`` (m⁴) and area ``A`` (m²) of a cross-section."""
+    """Second moment of area ``I`` (m⁴) and area ``A`` (m²) of a cross-section.  ``I``
+    bends the first plane (v, along y: I_z in the usual axes); ``I_w``: the second
+    moment for the second plane (w, along z: I_y), None: the same as I (round sections)."""
     I: float  # noqa: E741  (the engineer's name)
     A: float
+    I_w: float | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "I", check_positive("I", self.I))
         object.__setattr__(self, "A", check_positive("A", self.A))
+        if self.I_w is not None:
+            object.__setattr__(self, "I_w", check_positive("I_w", self.I_w))
 
     @classmethod
     def tube(cls, outer_diameter: float, wall: float) -> "Section":
@@ -69,9 +74,10 @@ class Section:
 
     @classmethod
     def rect(cls, b: float, h: float) -> "Section":
-        """A b × h rectangle bending about the axis parallel to b: I = bh³/12, A = bh."""
+        """A b × h rectangle, h along the first plane (v): I = bh³/12, A = bh, and
+        I_w = hb³/12 for bending along b (the second plane, w)."""
         b, h = check_positive("b", b), check_positive("h", h)
-        return cls(b * h**3 / 12, b * h)
+        return cls(b * h**3 / 12, b * h, h * b**3 / 12)
 
 
 @dataclass(frozen=True)
@@ -84,11 +90,15 @@ class Beam:
     loads given in N or N/m.  :meth:`physical` builds it from a Material and a Section;
     :meth:`stepped` a piecewise-uniform beam, whose ``segments`` are (x_end, EI, ρA) and
     whose k2, rho_S are the first segment's (the reference of the mass-normalisation).
+    ``k2_w``: EI_w/(ρA), the bending stiffness of the second plane (w) of a two-plane
+    scene; None: k2 (a round section); inf: a stepped beam whose segments' I_w/I differ
+    (refused in two planes).
     """
     L: float
     k2: float
     rho_S: float | None = None
     segments: tuple[tuple[float, float, float], ...] = ()
+    k2_w: float | None = None
 
     def __post_init__(self):
         L = check_positive("L", self.L)
@@ -101,12 +111,26 @@ class Beam:
         if self.segments and (self.rho_S is None or abs(self.segments[-1][0] - self.L)
                               > 1e-12 * self.L):
             raise InputError("Beam.segments: build a stepped beam with Beam.stepped(...)")
+        if self.k2_w is not None and not math.isinf(self.k2_w):
+            object.__setattr__(self, "k2_w", check_positive("k2_w", self.k2_w))
 
     @classmethod
     def physical(cls, L: float, material: Material, section: Section) -> "Beam":
-        """Uniform beam: k2 = EI/(ρA), rho_S = ρA."""
+        """Uniform beam: k2 = EI/(ρA), rho_S = ρA (and k2_w = EI_w/(ρA))."""
         EI, rhoA = material.E * section.I, material.rho * section.A
-        return cls(L, EI / rhoA, rhoA)
+        k2_w = None if section.I_w is None else material.E * section.I_w / rhoA
+        return cls(L, EI / rhoA, rhoA, k2_w=k2_w)
+
+    def plane_w(self) -> "Beam":
+        """The same beam bending in the second plane: k2 → k2_w."""
+        if self.k2_w is None:
+            return self
+        if math.isinf(self.k2_w):
+            raise InputError("a stepped beam whose segments' I_y/I_z differ cannot bend in two "
+                             "planes: give every segment the same ratio")
+        ratio = self.k2_w / self.k2
+        segs = tuple((x, EI * ratio, rhoA) for x, EI, rhoA in self.segments)
+        return Beam(self.L, self.k2_w, self.rho_S, segs)
 
     def with_added_mass(self, added: float) -> "Beam":
         """The beam carrying ``added`` kg/m more along its whole length (the fluid inside
@@ -116,10 +140,12 @@ class Beam:
         if self.rho_S is None:
             raise InputError("[mass] added needs the beam's own mass per length: give "
                              "[material] and [section], or rho_S")
+        scale = self.rho_S / (self.rho_S + added)
+        k2_w = None if self.k2_w is None else self.k2_w * scale
         if self.segments:
             segs = tuple((x, EI, rhoA + added) for x, EI, rhoA in self.segments)
-            return Beam(self.L, segs[0][1] / segs[0][2], segs[0][2], segs)
-        return Beam(self.L, self.k2 * self.rho_S / (self.rho_S + added), self.rho_S + added)
+            return Beam(self.L, segs[0][1] / segs[0][2], segs[0][2], segs, k2_w)
+        return Beam(self.L, self.k2 * scale, self.rho_S + added, k2_w=k2_w)
 
     @classmethod
     def stepped(cls, parts) -> "Beam":
@@ -135,10 +161,13 @@ class Beam:
                 raise InputError(f"Beam.stepped part {i} must be (length, Material, Section)")
             x += check_positive(f"length of part {i}", part[0])
             segs.append((x, part[1].E * part[2].I, part[1].rho * part[2].A))
+        ratios = {1.0 if s.I_w is None else s.I_w / s.I for _, _, s in parts}
+        ratio = ratios.pop() if len(ratios) == 1 else math.inf
         EI0, rhoA0 = segs[0][1], segs[0][2]
+        k2_w = None if ratio == 1.0 else ratio * EI0 / rhoA0
         if all(s[1] == EI0 and s[2] == rhoA0 for s in segs):
-            return cls(x, EI0 / rhoA0, rhoA0)   # uniform after all
-        return cls(x, EI0 / rhoA0, rhoA0, tuple(segs))
+            return cls(x, EI0 / rhoA0, rhoA0, k2_w=k2_w)   # uniform after all
+        return cls(x, EI0 / rhoA0, rhoA0, tuple(segs), k2_w)
 
     @property
     def EI(self) -> float | None:
@@ -174,19 +203,22 @@ class Support:
     ``lifting``: "paper" (the first paper's h: clamped end at x = 0, free or pinned end at
     L, uniform beam, no intermediate supports), "static" (h solves the discrete static
     problem with u = 1 at the moving support, docs/design.md §1), or "auto" (the paper's
-    h where it applies, static elsewhere).
+    h where it applies, static elsewhere).  ``direction``: in a two-plane scene, the unit
+    vector (dy, dz) the support moves along (default the first plane).
     """
     amplitude: float = 0.0
     omega: float = 0.0
     motion: TimeFunction | None = None
     at: float = 0.0
     lifting: str = "auto"
+    direction: tuple[float, float] = (1.0, 0.0)
 
     def __post_init__(self):
         check_finite("amplitude", self.amplitude)
         check_finite("omega", self.omega)
         object.__setattr__(self, "at", check_finite("at", self.at))
         check_choice("lifting", self.lifting, LIFTINGS)
+        object.__setattr__(self, "direction", check_direction("direction", self.direction))
         if self.motion is not None:
             if not callable(self.motion):
                 raise InputError(f"motion={self.motion!r} must be a function of t")
@@ -211,6 +243,17 @@ class Support:
         if self.motion is not None:
             return np.asarray(derivative(self.motion, 2)(np.asarray(t, dtype=float)))
         return -self.omega ** 2 * self.phi(t)
+
+
+def check_direction(name: str, d) -> tuple[float, float]:
+    """A unit vector [dy, dz] in the cross-section (normalised here; (0, 0) refused)."""
+    if isinstance(d, (str, bytes)) or not hasattr(d, "__len__") or len(d) != 2:
+        raise InputError(f"{name}={d!r} must be a pair [dy, dz]")
+    dy, dz = check_finite(f"{name}[0]", d[0]), check_finite(f"{name}[1]", d[1])
+    norm = math.hypot(dy, dz)
+    if norm == 0:
+        raise InputError(f"{name}=[0, 0] has no direction")
+    return (1.0, 0.0) if (dy, dz) == (1.0, 0.0) else (dy / norm, dz / norm)
 
 
 def lifting(x, L):
@@ -391,6 +434,17 @@ class Load:
         return Load(self.terms + other.terms, self.forces + other.forces,
                     self.points + other.points, self.g + other.g)
 
+    def scaled(self, factor: float) -> "Load":
+        """The load times ``factor`` (one plane's share of a direction; 0: no load)."""
+        from .timefunctions import Scaled
+        if factor == 1.0:
+            return self
+        if factor == 0.0:
+            return Load()
+        return Load(tuple((b, Scaled(a, factor)) for b, a in self.terms),
+                    tuple((b, Scaled(a, factor)) for b, a in self.forces),
+                    tuple((x, Scaled(a, factor)) for x, a in self.points), self.g * factor)
+
 
 @dataclass(frozen=True)
 class Damping:
@@ -449,6 +503,13 @@ class BeamProblem:
     ``pinned``, ``sliding``, ``free`` (see :mod:`skfem_beam.spaces.ends`); ``supports``
     are abscissae of rigid supports u(x_s) = 0, strictly inside (0, L) and at mesh nodes.
     The defaults are the papers' beam, clamped at 0 and free at L.
+
+    ``planes``: 1 (the papers' transverse u) or 2 (displacements v, w in two bending
+    planes, the second with the beam's ``k2_w``): then ``load`` acts in the first plane
+    and ``load_w`` in the second, ``obstacles`` (flat, g1 ≤ v ≤ g2) in the first, the
+    support moves along ``support.direction``, ``initial`` is the first plane's (the
+    second starts at rest, in the frame ``initial.fixed_frame`` says), and ``holes``
+    (:class:`~skfem_beam.holes.HoleAt`) bound (v, w) at their nodes.
     """
     beam: Beam
     obstacles: Obstacles = field(default_factory=Obstacles)
@@ -461,9 +522,13 @@ class BeamProblem:
     ends: tuple[str, str] = DEFAULT_ENDS
     supports: tuple[float, ...] = ()
     damping: Damping = field(default_factory=Damping)
+    planes: int = 1
+    holes: tuple = ()
+    load_w: Load = field(default_factory=Load)
 
     def __post_init__(self):
         object.__setattr__(self, "ends", check_ends(self.ends))
+        self._check_planes()
         object.__setattr__(self, "supports", self._check_supports())
         if self.nodes is None:
             check_count("J", self.J)
@@ -481,7 +546,7 @@ class BeamProblem:
             object.__setattr__(self, "nodes", x)
             object.__setattr__(self, "J", x.size - 1)
         check_choice("element", self.element, ("hermite", "bspline"))
-        for b in self.obstacles.breakpoints:
+        for b in (*self.obstacles.breakpoints, *self.hole_breakpoints):
             if not 0.0 <= b <= self.beam.L:
                 raise InputError(f"obstacle break point x={b:g} lies outside [0, L={self.beam.L:g}]")
             d = np.abs(self.nodes - b).min()
@@ -494,6 +559,8 @@ class BeamProblem:
                 raise InputError(f"the mesh has no node at the beam's step x={b:g} (nearest "
                                  f"node {d:.3g} m away); choose J or nodes so that it is one")
         self._check_load()
+        if self.planes == 2:
+            self._check_load(self.load_w)
         J = self.nodes.size - 1
         value_fixed, slope_fixed = fixed_dofs(J, self.ends,
                                               support_nodes(self.nodes, self.supports))
@@ -516,6 +583,33 @@ class BeamProblem:
         if self.support.moves:
             self._check_moving_support()
         self.obstacles.carried_at(self.nodes[free])   # carried and fixed may not meet
+
+    def _check_planes(self) -> None:
+        if self.planes not in (1, 2) or isinstance(self.planes, bool):
+            raise InputError(f"planes={self.planes!r} must be 1 or 2 (bending planes)")
+        if self.planes == 1:
+            given = [name for name, bad in (
+                ("holes", bool(self.holes)), ("load_w", self.load_w != Load()),
+                ("a support direction", self.support.direction != (1.0, 0.0))) if bad]
+            if given:
+                raise InputError(f"{', '.join(given)} need planes = 2 (the beam bends in one "
+                                 "plane here)")
+            return
+        self.beam.plane_w()          # a stepped beam must bend alike in both planes
+        if self.element not in ("hermite", "bspline"):
+            raise InputError(f"element={self.element!r}: two planes take hermite or bspline")
+        from .holes import HoleAt
+        object.__setattr__(self, "holes", tuple(self.holes))
+        for h in self.holes:
+            if not isinstance(h, HoleAt):
+                raise InputError(f"holes must be HoleAt objects, got {h!r}")
+            for b in h.breakpoints:
+                if not 0.0 <= b <= self.beam.L:
+                    raise InputError(f"hole at x={b:g} lies outside [0, L={self.beam.L:g}]")
+
+    @property
+    def hole_breakpoints(self) -> tuple[float, ...]:
+        return tuple(b for h in self.holes for b in h.breakpoints)
 
     @property
     def lifting(self) -> str:
@@ -550,8 +644,8 @@ class BeamProblem:
                              f"pinned end at L, a uniform beam and no intermediate "
                              f"supports (got at={at:g}, ends={self.ends!r}); use 'static'")
 
-    def _check_load(self) -> None:
-        ld, L = self.load, self.beam.L
+    def _check_load(self, ld: Load | None = None) -> None:
+        ld, L = ld or self.load, self.beam.L
         if (ld.forces or ld.points) and self.beam.rho_S is None:
             raise InputError("forces in N or N/m need the beam's mass per length: build it "
                              "with Beam.physical(...) or give rho_S")

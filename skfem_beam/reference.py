@@ -575,3 +575,42 @@ def _rod_gap(bar, sign: float):
     if np.abs(w - d * (1.0 - dist / L)).max() > 1e-12 * max(abs(d), 1e-300):
         return None
     return d
+
+
+def whirl_force(M, K, B, b, row, r: float, omega: float, dt: float, beta: float) -> float:
+    """The contact force |λ| of the β-scheme's steady whirl in a round hole.
+
+    A beam bending alike in two planes (mass M, stiffness K, damping B of one plane; B
+    may be None), loaded by the rotating force b·(cos ωt, sin ωt) (b the load vector of
+    one plane, in the system's units) and held at one node (``row``, the node's value
+    row) in the round hole of radius r centred on the axis, whirls on the wall: in
+    complex form v + iw = A·e^{iωtₙ} at every step, and the nodal contact force is
+    λⁿ = −(Λ/r)·(v, w)ⁿ at the node, of constant magnitude Λ.  Substituted in the
+    scheme's step (kernels.free_step, with the load windows of BetaScheme.load_averages),
+    with z = e^{iωΔt} and s = sin²(ωΔt/2):
+
+        Z A = g·b − (Λ/r)·z·A_i·e,   Z = −(4s/Δt²)M + (i sin(ωΔt)/Δt)B + (1 − 4βs)K,
+        g = (1 − 4βs)(z − 1)/(iωΔt)      (the forward window's average of e^{iωt}),
+
+    (λ acts at the new state n+1: the factor z).  So A_i = g(Z⁻¹b)_i / (1 + (Λ/r)z(Z⁻¹)_ii),
+    and |A_i| = r is the quadratic |r + Λ z (Z⁻¹)_ii|² = |g (Z⁻¹b)_i|² in Λ; its positive
+    root is returned (NaN when the force does not reach the wall: no whirl on it)."""
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+    s = np.sin(0.5 * omega * dt) ** 2
+    Z = -(4 * s / dt**2) * sp.csc_matrix(M) + (1 - 4 * beta * s) * sp.csc_matrix(K)
+    if B is not None:
+        Z = Z + 1j * np.sin(omega * dt) / dt * sp.csc_matrix(B)
+    Z = sp.csc_matrix(Z, dtype=complex)
+    z = np.exp(1j * omega * dt)
+    g = (1 - 4 * beta * s) * (z - 1) / (1j * omega * dt)
+    e = np.asarray(row, dtype=float).ravel()
+    Hb = spla.spsolve(Z, np.asarray(b, dtype=complex))
+    He = spla.spsolve(Z, e.astype(complex))
+    h, a = z * (e @ He), abs(g * (e @ Hb))
+    # Λ²|h|² + 2rΛ Re h + r² − a² = 0
+    qa, qb, qc = abs(h) ** 2, 2 * r * h.real, r * r - a * a
+    disc = qb * qb - 4 * qa * qc
+    if qc >= 0 or disc < 0:
+        return float("nan")
+    return float((-qb + np.sqrt(disc)) / (2 * qa))

@@ -75,7 +75,7 @@ class NumberOr(dict):
 TIME = {"amplitude": N, "omega": N, "phase": N, "value": N, "sines": V, "table": V,
         "random": {"rms": N, "f_low": N, "f_high": N, "seed": N, "count": N},
         "psd": Either({"table": V, "seed": N, "df": N})}
-SECTION = {"I": N, "A": N, "tube": {"outer_diameter": N, "wall": N},
+SECTION = {"I": N, "A": N, "I_y": N, "I_z": N, "tube": {"outer_diameter": N, "wall": N},
            "rod": {"diameter": N}, "rect": {"b": N, "h": N}}
 MATERIAL = {"E": N, "rho": N}
 U0, V0 = {"x": V, "u": V}, {"x": V, "v": V}
@@ -86,18 +86,19 @@ CONTACT = {"law": V, "stiffness": N, "restitution": N}
 G = NumberOr({"poly": V, "about": V, "x": V, "g": V})     # checked by _g
 
 BEAM_KEYS = {
-    "kind": V, "material": MATERIAL, "section": SECTION,
+    "kind": V, "planes": N, "material": MATERIAL, "section": SECTION,
     "mass_normalised": {"k2": N, "rho_S": N},
     "mass": {"added": N},
     "geometry": {"L": N},
     "segments": [{"length": N, "material": MATERIAL, "section": SECTION}],
     "ends": {"left": V, "right": V},
     "supports": [{"x": N}],
-    "motion": {"end": V, "at": N, "lifting": V, **TIME},
-    "obstacles": [{"x": N, "x_from": N, "x_to": N, "g1": G, "g2": G, "carried": V,
+    "motion": {"end": V, "at": N, "lifting": V, "direction": V, **TIME},
+    "obstacles": [{"x": N, "x_from": N, "x_to": N, "g1": G, "g2": G, "hole": V, "carried": V,
                    "stiffness": N, "damping": N}],
     "damping": {"zeta": N, "f1": N, "f2": N, "alpha": N, "alpha_K": N, "modal": N},
     "loads": [{"x": N, "distributed": V, "per_mass": V, "gravity": N, "x_from": N, "x_to": N,
+               "direction": V, "rotating": {"amplitude": N, "omega": N, "phase": N},
                **TIME}],
     "initial": {"mode": V, "amplitude": N, "u0": U0, "v0": V0, "fixed_frame": V},
     "mesh": {"J": N, "element": V, "nodes": V, "mass": V, "massless": V},
@@ -325,6 +326,9 @@ def _scene(kind, problem, data, text, files) -> Scene:
     out = {**OUTPUT_DEFAULTS, **data.get("output", {})}
     if kind == "beam":
         check_choice("[mesh] mass", mesh.get("mass", "consistent"), BEAM_MASSES)
+        if mesh.get("mass") == "redistributed" and _planes(data) == 2:
+            raise InputError("[mesh] mass = \"redistributed\" is for one plane; planes = 2 "
+                             "takes the consistent mass")
     rows = mesh.get("massless")
     methods.check_massless(rows, mesh.get("mass", "consistent"), "[mesh] massless")
     scene = Scene(kind, problem, Stepping(t["dt"], t["T"], 0.5, massless=rows or "beta"), law, k,
@@ -392,11 +396,18 @@ def _time_function(d: dict, where: str, reader: _Reader):
 
 
 def _section(d: dict, where: str) -> Section:
-    forms = [k for k in ("tube", "rod", "rect") if k in d] + (["I/A"] if "I" in d or "A" in d
-                                                             else [])
+    """A [section]: I and A, I_y, I_z and A (two planes: v along y bends with I_z, w
+    along z with I_y), tube, rod or rect."""
+    forms = [k for k in ("tube", "rod", "rect") if k in d] + (["I/A"] if set(d) & {
+        "I", "A", "I_y", "I_z"} else [])
     if len(forms) != 1:
-        raise InputError(f"[{where}] needs one of I and A, tube, rod, rect "
+        raise InputError(f"[{where}] needs one of I and A, I_y, I_z and A, tube, rod, rect "
                          f"(got {', '.join(forms) or 'none'})")
+    if "I_y" in d or "I_z" in d:
+        if "I" in d:
+            raise InputError(f"[{where}] give I (one plane) or I_y and I_z, not both")
+        axes = _need(d, ("I_y", "I_z", "A"), where)
+        return Section(axes["I_z"], axes["A"], axes["I_y"])
     if "tube" in d:
         return Section.tube(**_need(d["tube"], ("outer_diameter", "wall"), f"{where}.tube"))
     if "rod" in d:
@@ -499,6 +510,21 @@ def _g(value, where: str):
                      f"{{ x = [...], g = [...] }} (got keys {', '.join(value)})")
 
 
+def _hole(o: dict, i: int):
+    """A [[obstacles]] hole = {...} at x or over [x_from, x_to] (holes.HoleAt)."""
+    from .holes import HoleAt, hole_from_table
+    where = f"obstacles.{i}"
+    if "g1" in o or "g2" in o:
+        raise InputError(f"[{where}] a hole bounds (v, w) itself: leave out g1, g2")
+    hole = hole_from_table(o["hole"], f"{where}.hole")
+    if "x" in o:
+        if "x_from" in o or "x_to" in o:
+            raise InputError(f"[{where}] give x or x_from, x_to, not both")
+        return HoleAt(hole, o["x"], carried=o.get("carried", False))
+    a, b = _need(o, ("x_from", "x_to"), where).values()
+    return HoleAt(hole, a, b, carried=o.get("carried", False))
+
+
 def _obstacle(o: dict, i: int) -> Obstacles:
     where = f"obstacles.{i}"
     g1, g2 = _g(o.get("g1", -np.inf), f"{where}.g1"), _g(o.get("g2", np.inf), f"{where}.g2")
@@ -514,11 +540,24 @@ def _obstacle(o: dict, i: int) -> Obstacles:
     return Obstacles(g1, g2, carried=carried)
 
 
-def _obstacles(data: dict) -> Obstacles:
-    parts = [_obstacle(o, i) for i, o in enumerate(data.get("obstacles", []))]
+def _obstacles(data: dict) -> tuple[Obstacles, tuple]:
+    """The flat obstacles (the first plane's, g1 ≤ v ≤ g2) and the holes."""
+    items = list(enumerate(data.get("obstacles", [])))
+    holes = tuple(_hole(o, i) for i, o in items if "hole" in o)
+    if holes and _planes(data) != 2:
+        raise InputError("[[obstacles]] hole bounds (v, w) in the cross-section: it needs "
+                         "planes = 2 at the top of the file")
+    parts = [_obstacle(o, i) for i, o in items if "hole" not in o]
     if not parts:
-        return Obstacles()
-    return parts[0] if len(parts) == 1 else Obstacles.combine(*parts)
+        return Obstacles(), holes
+    return (parts[0] if len(parts) == 1 else Obstacles.combine(*parts)), holes
+
+
+def _planes(data: dict) -> int:
+    planes = data.get("planes", 1)
+    if planes not in (1, 2) or isinstance(planes, bool):
+        raise InputError(f"planes = {planes!r} must be 1 or 2 (bending planes)")
+    return int(planes)
 
 
 def _support(data: dict, L: float, reader: _Reader) -> Support:
@@ -534,45 +573,86 @@ def _support(data: dict, L: float, reader: _Reader) -> Support:
             raise InputError(f"[motion] end={m['end']!r} must be one of: left, right")
         at = ends[m["end"]]
     lifting = m.get("lifting", "auto")
-    if set(m) & {"amplitude", "omega"} and not set(m) & {"phase", "value", "sines", "table",
-                                                          "random", "psd"}:
-        return Support(m.get("amplitude", 0.0), m.get("omega", 0.0), at=at, lifting=lifting)
-    return Support(motion=_time_function(m, "motion", reader), at=at, lifting=lifting)
+    direction = _direction(m, data, "motion")
+    time = {k: v for k, v in m.items() if k != "direction"}
+    if set(time) & {"amplitude", "omega"} and not set(time) & {"phase", "value", "sines",
+                                                                "table", "random", "psd"}:
+        return Support(m.get("amplitude", 0.0), m.get("omega", 0.0), at=at, lifting=lifting,
+                       direction=direction)
+    return Support(motion=_time_function(time, "motion", reader), at=at, lifting=lifting,
+                   direction=direction)
 
 
-def _loads(data: dict, reader: _Reader) -> Load:
-    total = Load()
+def _direction(d: dict, data: dict, where: str) -> tuple[float, float]:
+    """A table's direction = [dy, dz] (two planes only; default the first plane)."""
+    from .problem import check_direction
+    if "direction" not in d:
+        return (1.0, 0.0)
+    if _planes(data) != 2:
+        raise InputError(f"[{where}] direction acts in the cross-section: it needs planes = 2")
+    return check_direction(f"[{where}] direction", d["direction"])
+
+
+def _loads(data: dict, reader: _Reader) -> tuple[Load, Load]:
+    """The loads of the first and the second plane: a load along ``direction`` = [dy, dz]
+    acts dy× in v and dz× in w; ``rotating`` = {amplitude, omega, phase} is
+    amplitude·cos(ωt + phase) in v and amplitude·sin(ωt + phase) in w (two planes)."""
+    total_v, total_w = Load(), Load()
     for i, d in enumerate(data.get("loads", [])):
         where = f"loads.{i}"
+        dy, dz = _direction(d, data, where)
+        d = {k: v for k, v in d.items() if k != "direction"}
+        if "rotating" in d:
+            if _planes(data) != 2:
+                raise InputError(f"[{where}] rotating acts in the cross-section: it needs "
+                                 "planes = 2")
+            if "gravity" in d or (dy, dz) != (1.0, 0.0) or \
+                    set(d) & {"amplitude", "omega", "phase", "value", "sines", "table",
+                              "random", "psd"}:
+                raise InputError(f"[{where}] rotating is the load's time function and "
+                                 "direction: give it alone with x, distributed or per_mass")
+            rot = _need(d["rotating"], ("amplitude", "omega"), f"{where}.rotating")
+            phase = d["rotating"].get("phase", 0.0)
+            rest = {k: v for k, v in d.items() if k != "rotating"}
+            total_v = total_v + _load(rest, where, Sine(rot["amplitude"], rot["omega"],
+                                                        phase + math.pi / 2))
+            total_w = total_w + _load(rest, where, Sine(rot["amplitude"], rot["omega"], phase))
+            continue
         if "gravity" in d:
             if len(d) > 1:
-                raise InputError(f"[{where}] gravity = g stands alone (got {', '.join(d)})")
-            total = total + Load.gravity(d["gravity"])
-            continue
-        time = _time_function(d, where, reader)
-        if time is None:
-            raise InputError(f"[{where}] needs a time function: amplitude/omega, value, "
-                             "sines, table or random")
-        kinds = [k for k in ("x", "distributed", "per_mass") if d.get(k, False) is not False]
-        span = [k for k in ("x_from", "x_to") if k in d]
-        if span and kinds != ["distributed"]:
-            raise InputError(f"[{where}] x_from, x_to bound a distributed load (distributed = "
-                             "true)")
-        if len(kinds) != 1:
-            raise InputError(f"[{where}] needs one of x (a point force, N), distributed = "
-                             "true (N/m) or per_mass = true (m/s²)")
-        if kinds[0] == "x":
-            total = total + Load(points=((d["x"], time),))
-        elif kinds[0] == "distributed" and span:
-            a, b = _need(d, ("x_from", "x_to"), where).values()
-            if not a < b:
-                raise InputError(f"[{where}] x_from={a:g} must be below x_to={b:g}")
-            total = total + Load.distributed(_span(a, b), time)
-        elif kinds[0] == "distributed":
-            total = total + Load.distributed(1.0, time)
+                raise InputError(f"[{where}] gravity = g stands alone (got {', '.join(d)}; "
+                                 "and direction)")
+            part = Load.gravity(d["gravity"])
         else:
-            total = total + Load.uniform(time)
-    return total
+            time = _time_function(d, where, reader)
+            if time is None:
+                raise InputError(f"[{where}] needs a time function: amplitude/omega, value, "
+                                 "sines, table, random or (two planes) rotating")
+            part = _load(d, where, time)
+        total_v, total_w = total_v + part.scaled(dy), total_w + part.scaled(dz)
+    return total_v, total_w
+
+
+def _load(d: dict, where: str, time) -> Load:
+    """One [[loads]] item's load with the time function ``time``."""
+    kinds = [k for k in ("x", "distributed", "per_mass") if d.get(k, False) is not False]
+    span = [k for k in ("x_from", "x_to") if k in d]
+    if span and kinds != ["distributed"]:
+        raise InputError(f"[{where}] x_from, x_to bound a distributed load (distributed = "
+                         "true)")
+    if len(kinds) != 1:
+        raise InputError(f"[{where}] needs one of x (a point force, N), distributed = "
+                         "true (N/m) or per_mass = true (m/s²)")
+    if kinds[0] == "x":
+        return Load(points=((d["x"], time),))
+    if kinds[0] == "distributed" and span:
+        a, b = _need(d, ("x_from", "x_to"), where).values()
+        if not a < b:
+            raise InputError(f"[{where}] x_from={a:g} must be below x_to={b:g}")
+        return Load.distributed(_span(a, b), time)
+    if kinds[0] == "distributed":
+        return Load.distributed(1.0, time)
+    return Load.uniform(time)
 
 
 def _span(a: float, b: float):
@@ -642,12 +722,14 @@ def _beam_problem(data: dict, reader: _Reader) -> BeamProblem:
     beam = _beam(data)
     ends = data.get("ends", {})
     mesh = data.get("mesh", {})
+    obstacles, holes = _obstacles(data)
+    load, load_w = _loads(data, reader)
     problem = BeamProblem(
-        beam, _obstacles(data), _support(data, beam.L, reader), _loads(data, reader),
+        beam, obstacles, _support(data, beam.L, reader), load,
         J=mesh.get("J", 19), element=mesh.get("element", "hermite"), nodes=mesh.get("nodes"),
         ends=(ends.get("left", "clamped"), ends.get("right", "free")),
         supports=tuple(s.get("x", math.nan) for s in data.get("supports", [])),
-        damping=_damping(data))
+        damping=_damping(data), planes=_planes(data), holes=holes, load_w=load_w)
     return _initial(data, problem)
 
 
@@ -800,18 +882,28 @@ def modes_main(argv) -> int:
     if args.out is not None:
         from .output.folder import check_output_dir
         out = check_output_dir(args.out, args.overwrite)
-    m = modes(scene.problem, args.n)
-    print(f"{'mode':>4s} {'f (Hz)':>14s} {'ω (rad/s)':>14s}")
-    for i, (f, w) in enumerate(zip(m.f, m.omega), 1):
-        print(f"{i:4d} {f:14.6g} {w:14.6g}")
+    problem = scene.problem
+    # two planes: each plane's modes (its own EI), the lowest n of both, with their plane
+    planes = [("", modes(problem, args.n))] if problem.planes == 1 else \
+        [(p, modes(replace(problem, planes=1, holes=(), load_w=Load(),
+                           support=Support(at=problem.support.at),
+                           beam=problem.beam if p == "v" else problem.beam.plane_w()), args.n))
+         for p in ("v", "w")]
+    rows = sorted(((m.f[i], m.omega[i], p, m.shapes[:, i]) for p, m in planes
+                   for i in range(m.f.size)), key=lambda r: r[0])[:args.n]
+    two = problem.planes == 2
+    print(f"{'mode':>4s}{' plane' if two else ''} {'f (Hz)':>14s} {'ω (rad/s)':>14s}")
+    for i, (f, w, p, _) in enumerate(rows, 1):
+        print(f"{i:4d}{p:>6s} {f:14.6g} {w:14.6g}" if two else f"{i:4d} {f:14.6g} {w:14.6g}")
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)
         with open(out / "modes.csv", "w", newline="") as fh:
             w = csv.writer(fh)
-            w.writerow(["mode", "f_Hz", "omega_rad_s"] + [f"u({float(x):.12g})" for x in m.x])
-            for i in range(m.f.size):
-                w.writerow([i + 1, f"{m.f[i]:.17g}", f"{m.omega[i]:.17g}"]
-                           + [f"{u:.17g}" for u in m.shapes[:, i]])
+            w.writerow(["mode"] + (["plane"] if two else []) + ["f_Hz", "omega_rad_s"]
+                       + [f"u({float(x):.12g})" for x in planes[0][1].x])
+            for i, (f, om, p, shape) in enumerate(rows, 1):
+                w.writerow([i] + ([p] if two else []) + [f"{f:.17g}", f"{om:.17g}"]
+                           + [f"{u:.17g}" for u in shape])
         print(f"written: {out / 'modes.csv'}", file=sys.stderr)
     return 0
 

@@ -64,6 +64,10 @@ class SceneView:
     EI: float | None = None
     lift: Lifting | None = None
     observed_x: float | None = None     # the default observed point (None: the tip, x = L)
+    planes: int = 1                     # 2: coefficients [v; w] (two_planes)
+    direction: tuple = (1.0, 0.0)       # two planes: the support moves along it
+    k2_w: float | None = None           # two planes: the second plane's k2
+    holes: tuple = ()                   # two planes: the holes (holes.HoleAt)
 
 
 @dataclass
@@ -93,6 +97,13 @@ class SemiDiscrete:
     bound_motion: Callable | None = None
     bound_shift: np.ndarray | None = None    # (m,)
     sample_shift: np.ndarray | None = None   # (samples,)
+    # two planes (two_planes): the round holes' row pairs (q, 2); per constrained row its
+    # node's values v, w (rows 2j, 2j+1 of row_nodes) and [cy, cz, sy, sz]: the centre of
+    # its hole at rest and how it moves per unit φ (None: one plane)
+    planes: int = 1
+    disks: np.ndarray | None = None
+    row_nodes: sp.csr_matrix | None = None
+    row_centres: np.ndarray | None = None
 
     @property
     def n(self) -> int:
@@ -204,7 +215,11 @@ def _snap(shift: np.ndarray) -> np.ndarray:
 
 
 def beam_system(problem: BeamProblem, samples_per_element: int = 20) -> SemiDiscrete:
-    """Discretise a beam scene (the papers' V_h, K_h of (8), loads with the lifting)."""
+    """Discretise a beam scene (the papers' V_h, K_h of (8), loads with the lifting; two
+    planes: :func:`skfem_beam.two_planes.two_plane_system`)."""
+    if problem.planes == 2:
+        from .two_planes import two_plane_system
+        return two_plane_system(problem, samples_per_element)
     beam, sup = problem.beam, problem.support
     space = beam_space(problem)
     x_nodes = problem.nodes[space.value_nodes]     # where u is free (x_1..x_J when clamped)
@@ -319,8 +334,23 @@ def add_probes(system: SemiDiscrete, xs) -> list[dict]:
         a, b = float(space.nodes[e]), float(space.nodes[e + 1])
         ei = float(problem.beam.factors(0.5 * (a + b))[1])   # EI of that element
         rows = [space.point_rows([x], k).toarray().ravel() for k in (0, 2, 3)]
-        system.observe[f"{name}_displacement"] = rows[0]
-        system.observe[f"{name}_moment"] = k2 * ei * rows[1]
-        system.observe[f"{name}_shear"] = -k2 * ei * rows[2]
+        for suffix, k2_p, pad in plane_rows(system, k2):
+            system.observe[f"{name}_displacement{suffix}"] = pad(rows[0])
+            system.observe[f"{name}_moment{suffix}"] = k2_p * ei * pad(rows[1])
+            system.observe[f"{name}_shear{suffix}"] = -k2_p * ei * pad(rows[2])
         probes.append({"name": name, "x": x, "element": (a, b), "EI_factor": ei})
     return probes
+
+
+PLANE_SUFFIXES = ("_v", "_w")      # a two-plane column's name ends with its plane
+
+
+def plane_rows(system, k2: float):
+    """(suffix, k2, pad) per plane: one plane ("", k2, rows as they are); two planes the
+    first and second plane's suffix ("_v", "_w"), k2, and rows placed in [v; w]."""
+    if system.planes == 1:
+        return [("", k2, lambda r: r)]
+    n = system.meta["n_plane"]
+    zero = np.zeros(n)
+    return [("_v", k2, lambda r: np.concatenate([r, zero])),
+            ("_w", system.meta["k2_w"], lambda r: np.concatenate([zero, r]))]

@@ -99,6 +99,22 @@ class Sine:
 
 
 @dataclass(frozen=True)
+class Scaled:
+    """factor · f(t) (a support or a load along one plane's share of a direction)."""
+    f: object
+    factor: float
+
+    def __call__(self, t):
+        return self.factor * np.asarray(self.f(t), dtype=float)
+
+    def d(self, t):
+        return self.factor * np.asarray(derivative(self.f, 1)(t), dtype=float)
+
+    def dd(self, t):
+        return self.factor * np.asarray(derivative(self.f, 2)(t), dtype=float)
+
+
+@dataclass(frozen=True)
 class SumOfSines(_FromEval):
     """Σ_k amplitudes[k] · sin(omegas[k]·t + phases[k])."""
     amplitudes: tuple[float, ...]

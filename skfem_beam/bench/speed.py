@@ -31,15 +31,29 @@ CONFIGS = [
     ("flat J=40 hermite dt=1e-3 T=1", "flat", dict(J=40, dt=1e-3, T=1.0), None),
     ("flat J=160 hermite dt=1e-3 T=1", "flat", dict(J=160, dt=1e-3, T=1.0), None),
     ("bar rigid N=100 dt=1e-3 T=3 (β=1/4)", "bar", dict(N=100, dt=1e-3, T=3.0, beta=0.25), 0.03),
+    # two planes against one: the heat-exchanger tube, J=30, two baffles, 0.4 mm
+    ("tube 1 plane, stops ±0.4 mm J=30 dt=1e-4 T=1", "file:heat_exchanger_tube",
+     dict(dt=1e-4, T=1.0), None),
+    ("tube 2 planes, square holes J=30 dt=1e-4 T=1", "file:tube_round_holes",
+     dict(dt=1e-4, T=1.0, set=["obstacles.0.hole={ sides = 4, radius = 0.0004 }",
+                               "obstacles.1.hole={ sides = 4, radius = 0.0004 }"]), None),
+    ("tube 2 planes, round holes J=30 dt=1e-4 T=1", "file:tube_round_holes",
+     dict(dt=1e-4, T=1.0), None),
 ]
 SOLVERS = {"point_stops": ["projection", "active-set", "daqp", "osqp"],
            "convex": ["active-set", "daqp", "osqp"], "flat": ["active-set", "daqp", "osqp"],
-           "bar": ["projection", "daqp", "osqp"]}
+           "bar": ["projection", "daqp", "osqp"], "file:heat_exchanger_tube": ["auto"],
+           "file:tube_round_holes": ["auto"]}
 SLOW = {"osqp", "daqp"}   # Python-level engines: only on the short configurations
 # OSQP against the compiled active set, per step: the four rows of issue #22 (≤ 5×)
 OSQP_ROWS = ["flat J=40 hermite dt=1e-3 T=1", "flat J=160 hermite dt=1e-3 T=1",
              "convex J=40 hermite dt=1e-3 T=1", "convex J=160 hermite dt=1e-3 T=1"]
 OSQP_LIMIT = 5.0
+# a two-plane step against the one-plane step of the same tube (issue #23: ≤ 2.5×)
+PLANE_ROWS = ("tube 1 plane, stops ±0.4 mm J=30 dt=1e-4 T=1",
+              ["tube 2 planes, square holes J=30 dt=1e-4 T=1",
+               "tube 2 planes, round holes J=30 dt=1e-4 T=1"])
+PLANE_LIMIT = 2.5
 
 
 def build(scene: str, p: dict):
@@ -47,6 +61,9 @@ def build(scene: str, p: dict):
     from ..bar import bar_system
     if scene == "bar":
         return bar_system(scenes.impacting_bar(N=p["N"]))
+    if scene.startswith("file:"):
+        from ..scenefile import example, load
+        return load(example(scene[5:]), p.get("set", [])).problem
     make = {"point_stops": scenes.point_stops, "convex": scenes.convex_obstacles,
             "flat": scenes.flat_obstacles}[scene]
     return make(**{k: p[k] for k in ("J", "element") if k in p})
@@ -127,6 +144,23 @@ def osqp_table(rows: list[dict]) -> None:
               f"{o['contact_steps']:5d}/{o['steps']:<5d} {o['repairs']:8d}", flush=True)
 
 
+def planes_table(rows: list[dict]) -> None:
+    """Two planes against one: µs per step of the same tube, J and baffles (PLANE_ROWS)."""
+    by = {r["configuration"]: r for r in rows if "solver" in r}
+    one, twos = PLANE_ROWS
+    if one not in by:
+        return
+    print(f"\n{'two planes against one':48s} {'solver':11s} {'µs/step':>8s} {'1 plane':>8s} "
+          f"{'ratio':>6s} {'≤ 2.5×':>6s}")
+    for c in twos:
+        if c in by:
+            ratio = by[c]["us_per_step"] / by[one]["us_per_step"]
+            by[c]["ratio_to_one_plane"] = ratio
+            print(f"{c:48s} {by[c]['solver']:11s} {by[c]['us_per_step']:8.2f} "
+                  f"{by[one]['us_per_step']:8.2f} {ratio:6.2f} "
+                  f"{'yes' if ratio <= PLANE_LIMIT else 'NO':>6s}", flush=True)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="skfem_beam.bench.speed", description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="one repeat, fast solvers only")
@@ -162,6 +196,7 @@ def main(argv=None) -> int:
                   f"{res['us_per_step']:8.2f} {res['floor_us_per_step']:8.2f} {t:>8s} "
                   f"{res['peak_rss_MB']:6.0f}", flush=True)
     osqp_table(rows)
+    planes_table(rows)
     print(f"\n{'whole command':56s} {'command s':>9s} {'loop s':>7s} {'2(loop+2) s':>11s} "
           f"{'peak MB':>8s}")
     with tempfile.TemporaryDirectory() as tmp:

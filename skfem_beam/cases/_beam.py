@@ -16,7 +16,7 @@ from ..output.series import Series, execute, prepare
 from ..methods import Penalty
 from ..scheme.kernels import WORK_TERMS
 from ..spec import RunSpec
-from ..semidiscrete import add_probes, beam_system
+from ..semidiscrete import PLANE_SUFFIXES, add_probes, beam_system
 from ..spaces.redistribution import redistributed
 from ..stability import kappa_h, linear_limit
 
@@ -51,7 +51,11 @@ def run_beam_case(case: str, problem, spec: RunSpec, stops=(), extra=None) -> in
     def events(folder: Path, run, last: int) -> dict:
         return beam_impacts(folder, run, problem, last)
 
-    series = Series(beam_columns(system.view, rho_S), events=events)
+    two = system.planes == 2
+    if two:
+        summary["units"].update(two_plane_units(rho_S))
+    series = Series((two_plane_columns if two else beam_columns)(system.view, rho_S),
+                    events=events)
     code = execute(run, spec.options, summary, series,
                    beam_charts(case, problem, rho_S, stops, extra, system.view.observed_x))
     if code == 0:
@@ -97,15 +101,72 @@ def beam_columns(view, rho_S):
         if rho_S:                            # physical units: N and J
             cols["contact_force_N"] = force * rho_S
             cols["energy_J"] = run.energy[k0:k1] * rho_S
-        # work since state 1, in the units of energy: energy − energy[0] + damping
-        # = input + contact (the scheme's identity, docs/design.md §3)
-        work = run.work[k0:k1]
-        terms = {f"work_{name}": work[:, i] for i, name in enumerate(WORK_TERMS)}
-        cols.update(terms)
-        if rho_S:
-            cols.update({f"{k}_J": v * rho_S for k, v in terms.items()})
-        return {**cols, **probe_columns(run, k0, k1)}
+        return {**cols, **work_columns(run, k0, k1, rho_S), **probe_columns(run, k0, k1)}
     return columns
+
+
+def work_columns(run, k0, k1, rho_S) -> dict:
+    """The work since state 1, in the units of energy (and J): energy − energy[0] +
+    damping = input + contact (the scheme's identity, docs/design.md §3)."""
+    work = run.work[k0:k1]
+    terms = {f"work_{name}": work[:, i] for i, name in enumerate(WORK_TERMS)}
+    if rho_S:
+        terms.update({f"{k}_J": v * rho_S for k, v in list(terms.items())})
+    return terms
+
+
+def two_plane_columns(view, rho_S):
+    """timeseries.csv's columns of saved rows k0..k1 of a two-plane beam run: each of the
+    one-plane beam's displacement and force columns per plane (``_v``, ``_w``), the
+    orbit of every hole's node (``hole_<x>_displacement_v``, ``_w``), the energy and work."""
+    from ..output.supports import row_planes
+
+    def columns(run, k0, k1):
+        names = list(run.system.observe)
+        t = np.arange(k0, k1) * run.save_every * run.dt
+        cols = {"t": t}
+        for suffix, share in zip(PLANE_SUFFIXES, view.direction):
+            i = names.index(f"tip_displacement{suffix}")
+            tip, tip_v = physical_tip(view, t, run.obs[k0:k1, i], run.obsv[k0:k1, i], share)
+            cols[f"tip_displacement{suffix}"], cols[f"tip_velocity{suffix}"] = tip, tip_v
+        for name in names:
+            if name.startswith("hole_"):
+                x = float(name.split("_")[1])
+                share = view.direction[name.endswith("_w")]
+                cols[name] = physical_at(view, x, t, run.obs[k0:k1, names.index(name)],
+                                         share)
+        cols["energy"] = run.energy[k0:k1]
+        force = run.lam[k0:k1] @ row_planes(run.ops.pair, run.ops.Nc)   # net, per plane
+        for c, suffix in enumerate(PLANE_SUFFIXES):
+            cols[f"contact_force{suffix}"] = force[:, c]
+            if rho_S:
+                cols[f"contact_force{suffix}_N"] = force[:, c] * rho_S
+        if rho_S:
+            cols["energy_J"] = run.energy[k0:k1] * rho_S
+        return {**cols, **work_columns(run, k0, k1, rho_S), **probe_columns(run, k0, k1)}
+    return columns
+
+
+def two_plane_units(rho_S) -> dict:
+    """summary.json's units of the two-plane columns (beside the one-plane ones)."""
+    out = {"tip_displacement_v": "m, the first plane's (along y), as tip_displacement",
+           "tip_displacement_w": "m, the second plane's (along z)",
+           "hole_<x>_displacement_v": "m, the node of a hole at x, first plane (the orbit)",
+           "hole_<x>_displacement_w": "m, the same, second plane",
+           "contact_force_v": "net contact force along y, as contact_force",
+           "contact_force_w": "net contact force along z, as contact_force"}
+    if rho_S:
+        out.update({"contact_force_v_N": "N", "contact_force_w_N": "N"})
+    return out
+
+
+def physical_at(view, x: float, t, u, share: float):
+    """ũ(x, t) = u + share·h(x)φ(t) (the support's motion along its direction)."""
+    lift = view.lift
+    h = 0.0 if lift is None else float(lift.h(np.array([x]))[0])
+    if abs(h) <= 1e-9 or share == 0.0:
+        return u
+    return np.asarray(u) + share * h * np.asarray(lift.motion.phi(np.asarray(t)), dtype=float)
 
 
 def beam_charts(case, problem, rho_S, stops, extra, observed_x=None):
@@ -117,6 +178,11 @@ def beam_charts(case, problem, rho_S, stops, extra, observed_x=None):
     def finish(folder: Path, data: dict, run):
         t = data["t"]
         about = f"{run.label}, Δt={run.dt:g} s, J={problem.J}, {problem.element}"
+        if problem.planes == 2:
+            two_plane_charts(folder, data, run, case, problem, about, where, what, rho_S)
+            if extra is not None:
+                extra(folder, data, run)
+            return
         trajectory_chart(folder / "tip_displacement.png", t,
                          {f"ũ({where}, t)": data["tip_displacement"]},
                          stops=stops if observed_x is None else (),
@@ -139,6 +205,37 @@ def beam_charts(case, problem, rho_S, stops, extra, observed_x=None):
         if extra is not None:
             extra(folder, data, run)
     return finish
+
+
+def two_plane_charts(folder, data, run, case, problem, about, where, what, rho_S) -> None:
+    """A two-plane run's charts: v and w at the observed point, the energy, the net
+    contact force per plane, and an orbit per hole node (w against v, the wall drawn)."""
+    from ..output.supports import orbit_chart
+    t = data["t"]
+    trajectory_chart(folder / "tip_displacement.png", t,
+                     {f"v({where}, t)": data["tip_displacement_v"],
+                      f"w({where}, t)": data["tip_displacement_w"]},
+                     title=f"{case}: {what}, both planes ({about})")
+    joules = "energy_J" in data
+    energy_chart(folder / "energy.png", t, data["energy_J" if joules else "energy"],
+                 title=f"{case}: discrete energy ½E_β ({about})",
+                 work={k: data[f"work_{k}" + ("_J" if joules else "")] for k in WORK_TERMS},
+                 joules=joules)
+    newtons = "contact_force_v_N" in data
+    forces = {f"net contact force, {p}": data[f"contact_force_{p}" + ("_N" if newtons else "")]
+              for p in ("v", "w")}
+    if any(np.any(f) for f in forces.values()):
+        trajectory_chart(folder / "contact_force.png", t, forces,
+                         title=f"{case}: net contact force on the beam ({about})",
+                         ylabel="force (N)" if newtons else
+                         "force per mass (m²/s² = N per kg/m)")
+    for h in problem.holes:
+        for x in problem.nodes[h.acts_at(problem.nodes, problem.beam.L)]:
+            key = f"hole_{float(x):g}_displacement"
+            orbit_chart(folder / f"orbit_{float(x):g}.png", data[f"{key}_v"],
+                        data[f"{key}_w"], h.hole.outline(),
+                        f"{case}: orbit at x = {float(x):g} m, {h.hole.shape} hole\n({about})",
+                        h.hole.centre)
 
 
 def units(rho_S, system) -> dict:

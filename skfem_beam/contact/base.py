@@ -40,7 +40,7 @@ import atexit
 import os
 import subprocess
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
@@ -141,6 +141,9 @@ class StepData:
     hi: np.ndarray
     dt: float
     beta: float
+    disks: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
+    #                     (q, 2) row pairs (v, w) of round holes: |y_p − c| ≤ r with c, r
+    #                     those of the pair's box [lo, hi] (contact.round_hole)
 
     @property
     def decoupled(self) -> bool:
@@ -158,6 +161,7 @@ class ContactLaw:
     explicit = None
     free_inside = True   # μ = 0 whenever y_free lies within [lo, hi] (a Python law's
     #                      solver is then not called: every position-level law)
+    round_holes = False  # takes StepData.disks (round holes); the others refuse them
 
     def setup(self, step: StepData, first: bool = False) -> np.ndarray:
         return np.zeros(0)

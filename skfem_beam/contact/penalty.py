@@ -16,13 +16,22 @@ and monotone (with the activity of t_{n+1} the dashpot would switch on with a ju
 c·ẏ and Newton could cycle).  Like every linear Kelvin–Voigt contact, it also pulls
 while the support unloads.
 
+In a round hole (a disk pair of rows, contact.round_hole) the spring is radial:
+r(y_p) = −κ(|y_p − c| − r)⁺ (y_p − c)/|y_p − c|, the gradient of a convex energy, so the
+implicit step is the minimiser of a strictly convex function and Newton solves it
+(`disk_compliance_solve`); a dashpot there is not modelled (refused).
+
 The start step weights the spring at u⁰ by ½(1−2β) instead (see scheme.run).
 """
 import numpy as np
 from numba import njit
 
 from ..checks import check_nonnegative, check_positive
+from ..errors import InputError
 from .base import ContactLaw, compiled_explicit, compiled_law
+from .round_hole import disk_params, kinds_of
+
+DISKS_AT = 5      # params[DISKS_AT:]: the disk pairs (round_hole.disk_params)
 
 
 @njit(cache=True)
@@ -81,6 +90,23 @@ def compliance_solve(D, yf, lo, hi, c, state, mu, d, y_cur, y_prev):
     return it
 
 
+@njit(cache=True)
+def radial(ya, yb, lo_a, hi_a, lo_b, hi_b):
+    """(p_a, p_b, |p|, r): the pair's offset from its hole's centre and the radius."""
+    pa, pb = ya - 0.5 * (lo_a + hi_a), yb - 0.5 * (lo_b + hi_b)
+    return pa, pb, np.hypot(pa, pb), 0.5 * (hi_a - lo_a)
+
+
+@njit(cache=True)
+def disk_spring(ya, yb, lo_a, hi_a, lo_b, hi_b, stiffness):
+    """The radial spring's force (r_a, r_b) on a pair in its round hole."""
+    pa, pb, rho, rad = radial(ya, yb, lo_a, hi_a, lo_b, hi_b)
+    if rho <= rad:
+        return 0.0, 0.0
+    f = -stiffness * (rho - rad) / rho
+    return f * pa, f * pb
+
+
 @compiled_explicit
 def penalty_explicit(y_cur, y_prev, lo, hi, params, r):
     """r = w_cur r(yⁿ) + w_prev r(yⁿ⁻¹): (1−2β) and β in a step, ½(1−2β) and 0 at the start."""
@@ -88,15 +114,89 @@ def penalty_explicit(y_cur, y_prev, lo, hi, params, r):
     for j in range(r.size):
         r[j] = w_cur * spring(y_cur[j], lo[j], hi[j], stiffness) \
             + w_prev * spring(y_prev[j], lo[j], hi[j], stiffness)
+    for p in range(int(params[DISKS_AT]) if params.size > DISKS_AT else 0):
+        a, b = int(params[DISKS_AT + 1 + 2 * p]), int(params[DISKS_AT + 2 + 2 * p])
+        fa, fb = disk_spring(y_cur[a], y_cur[b], lo[a], hi[a], lo[b], hi[b], stiffness)
+        ga, gb = disk_spring(y_prev[a], y_prev[b], lo[a], hi[a], lo[b], hi[b], stiffness)
+        r[a] = w_cur * fa + w_prev * ga
+        r[b] = w_cur * fb + w_prev * gb
     return 0
+
+
+@njit(cache=True)
+def disk_compliance_solve(D, yf, lo, hi, c, kind, mu):
+    """y = yf + D μ(y) with μ = c·r(y) (c = Δt²β, r the one-sided springs: radial on the
+    disks of ``kind``, round_hole.cone_solve's), by Newton on
+    G(y) = y − yf − D μ(y); μ is the gradient of a convex energy, so G is the gradient
+    of a strictly convex function and its Newton steps are halved until |G| decreases.
+    Returns iterations (< 0: failed)."""
+    m = yf.size
+    y = yf.copy()
+    scale = 1e-300
+    for j in range(m):
+        scale = max(scale, abs(yf[j]), abs(lo[j]) if np.isfinite(lo[j]) else 0.0,
+                    abs(hi[j]) if np.isfinite(hi[j]) else 0.0)
+    its = 0
+    for its in range(1, 200):
+        mu_y = np.zeros(m)
+        Jm = np.zeros((m, m))           # ∂μ/∂y
+        for j in range(m):
+            if kind[j] == 0:
+                if y[j] > hi[j]:
+                    mu_y[j] = -c * (y[j] - hi[j])
+                    Jm[j, j] = -c
+                elif y[j] < lo[j]:
+                    mu_y[j] = -c * (y[j] - lo[j])
+                    Jm[j, j] = -c
+            elif kind[j] > 0:
+                a, b = j, kind[j]
+                pa, pb, rho, rad = radial(y[a], y[b], lo[a], hi[a], lo[b], hi[b])
+                if rho > rad:
+                    f = 1.0 - rad / rho
+                    ea, eb = pa / rho, pb / rho
+                    mu_y[a], mu_y[b] = -c * f * pa, -c * f * pb
+                    g = rad / rho
+                    Jm[a, a] = -c * (f + g * ea * ea)
+                    Jm[b, b] = -c * (f + g * eb * eb)
+                    Jm[a, b] = Jm[b, a] = -c * g * ea * eb
+        G = y - yf - D @ mu_y
+        gn = np.abs(G).max()
+        if gn <= 1e-15 * scale:
+            break
+        dy = np.linalg.solve(np.eye(m) - D @ Jm, G)
+        y = y - dy
+        if np.abs(dy).max() <= 1e-16 * scale:
+            break
+    else:
+        return -1
+    for j in range(m):
+        mu[j] = 0.0
+        if kind[j] == 0:
+            mu[j] = -c * (max(y[j] - hi[j], 0.0) - max(lo[j] - y[j], 0.0))
+        elif kind[j] > 0:
+            a, b = j, kind[j]
+            pa, pb, rho, rad = radial(y[a], y[b], lo[a], hi[a], lo[b], hi[b])
+            if rho > rad:
+                mu[a] = -c * (1.0 - rad / rho) * pa
+                mu[b] = -c * (1.0 - rad / rho) * pb
+    return its
 
 
 @compiled_law
 def penalty_kernel(D, yf, y_cur, y_prev, lo, hi, params, state, mu, active):
     """The implicit springs (params[1] = Δt²βκ) and dashpots (params[4] = cΔt/2, on the
     values compressed at tₙ): y = yf + Dμ."""
-    its = compliance_solve(D, yf, lo, hi, params[1], state, mu, params[4], y_cur, y_prev)
     m = yf.size
+    if params.size > DISKS_AT and params[DISKS_AT] > 0:
+        kind = kinds_of(params[DISKS_AT:], m)
+        its = disk_compliance_solve(D, yf, lo, hi, params[1], kind, mu)
+        for i in range(m):   # in contact: the spring is compressed at y^{n+1}
+            if kind[i] == 0:
+                active[i] = mu[i] != 0.0
+            else:
+                active[i] = kind[i] > 0 and (mu[i] != 0.0 or mu[kind[i]] != 0.0)
+        return its
+    its = compliance_solve(D, yf, lo, hi, params[1], state, mu, params[4], y_cur, y_prev)
     for i in range(m):   # in contact: the spring is compressed at y^{n+1}
         y = yf[i]
         for j in range(m):
@@ -111,6 +211,7 @@ class Penalty(ContactLaw):
     name = "penalty"
     kernel = penalty_kernel
     explicit = penalty_explicit
+    round_holes = True
 
     def __init__(self, stiffness: float, damping: float = 0.0):
         self.stiffness = check_positive("stiffness", stiffness)
@@ -119,8 +220,14 @@ class Penalty(ContactLaw):
     def setup(self, step, first=False):
         beta, k = step.beta, self.stiffness
         w_cur, w_prev = (0.5 * (1 - 2 * beta), 0.0) if first else (1 - 2 * beta, beta)
-        return np.array([k, step.dt ** 2 * beta * k, w_cur, w_prev,
-                         0.5 * step.dt * self.damping])
+        params = np.array([k, step.dt ** 2 * beta * k, w_cur, w_prev,
+                           0.5 * step.dt * self.damping])
+        if not step.disks.size:
+            return params
+        if self.damping:
+            raise InputError("a support's damping (a dashpot) in a round hole is not "
+                             "modelled: leave out [[obstacles]] damping")
+        return np.concatenate([params, disk_params(step.disks)])
 
     def __repr__(self) -> str:
         return f"Penalty(stiffness={self.stiffness:g}, damping={self.damping:g})"

@@ -9,6 +9,7 @@ from .osqp_solver import OSQP
 from .penalty import Penalty
 from .projection import Projection
 from .restitution import Restitution
+from .round_hole import RoundHole
 
 LAWS = {
     "projection": Projection,
@@ -17,6 +18,7 @@ LAWS = {
     "daqp": DAQP,
     "penalty": Penalty,      # needs stiffness=
     "restitution": Restitution,   # needs restitution= (e)
+    "round-hole": RoundHole,      # round holes (and boxes beside them), exact
 }
 SOLVERS = ("auto", *LAWS)
 
@@ -52,9 +54,12 @@ def resolve(law: str | ContactLaw = "auto", stiffness: float | None = None,
 
 
 class Auto(ContactLaw):
-    """Projection when the constraints are decoupled, else the exact active set."""
+    """The exact round-hole law where there are round holes; else projection when the
+    constraints are decoupled, the exact active set when not."""
     name = "auto"
 
     @staticmethod
     def choose(step: StepData) -> ContactLaw:
+        if step.disks.size:
+            return RoundHole()
         return Projection() if step.decoupled else ActiveSet()

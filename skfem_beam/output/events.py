@@ -13,6 +13,10 @@ carries, so a resumed run writes the same table as an uninterrupted one):
     impulse          Σ force·Δt over the event, signed like the timeseries column
                      ``contact_force`` (beam: λ, > 0 pushed up by g1; bar: R ≥ 0)
     max_violation    m: the largest nodal violation of the bound during the contact
+    angle, normal_velocity, tangential_velocity
+                     two planes only (before ``open``): where on the hole (rad) and the
+                     node's velocity before the impact, normal and along the wall (m/s);
+                     output.supports says how
     open             1: the event was not over at the run's last state (in contact, or
                      within the two states after t_end that a penalty spring's trailing
                      force reaches); its peak_force and impulse are those so far.  Only
@@ -38,10 +42,12 @@ from .folder import atomic_write, csv_rows
 IMPACTS = "impacts.csv"
 COLUMNS = ("t_start", "t_end", "x", "bound", "velocity", "peak_force", "impulse",
            "max_violation", "open")
+HOLE_COLUMNS = ("angle", "normal_velocity", "tangential_velocity")   # two planes
+TWO_PLANE_COLUMNS = COLUMNS[:-1] + HOLE_COLUMNS + COLUMNS[-1:]
 
 
 def impact_table(events: dict, lo: np.ndarray, hi: np.ndarray, scale: float = 1.0,
-                 sign: float = 1.0) -> dict[str, np.ndarray]:
+                 sign: float = 1.0, planes: int = 1) -> dict[str, np.ndarray]:
     """The impacts.csv columns of ``events`` (``Run.impact_events()``): forces and impulses
     times ``scale`` (ρS for a beam in N), impulses times ``sign`` (the bar's R = sign·λ);
     ``lo``, ``hi``: the bounds of the constrained values (which side each contact is on)."""
@@ -49,11 +55,13 @@ def impact_table(events: dict, lo: np.ndarray, hi: np.ndarray, scale: float = 1.
     impulse = np.asarray(events["impulse"], dtype=float)
     lower = np.isfinite(lo[j]) & (~np.isfinite(hi[j]) | (impulse > 0)
                                   | ((impulse == 0) & (events["velocity"] < 0)))
-    return {"t_start": events["t_start"], "t_end": events["t_end"], "x": events["x"],
-            "bound": np.where(lower, 1, 2), "velocity": events["velocity"],
-            "peak_force": scale * np.asarray(events["peak_force"], dtype=float),
-            "impulse": sign * scale * impulse, "max_violation": events["max_violation"],
-            "open": np.asarray(events["open"], dtype=int)}
+    table = {"t_start": events["t_start"], "t_end": events["t_end"], "x": events["x"],
+             "bound": np.where(lower, 1, 2), "velocity": events["velocity"],
+             "peak_force": scale * np.asarray(events["peak_force"], dtype=float),
+             "impulse": sign * scale * impulse, "max_violation": events["max_violation"]}
+    if planes == 2:
+        table.update({k: np.asarray(events[k], dtype=float) for k in HOLE_COLUMNS})
+    return {**table, "open": np.asarray(events["open"], dtype=int)}
 
 
 def _union_length(start: np.ndarray, end: np.ndarray) -> float:
@@ -128,10 +136,12 @@ def write_impacts(folder: Path, run, units: dict, scale: float = 1.0, sign: floa
     # an unstable run ends at its last good saved state: impacts after it are not kept
     keep = np.asarray(events["t_start"]) <= (last + 0.5) * run.dt
     events = {k: np.asarray(v)[keep] for k, v in events.items()}
-    table = impact_table(events, np.asarray(s.lo), np.asarray(s.hi), scale, sign)
+    planes = getattr(s, "planes", 1)
+    table = impact_table(events, np.asarray(s.lo), np.asarray(s.hi), scale, sign, planes)
+    columns = list(COLUMNS if planes == 1 else TWO_PLANE_COLUMNS)
     path = Path(folder) / IMPACTS
-    atomic_write(path, lambda fh: fh.write(",".join(COLUMNS) + "\n"
-                                           + (csv_rows(table, list(COLUMNS), ("bound", "open"))
+    atomic_write(path, lambda fh: fh.write(",".join(columns) + "\n"
+                                           + (csv_rows(table, columns, ("bound", "open"))
                                               if table["x"].size
                                               else "")))
     # the share of the states 1..n, as the run's own contact_fraction counts it
@@ -145,6 +155,12 @@ def write_impacts(folder: Path, run, units: dict, scale: float = 1.0, sign: floa
                       "2 = g2 (upper)", "velocity": "m/s", "peak_force": f, "impulse": i,
                       "max_violation": "m", "open": "1 = not over at the last state",
                       "contact_fraction": "of the run's time"}
+    if planes == 2:
+        from .supports import support_statistics, work_rate_units
+        stats["supports"] = support_statistics(table, run, scale, duration, last * run.dt)
+        stats["units"].update(work_rate_units(units["force"] == "N"))
+        stats["units"]["peak_force"] += "; a round hole's: the force's magnitude"
+        stats["units"]["impulse"] += "; a round hole's: Σ|force|Δt"
     return {"impact_statistics": stats}
 
 

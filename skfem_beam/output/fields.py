@@ -52,17 +52,19 @@ from ..semidiscrete import SceneView
 FORMATS = ("xdmf", "vtu", "both", "none")
 
 
-def physical_tip(view, t, u_tip, v_tip):
+def physical_tip(view, t, u_tip, v_tip, share: float = 1.0):
     """(ũ(X, t), ũ_t(X, t)) from the lifted observed values u(X), v(X) at times t, X the
     tip L (or ``view.observed_x`` where the end at L is held): u + h(X)φ(t) and
     v + h(X)φ'(t) for any lifting (``view.lift``).  h(X) within 1e-9 of 0 is 0 (the
     paper's h(L) is −5.6e-17 in floating point), and then u, v are returned as they are:
-    the papers' columns stay bit for bit."""
+    the papers' columns stay bit for bit.  ``share``: the plane's part of the support's
+    direction (two planes)."""
     lift = None if view is None else view.lift
     X = view.L if view is None or view.observed_x is None else view.observed_x
     hL = 0.0 if lift is None else float(lift.h(np.array([X]))[0])
-    if abs(hL) <= 1e-9:
+    if abs(hL) <= 1e-9 or share == 0.0:
         return u_tip, v_tip
+    hL *= share
     t = np.asarray(t, dtype=float)
     return (np.asarray(u_tip) + hL * np.asarray(lift.motion.phi(t), dtype=float),
             np.asarray(v_tip) + hL * np.asarray(lift.motion.phi_d(t), dtype=float))
@@ -88,6 +90,10 @@ class LineSamples:
     #                               None when nothing is carried
     push: np.ndarray | None = None   # (m,) sign: the field's contact force is push·λ
     rho_S: float = 1.0            # forces and moments × this: N and N·m for a beam with ρS
+    planes: int = 1               # 2: coefficients [v; w] (two_plane_fields)
+    direction: tuple = (1.0, 0.0)  # two planes: the support's direction
+    k2_w: float | None = None     # two planes: the second plane's k2
+    row_planes: np.ndarray | None = None   # two planes: (m, 2) each row's force direction
 
     @property
     def points(self) -> np.ndarray:
@@ -106,6 +112,8 @@ class LineSamples:
 
     def fields(self, t: float, u, v, force) -> dict[str, np.ndarray]:
         """The point arrays of one frame (see the module docstring)."""
+        if self.planes == 2:
+            return self.two_plane_fields(t, u, v, force)
         u, v = np.asarray(u, dtype=float), np.asarray(v, dtype=float)
         disp, vel = self.E0 @ u, self.E0 @ v
         moment = self.E2 @ u if self.E2 is not None else None
@@ -125,6 +133,39 @@ class LineSamples:
                "velocity": vel, "g1": g1, "g2": g2, "contact_force": lam}
         if moment is not None:
             out["bending_moment"] = self.rho_S * self.k2 * moment
+        return out
+
+
+    def two_plane_fields(self, t: float, u, v, force) -> dict[str, np.ndarray]:
+        """Two planes: each plane's ũ as a one-plane field (``displacement_v``, ``_w``,
+        likewise velocity and bending moment) and the vectors (0, ũ_v, ũ_w) of the
+        displacement, the velocity and the nodal contact force (Warp By Vector shows the
+        whirl)."""
+        u, v = np.asarray(u, dtype=float), np.asarray(v, dtype=float)
+        n = u.size // 2
+        out, vec = {}, {}
+        for c, (suffix, share, k2) in enumerate(zip(("_v", "_w"), self.direction,
+                                                     (self.k2, self.k2_w))):
+            one = LineSamples(**{**self.__dict__, "planes": 1, "k2": k2, "push": None,
+                                 "h": None if self.h is None or share == 0.0
+                                 else share * self.h,
+                                 "h_dd": None if self.h_dd is None or share == 0.0
+                                 else share * self.h_dd,
+                                 "carried": None})
+            f = one.fields(t, u[c * n:(c + 1) * n], v[c * n:(c + 1) * n],
+                           np.zeros(self.contact.size))
+            for key in ("displacement", "velocity", "bending_moment"):
+                if key in f:
+                    out[f"{key}{suffix}"] = f[key]
+            vec[c] = (f["displacement"], f["velocity"])
+        lam = np.zeros((self.x.size, 2))
+        np.add.at(lam, self.contact, self.rho_S * np.asarray(force, dtype=float)[:, None]
+                  * self.row_planes)
+        zero = np.zeros(self.x.size)
+        out.update({"displacement_vector": np.column_stack([zero, vec[0][0], vec[1][0]]),
+                    "velocity_vector": np.column_stack([zero, vec[0][1], vec[1][1]]),
+                    "contact_force_vector": np.column_stack([zero, lam[:, 0], lam[:, 1]]),
+                    "g1": self.g1, "g2": self.g2})
         return out
 
 
@@ -199,6 +240,13 @@ def sample_line(system, samples_per_element: int = 8) -> LineSamples:
             side = _side_values(lift.h_dd, space, smp.x, s)
             h_dd = R @ (side if EIf is None else EIf * side)
     g1, g2, contact, carried, fixed = _obstacle_lines(system, view, x, L)
+    two = {}
+    if view.planes == 2:
+        from ..scheme.beta import hole_arrays
+        from .supports import row_planes
+        pair, *_, Nc = hole_arrays(system)
+        two = {"planes": 2, "direction": view.direction, "k2_w": view.k2_w,
+               "row_planes": row_planes(pair, Nc)}
     # the bar's field force is the obstacle's push R ≥ 0, as in timeseries.csv: λ at a
     # lower bound (x = 0), −λ at an upper one (x = L, where U = −u(L))
     push = None
@@ -210,7 +258,7 @@ def sample_line(system, samples_per_element: int = 8) -> LineSamples:
                        k2=view.k2 if beam else None, L=L,
                        motion=None if lift is None else lift.motion, h=h, h_dd=h_dd,
                        carried=carried, fixed=fixed, push=push,
-                       rho_S=float(view.rho_S or 1.0) if beam else 1.0)
+                       rho_S=float(view.rho_S or 1.0) if beam else 1.0, **two)
 
 
 def _obstacle_lines(system, view, x, L):

@@ -5,6 +5,7 @@ At each probe x, four columns: ``probe_<x>_displacement`` (the physical ũ = u +
 ``probe_<x>_moment`` (bending moment k²ũ'' times EI(x)/EI_ref) and ``probe_<x>_shear``
 (shear force σ̃ = −k²ũ''' likewise, docs/design.md §1), in N·m and N when the beam's mass
 per length ρS is known (the mass-normalised values times ρS), else in m³/s² and m²/s².
+A two-plane beam has each column twice, ending ``_v`` and ``_w`` (its plane).
 """
 from __future__ import annotations
 
@@ -50,19 +51,23 @@ def probe_columns(run, k0: int, k1: int) -> dict:
         phi = np.asarray(lift.motion.phi(t), dtype=float)
         dphi = np.asarray(lift.motion.phi_d(t), dtype=float)
     cols = {}
+    planes = [("", view.k2, 1.0)] if view.planes == 1 else \
+        [("_v", view.k2, view.direction[0]), ("_w", view.k2_w, view.direction[1])]
     for p in probes:
         x, name = p["x"], p["name"]
-        i = names.index(f"{name}_displacement")
-        u, v = run.obs[k0:k1, i], run.obsv[k0:k1, i]
-        m = run.obs[k0:k1, names.index(f"{name}_moment")]
-        s = run.obs[k0:k1, names.index(f"{name}_shear")]
-        if lift is not None:
-            h = float(lift.h(np.array([x]))[0])
-            h = 0.0 if abs(h) <= 1e-9 else h     # h(L) = −5.6e-17 is 0 (as for the bounds)
-            k2 = view.k2 * p["EI_factor"]
-            u, v = u + h * phi, v + h * dphi
-            m = m + k2 * float(lift.h_dd(np.array([x]))[0]) * phi
-            s = s - k2 * third_derivative(lift.h_dd, x, *p["element"]) * phi
-        cols.update({f"{name}_displacement": u, f"{name}_velocity": v,
-                     f"{name}_moment": scale * m, f"{name}_shear": scale * s})
+        for suffix, k2_plane, share in planes:
+            i = names.index(f"{name}_displacement{suffix}")
+            u, v = run.obs[k0:k1, i], run.obsv[k0:k1, i]
+            m = run.obs[k0:k1, names.index(f"{name}_moment{suffix}")]
+            s = run.obs[k0:k1, names.index(f"{name}_shear{suffix}")]
+            if lift is not None and share != 0.0:
+                h = float(lift.h(np.array([x]))[0])
+                h = share * (0.0 if abs(h) <= 1e-9 else h)   # h(L) = -5.6e-17 is 0
+                k2 = k2_plane * p["EI_factor"]
+                u, v = u + h * phi, v + h * dphi
+                m = m + share * k2 * float(lift.h_dd(np.array([x]))[0]) * phi
+                s = s - share * k2 * third_derivative(lift.h_dd, x, *p["element"]) * phi
+            cols.update({f"{name}_displacement{suffix}": u, f"{name}_velocity{suffix}": v,
+                         f"{name}_moment{suffix}": scale * m,
+                         f"{name}_shear{suffix}": scale * s})
     return cols

@@ -16,8 +16,9 @@ from ..contact.base import NoContact, no_explicit
 from ..contact.registry import Auto
 from ..errors import InputError, SolverError
 from ..linalg import band_solve, rows_matvec
-from .kernels import (Inputs, Ops, PythonLaw, Series, State, csr_product, energy_beta,
-                      move_bounds, record, run_steps, run_steps_python)
+from .kernels import (EVENT_COLUMNS, IMPACT_FIELDS, Inputs, Ops, PythonLaw, Series, State,
+                      csr_product, energy_beta, move_bounds, record, run_steps,
+                      run_steps_python)
 from .operators import csr_arrays, load_norms, step_operators
 from .stepping import Stepping
 
@@ -49,6 +50,52 @@ def observers(system) -> scipy.sparse.csr_matrix:
     return scipy.sparse.csr_matrix((0, system.n))
 
 
+def disk_rows(system) -> np.ndarray:
+    """The (q, 2) row pairs of the system's round holes (none: (0, 2))."""
+    disks = getattr(system, "disks", None)
+    return np.zeros((0, 2), np.int64) if disks is None else \
+        np.ascontiguousarray(disks, dtype=np.int64).reshape(-1, 2)
+
+
+def hole_arrays(system):
+    """Ops' (pair, Np, Ni, Nx, Nc) of ``system`` (kernels.Ops): the round holes' row pairs
+    and, in two planes, each row's node and hole (one plane: empty)."""
+    m = system.C.shape[0]
+    pair = np.zeros(m, np.int64)
+    for a, b in disk_rows(system):
+        pair[a], pair[b] = b, -1
+    if getattr(system, "row_nodes", None) is None or not m:
+        return (pair, np.zeros(1, np.int64), np.zeros(0, np.int64), np.zeros(0),
+                np.zeros((0, 6)))
+    Nc = np.zeros((m, 6))
+    Nc[:, :4] = system.row_centres
+    C = system.C.tocsr()
+    for j in range(m):
+        if pair[j] == 0:        # a face: its normal is its row on the node's (v, w)
+            nv, nw = (system.row_nodes[2 * j + c].multiply(C[j]).sum() /
+                      system.row_nodes[2 * j + c].multiply(system.row_nodes[2 * j + c]).sum()
+                      for c in range(2))
+            Nc[j, 4:] = nv, nw
+    return (pair, *csr_arrays(system.row_nodes), np.ascontiguousarray(Nc))
+
+
+def two_plane_state(ops) -> dict:
+    """State's pos, rowwork (rows × 4, × 2 in two planes; none in one) and hk."""
+    m = ops.Nc.shape[0]
+    return {"pos": np.zeros((m, 4)), "rowwork": np.zeros((m, 2)), "hk": np.zeros(4)}
+
+
+def start_positions(ops, st, u0, u1) -> None:
+    """State.pos of states 0 and 1 (two planes): each row's node (v, w) in u⁰ and u¹."""
+    if not ops.Nc.shape[0]:
+        return
+    for k, u in ((0, u0), (2, u1)):
+        for j in range(ops.Nc.shape[0]):
+            for c in range(2):
+                r = 2 * j + c
+                st.pos[j, k + c] = ops.Nx[ops.Np[r]:ops.Np[r + 1]] @ u[ops.Ni[ops.Np[r]:ops.Np[r + 1]]]
+
+
 def penetration_samples(system):
     """CSR arrays of the penetration samples and their bounds (none: empty arrays)."""
     if system.sample_E is not None and system.sample_E.shape[0]:
@@ -65,7 +112,7 @@ class BetaScheme:
     CHECKPOINT = {"u_prev": "u_prev", "u_cur": "u_cur", "state": "law_state",
                   "active_prev": "active_prev", "stats": "stats", "counters": "counters",
                   "lo": "lo", "hi": "hi", "slo": "slo", "shi": "shi", "work_sums": "work",
-                  "impact": "impact"}
+                  "impact": "impact", "pos": "pos", "rowwork": "rowwork"}
 
     def __init__(self, system, stepping: Stepping, law: str | ContactLaw = "auto"):
         s, m = stepping, system.C.shape[0]
@@ -75,8 +122,13 @@ class BetaScheme:
         self.shift = 0.5 * s.dt if s.load_window == "centered" else 0.0
         self.op = op = step_operators(system, s.dt, s.beta, s.massless)
         self.step = StepData(op.A, op.C, op.D, np.ascontiguousarray(system.lo, dtype=float),
-                             np.ascontiguousarray(system.hi, dtype=float), s.dt, s.beta)
+                             np.ascontiguousarray(system.hi, dtype=float), s.dt, s.beta,
+                             disk_rows(system))
         self.law = law = self._law(law, m)
+        if self.step.disks.size and not law.round_holes:
+            raise InputError(f"the {law.name} law takes flat faces only; round holes need "
+                             "the exact round-hole law (solver auto or round-hole) or the "
+                             "penalty law")
         self.solver = law.name
         params = law.setup(self.step)       # (it may choose the law's kernel)
         self.pysolver = law.solver(self.step) if law.kernel is None else None
@@ -107,7 +159,7 @@ class BetaScheme:
         return Ops(s.dt, s.beta, s.save_every, s.frame_every, op.Kb.rows, op.Bb, op.Ab.chol,
                    op.Eb.rows, self.loads, *csr_arrays(op.C), step.lo, step.hi, shift, sshift,
                    op.W, op.D, *csr_arrays(self.Orows), *samples, slo, shi, params, op.Z,
-                   *csr_arrays(system.K.tocsr()[op.Z]))
+                   *csr_arrays(system.K.tocsr()[op.Z]), *hole_arrays(system))
 
     def _state(self) -> State:
         """The loop's state (kernels.State), by field name."""
@@ -117,7 +169,8 @@ class BetaScheme:
                      y_cur=np.empty(m), lo=ops.lo.copy(), hi=ops.hi.copy(),
                      slo=ops.slo.copy(), shi=ops.shi.copy(), law_state=z(m, np.int8),
                      active=z(m, np.bool_), active_prev=z(m, np.bool_), stats=z(4),
-                     counters=z(6, np.int64), work=z(3), impact=np.full((m, 6), -1.0),
+                     counters=z(6, np.int64), work=z(3),
+                     impact=np.full((m, IMPACT_FIELDS), -1.0), **two_plane_state(ops),
                      r_e=z(m), x=np.empty(n), yf=np.empty(m), mu=z(m), Ku=np.empty(n),
                      d=np.empty(n), dy=z(m), ez=z(self.op.Z.size))
 
@@ -127,7 +180,8 @@ class BetaScheme:
         return Series(np.full((rows, nobs), np.nan), np.full((rows, nobs), np.nan),
                       np.full(rows, np.nan), np.zeros((rows, 3)), np.zeros((rows, m)),
                       np.full((nframes, n), np.nan), np.full((nframes, n), np.nan),
-                      np.zeros((nframes, m)), np.zeros((max(4096, 4 * m), 7)))
+                      np.zeros((nframes, m)),
+                      np.zeros((max(4096, 4 * m), len(EVENT_COLUMNS))))
 
     @property
     def _kernels(self):
@@ -228,6 +282,7 @@ class BetaScheme:
     def _record_first_states(self, out) -> None:
         """States 0 and 1 (E_β needs two states: the energy saved at t = 0 is E_β¹)."""
         system, op, st, Orows = self.system, self.op, self.st, self.Orows
+        start_positions(self.ops, st, st.u_prev, st.u_cur)
         out.obs[0] = Orows @ st.u_prev
         out.obsv[0] = Orows @ system.v0
         rows_matvec(op.Kb.rows, st.u_prev, st.Ku, 1.0, False)   # K uⁿ⁻¹ for the energy

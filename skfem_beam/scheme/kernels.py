@@ -37,19 +37,29 @@ Ops = namedtuple("Ops", [
     "Sp", "Si", "Sx", "slo", "shi",   # penetration samples between the nodes and their bounds
     "params",                         # the contact law's constants
     "Zr", "Zp", "Zi", "Zx",           # quasi-static massless rows: their indices, K's rows
+    "pair",                           # per row: a round hole's first row holds its second
+    #                                   row's index, its second row −1, other rows 0
+    "Np", "Ni", "Nx", "Nc",           # two planes: each row's node (v, w) as CSR rows 2j,
+    #                                   2j+1, and [cy, cz, sy, sz, ny, nz]: its hole's centre
+    #                                   at rest, the centre's motion per unit φ, the row's
+    #                                   normal ((0, 0): radial, a round hole); none: 1 plane
 ])
 State = namedtuple("State", [
     "u_prev", "u_cur",                # uⁿ⁻¹, uⁿ
     "y_prev", "y_cur",                # C uⁿ⁻¹, C uⁿ
     "lo", "hi", "slo", "shi",         # the bounds now (moved with the support, or as at rest)
     "law_state", "active", "active_prev",
-    "stats",      # [max nodal violation, max (g1−u)⁺ sampled, max (u−g2)⁺ sampled, -]
+    "stats",      # [max nodal violation, max (g1−u)⁺ sampled, max (u−g2)⁺ sampled, φ now]
     "counters",   # [impacts, steps in contact, law iterations, step where it stopped,
                   #  impact events written, first saved row held in the Series buffers]
     "work",       # Σ over the steps of [damping, load input, contact] work (energy units)
     "impact",     # per constrained value: [start step, approach velocity, peak |λ|,
-                  #  Σ λΔt, max violation, first step off (−1: in contact)] of the
-                  #  event under way (start −1: none)
+                  #  Σ λΔt, max violation, first step off (−1: in contact), and in two
+                  #  planes the angle on the hole, the normal and tangential approach
+                  #  velocities] of the event under way (start −1: none)
+    "pos",        # two planes: each row's node (v, w) at states n−1 and n (m × 4)
+    "rowwork",    # two planes: per row, Σ contact work and Σ |F_n||v_t|Δt (m × 2)
+    "hk",         # scratch (4) of hole_kinematics
     "r_e",                            # the law's explicit force (see contact.base)
     "x", "yf", "mu", "Ku", "d", "dy", # the step's free solution (then uⁿ⁺¹), C x, μ, K uⁿ,
                                       # scratch (n), C(uⁿ⁺¹ − uⁿ⁻¹)
@@ -61,7 +71,8 @@ Series = namedtuple("Series", ["obs", "obsv", "energy", "work", "lam", "frames_u
 Inputs = namedtuple("Inputs", ["G", "phi", "H"], defaults=(np.zeros((0, 0)),))
 WORK_TERMS = ("damping", "input", "contact")   # the columns of State.work and Series.work
 EVENT_COLUMNS = ("value", "start_step", "end_step", "velocity", "peak_force", "impulse",
-                 "max_violation")
+                 "max_violation", "angle", "normal_velocity", "tangential_velocity")
+IMPACT_FIELDS = 9      # State.impact's columns
 FAILED, UNSTABLE, EVENTS_FULL = 1, 2, 3
 # State.counters by name (the compiled loops index them by these numbers)
 IMPACTS, CONTACT_STEPS, ITERATIONS, STOPPED_AT, EVENTS_WRITTEN, ROW0 = range(6)
@@ -182,6 +193,8 @@ def finish_step(ops, st, Gn):
     for j in range(mu.size):
         if mu[j] != 0.0:
             st.work[2] += 0.5 * mu[j] / dt2 * st.dy[j]
+            if st.rowwork.shape[0]:
+                st.rowwork[j, 0] += 0.5 * mu[j] / dt2 * st.dy[j]
 
 
 @njit(cache=True)
@@ -203,7 +216,7 @@ def record(n, ops, st, out):
     """Diagnostics after state n: penetration (every step), saved series, frames."""
     stats, u_cur, u_prev, dt = st.stats, st.u_cur, st.u_prev, ops.dt
     for r in range(st.y_cur.size):
-        v = max(st.lo[r] - st.y_cur[r], st.y_cur[r] - st.hi[r])
+        v = violation(ops.pair, st, r)
         if v > stats[0]:
             stats[0] = v
     for r in range(st.slo.size):
@@ -253,9 +266,33 @@ def move_bounds(ops, st, phi):
     for j in range(ops.shift.size):
         st.lo[j] = ops.lo[j] + ops.shift[j] * phi
         st.hi[j] = ops.hi[j] + ops.shift[j] * phi
+    st.stats[3] = phi
     for r in range(ops.sshift.size):
         st.slo[r] = ops.slo[r] + ops.sshift[r] * phi
         st.shi[r] = ops.shi[r] + ops.sshift[r] * phi
+
+
+@njit(cache=True, inline="always")
+def violation(pair, st, j):
+    """How far the value j is beyond its bounds (≤ 0: within); a round hole's first row:
+    its pair's distance beyond the circle (the box [lo, hi] is the disk's square)."""
+    v = max(st.lo[j] - st.y_cur[j], st.y_cur[j] - st.hi[j])
+    if pair[j] > 0:
+        b = pair[j]
+        pa = st.y_cur[j] - 0.5 * (st.lo[j] + st.hi[j])
+        pb = st.y_cur[b] - 0.5 * (st.lo[b] + st.hi[b])
+        v = max(v, np.hypot(pa, pb) - 0.5 * (st.hi[j] - st.lo[j]))
+    return v
+
+
+@njit(cache=True, inline="always")
+def row_force(pair, mu, j):
+    """|μ| of the value j's contact (a round hole's first row: of its pair; its second: 0)."""
+    if pair[j] > 0:
+        return np.hypot(mu[j], mu[pair[j]])
+    if pair[j] < 0:
+        return 0.0
+    return abs(mu[j])
 
 
 @internal
@@ -267,8 +304,59 @@ def write_event(events, counters, j, e):
     events[k, 2] = e[5]
     for c in range(1, 5):
         events[k, c + 2] = e[c]
+    for c in range(6, 9):
+        events[k, c + 1] = e[c]
     counters[4] = k + 1
     e[0] = -1.0
+
+
+@internal
+def node_position(ops, st, j, out):
+    """out ← the value j's node (v, w) at uⁿ⁺¹ (st.u_cur) minus its hole's centre now."""
+    for c in range(2):
+        s = 0.0
+        for p in range(ops.Np[2 * j + c], ops.Np[2 * j + c + 1]):
+            s += ops.Nx[p] * st.u_cur[ops.Ni[p]]
+        out[c] = s
+    out[2] = out[0] - (ops.Nc[j, 0] + ops.Nc[j, 2] * st.stats[3])
+    out[3] = out[1] - (ops.Nc[j, 1] + ops.Nc[j, 3] * st.stats[3])
+
+
+@internal
+def normal_of(ops, j, px, py):
+    """The unit normal of the value j's wall at the offset (px, py) from the centre."""
+    nx, ny = ops.Nc[j, 4], ops.Nc[j, 5]
+    if nx == 0.0 and ny == 0.0:          # a round hole: radial
+        r = np.hypot(px, py)
+        if r == 0.0:
+            return 1.0, 0.0
+        return px / r, py / r
+    return nx, ny
+
+
+@internal
+def hole_kinematics(ops, st, step, dt, p):
+    """Two planes, after state step+1: every row's node position, its impact angle and
+    velocities when a contact starts, and its work rates' sums (State.pos, rowwork)."""
+    for j in range(st.active.size):
+        if ops.pair[j] < 0:
+            continue
+        node_position(ops, st, j, p)
+        ev = st.impact[j]
+        nx, ny = normal_of(ops, j, p[2], p[3])
+        if ev[0] == step + 1:            # a contact starts: where and how fast before it
+            vx = (st.pos[j, 2] - st.pos[j, 0]) / dt
+            vy = (st.pos[j, 3] - st.pos[j, 1]) / dt
+            ev[6] = np.arctan2(p[3], p[2])
+            ev[7] = vx * nx + vy * ny
+            ev[8] = -vx * ny + vy * nx
+        f = row_force(ops.pair, st.mu, j) / (dt * dt)
+        if f != 0.0:                     # |F_n||v_t|Δt, v_t of the central difference
+            vx = (p[0] - st.pos[j, 0]) / (2.0 * dt)
+            vy = (p[1] - st.pos[j, 1]) / (2.0 * dt)
+            st.rowwork[j, 1] += f * abs(-vx * ny + vy * nx) * dt
+        st.pos[j, 0], st.pos[j, 1] = st.pos[j, 2], st.pos[j, 3]
+        st.pos[j, 2], st.pos[j, 3] = p[0], p[1]
 
 
 @njit(cache=True, inline="always")
@@ -296,21 +384,27 @@ def track_impacts(ops, st, out, step):
             ev[j, 3] = 0.0
             ev[j, 4] = 0.0
             ev[j, 5] = -1.0
+            for c in range(6, 9):
+                ev[j, c] = np.nan
         elif st.active_prev[j] and not a:
             ev[j, 5] = step + 1          # the first state off the obstacle
         if ev[j, 0] >= 0.0:
-            if st.mu[j] != 0.0:
-                lam = st.mu[j] / (dt * dt)
+            if st.mu[j] != 0.0 or ops.pair[j] > 0:
+                # a round hole's force is its pair's, its impulse Σ|λ|Δt
+                lam = st.mu[j] / (dt * dt) if ops.pair[j] == 0 else \
+                    row_force(ops.pair, st.mu, j) / (dt * dt)
                 ev[j, 2] = max(ev[j, 2], abs(lam))
                 ev[j, 3] += lam * dt
             if a:
-                ev[j, 4] = max(ev[j, 4], st.lo[j] - st.y_cur[j], st.y_cur[j] - st.hi[j])
+                ev[j, 4] = max(ev[j, 4], violation(ops.pair, st, j))
             elif step + 1 > ev[j, 5]:    # the second state off: no force can trail further
                 write_event(out.events, counters, j, ev[j])
         st.active_prev[j] = a
         any_active = any_active or a
     if any_active:
         counters[1] += 1
+    if ops.Nc.shape[0]:
+        hole_kinematics(ops, st, step, dt, st.hk)
     return EVENTS_FULL if counters[4] + st.active.size > out.events.shape[0] else 0
 
 

@@ -47,9 +47,10 @@ from ..contact.base import ContactLaw
 from ..contact.restitution import Restitution
 from ..errors import Deferred, InputError
 from ..linalg import Banded, band_solve, rows_dot, rows_matvec
-from .beta import observers, penetration_samples
-from .kernels import (FAILED, ITERATIONS, ROW0, STOPPED_AT, UNSTABLE, Inputs, Series,
-                      csr_product, track_impacts)
+from .beta import (disk_rows, hole_arrays, observers, penetration_samples, start_positions,
+                   two_plane_state)
+from .kernels import (EVENT_COLUMNS, FAILED, IMPACT_FIELDS, ITERATIONS, ROW0, STOPPED_AT,
+                      UNSTABLE, Inputs, Series, csr_product, track_impacts)
 from .operators import csr_arrays, load_norms, step_operators
 from .run import Run
 from .stepping import Result, Stepping
@@ -59,12 +60,14 @@ MJOps = namedtuple("MJOps", [
     "Kb", "Mb", "Bb", "Achol", "loads",    # K, M, B rows; Â's factor; load vectors
     "Cp", "Ci", "Cx", "W", "D",            # constraint rows, Â⁻¹Cᵀ, C Â⁻¹ Cᵀ
     "Op", "Oi", "Ox", "Sp", "Si", "Sx",    # observers, penetration samples
+    "pair", "Np", "Ni", "Nx", "Nc",        # two planes: each row's node and hole (kernels.Ops)
 ])
 MJState = namedtuple("MJState", [
     "u_prev", "u_cur", "v",
     "y_prev", "y_cur", "dy", "yv", "yp",   # C uⁿ⁻¹, C uⁿ, C(uⁿ⁺¹ − uⁿ⁻¹), C vⁿ, predicted C u
     "lo", "hi", "slo", "shi", "lo_e", "hi_e",
     "law_state", "active", "active_prev", "stats", "counters", "work", "impact",
+    "pos", "rowwork", "hk",                # two planes (kernels.State)
     "mu",                                  # Δt·p (so that mu/Δt² is the force p/Δt)
     "p", "wf", "x", "dv", "Ku", "Kv",      # scratch
 ])
@@ -189,6 +192,8 @@ def mj_steps(ops, st, out, n0, n1, inputs, Ebound):
         for j in range(m):
             st.dy[j] += st.y_cur[j]
             st.work[2] += st.p[j] * (st.y_cur[j] - st.y_prev[j]) / dt
+            if st.rowwork.shape[0]:
+                st.rowwork[j, 0] += st.p[j] * (st.y_cur[j] - st.y_prev[j]) / dt
             st.mu[j] = st.p[j] * dt
             st.active[j] = st.p[j] != 0.0
         full = track_impacts(ops, st, out, step)
@@ -212,8 +217,8 @@ def check_theta(theta) -> float:
                      f"unconditionally stable there)")
 
 
-# checkpointed: every field of MJState but the step's scratch (p, wf, x, dv, Ku, Kv)
-_MJ_SCRATCH = ("p", "wf", "x", "dv", "Ku", "Kv")
+# checkpointed: every field of MJState but the step's scratch (p, wf, x, dv, Ku, Kv, hk)
+_MJ_SCRATCH = ("p", "wf", "x", "dv", "Ku", "Kv", "hk")
 
 
 class MoreauJeanScheme:
@@ -230,6 +235,9 @@ class MoreauJeanScheme:
         if system.bound_motion is not None:
             raise InputError(f"law={NAME!r} does not handle obstacles that move with a "
                              "support: use the position-level scheme")
+        if disk_rows(system).size:
+            raise InputError(f"law={NAME!r} takes flat faces only; round holes need the "
+                             "position-level scheme (exact) or the penalty law")
         s, th = stepping, self.theta
         self.system, self.stepping, self.law = system, s, MoreauJeanLaw()
         self.solver = self.law.name
@@ -252,7 +260,7 @@ class MoreauJeanScheme:
         return MJOps(s.dt, self.theta, self.e, s.save_every, s.frame_every, op.Kb.rows,
                      Banded(system.M).rows, Banded(B).rows if B is not None
                      else np.zeros((0, 1)), op.Ab.chol, self.loads, *csr_arrays(op.C),
-                     op.W, op.D, *csr_arrays(self.Orows), *samples)
+                     op.W, op.D, *csr_arrays(self.Orows), *samples, *hole_arrays(system))
 
     def _state(self) -> MJState:
         system, op, z = self.system, self.op, np.zeros
@@ -265,7 +273,8 @@ class MoreauJeanScheme:
                        lo=lo, hi=hi, slo=np.array(slo, float), shi=np.array(shi, float),
                        lo_e=z(m), hi_e=z(m), law_state=z(m, np.int8), active=z(m, np.bool_),
                        active_prev=z(m, np.bool_), stats=z(4), counters=z(6, np.int64),
-                       work=z(3), impact=np.full((m, 6), -1.0), mu=z(m), p=z(m), wf=z(m),
+                       work=z(3), impact=np.full((m, IMPACT_FIELDS), -1.0),
+                       **two_plane_state(self.ops), mu=z(m), p=z(m), wf=z(m),
                        x=z(n), dv=z(n), Ku=z(n), Kv=z(n))
 
     def series(self, rows: int, nframes: int) -> Series:
@@ -275,10 +284,11 @@ class MoreauJeanScheme:
         return Series(np.full((rows, nobs), np.nan), np.full((rows, nobs), np.nan),
                       np.full(rows, np.nan), z((rows, 3)), z((rows, m)),
                       np.full((nframes, n), np.nan), np.full((nframes, n), np.nan),
-                      z((nframes, m)), z((max(4096, 4 * m), 7)))
+                      z((nframes, m)), z((max(4096, 4 * m), len(EVENT_COLUMNS))))
 
     def start(self, out) -> int:
         """State 0 is the data themselves: recorded; the driver steps on from there."""
+        start_positions(self.ops, self.st, self.st.u_cur, self.st.u_cur)
         mj_record(0, self.ops, self.st, out)
         return 0
 

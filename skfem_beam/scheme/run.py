@@ -12,8 +12,8 @@ from ..contact import ContactLaw
 from ..errors import Deferred, InputError, SolverError
 from ..stability import kappa_h, linear_limit
 from .beta import BetaScheme
-from .kernels import (EVENTS_FULL, EVENTS_WRITTEN, FAILED, ROW0, STOPPED_AT, UNSTABLE,
-                      WORK_TERMS, Inputs, PythonLaw)
+from .kernels import (EVENT_COLUMNS, EVENTS_FULL, EVENTS_WRITTEN, FAILED, ROW0, STOPPED_AT,
+                      UNSTABLE, WORK_TERMS, Inputs, PythonLaw)
 from .stepping import Result, Stepping
 
 FIRST_ROWS = 1 << 15      # saved rows allocated at first; more as a chunk needs them
@@ -151,16 +151,21 @@ class Run:
             self.st.counters[EVENTS_WRITTEN] = 0
 
     def _all_events(self) -> np.ndarray:
-        return np.concatenate(self.events) if self.events else np.zeros((0, 7))
+        return np.concatenate(self.events) if self.events else \
+            np.zeros((0, len(EVENT_COLUMNS)))
 
     def impact_events(self, last: int | None = None) -> dict:
         """One row per impact of a constrained value so far: ``value`` (its index), ``x``,
         ``t_start``, ``t_end`` (the first state off the obstacle), ``velocity`` (approach
         velocity (yⁿ − yⁿ⁻¹)/Δt before contact), ``peak_force`` (max |λ|), ``impulse``
-        (Σ λΔt), ``max_violation`` (m), in the system's units, and ``open``: 1 for an
-        event the loop still holds at the last state (``last``, default ``n``): in contact
-        (t_end is then that state) or within the two states after t_end that a spring's
-        trailing force reaches; its peak and impulse are those so far."""
+        (Σ λΔt; a round hole's: Σ|λ|Δt of its pair), ``max_violation`` (m), in the
+        system's units, and ``open``: 1 for an event the loop still holds at the last state
+        (``last``, default ``n``): in contact (t_end is then that state) or within the two
+        states after t_end that a spring's trailing force reaches; its peak and impulse are
+        those so far.  Two planes add ``angle`` (rad, of the node's offset from its hole's
+        centre at the first state in contact), ``normal_velocity`` and
+        ``tangential_velocity`` (m/s, the node's velocity before it, along the wall's
+        outward normal and counter-clockwise along the wall); NaN in one plane."""
         last = self.n if last is None else int(last)
         done = self._all_events()
         rows = [np.column_stack([done, np.zeros(len(done))])]
@@ -169,7 +174,8 @@ class Run:
             j = np.flatnonzero(open_)
             e = self.st.impact[j]
             end = np.where(e[:, 5] >= 0, e[:, 5], last)
-            rows.append(np.column_stack([j, e[:, 0], end, e[:, 1:5], np.ones(j.size)]))
+            rows.append(np.column_stack([j, e[:, 0], end, e[:, 1:5], e[:, 6:9],
+                                         np.ones(j.size)]))
         table = np.concatenate(rows)
         table = table[np.lexsort((table[:, 0], table[:, 1]))]
         x = np.asarray(self.system.x_contact, dtype=float)
@@ -177,7 +183,8 @@ class Run:
         return {"value": value, "x": x[value], "t_start": table[:, 1] * self.dt,
                 "t_end": table[:, 2] * self.dt, "velocity": table[:, 3],
                 "peak_force": table[:, 4], "impulse": table[:, 5], "max_violation": table[:, 6],
-                "open": table[:, 7].astype(int)}
+                "angle": table[:, 7], "normal_velocity": table[:, 8],
+                "tangential_velocity": table[:, 9], "open": table[:, 10].astype(int)}
 
     @property
     def done(self) -> bool:
@@ -287,7 +294,7 @@ class Run:
         sc.restored()
         if sc.pysolver is not None:
             sc.pysolver.restore({k[7:]: ck[k] for k in ck if k.startswith("solver_")})
-        self.events = [np.asarray(ck["events"], dtype=float).reshape(-1, 7)]
+        self.events = [np.asarray(ck["events"], dtype=float).reshape(-1, len(EVENT_COLUMNS))]
         self.n, self.load_bound, self.wall, self.E1 = int(ck["n"]), float(ck["load_bound"]), \
             float(ck["wall"]), float(ck["E1"])
         if self.n >= self.n_steps:       # a checkpoint at the last step: nothing to compute

@@ -1,0 +1,221 @@
+"""Holes in a support, in the beam's cross-section plane: where a two-plane beam's
+displacement (v, w) at a node may be.
+
+A hole is a convex set around the beam's rest position (0, 0):
+
+- ``Hole.round(radius, centre)``: a drilled hole, |(v, w) − centre| ≤ radius (a
+  second-order cone: the exact round-hole law, contact.round_hole);
+- ``Hole.faces(rows, centre)``: flat faces (anti-vibration bars, broached lands), each row
+  (ny, nz, gap) saying n·((v, w) − centre) ≤ gap with n = (ny, nz) normalised;
+- ``Hole.regular(sides, radius, angle, centre)``: a regular polygon, ``radius`` to its
+  faces (the inscribed circle), the first face's normal at ``angle`` (rad);
+- ``Hole.polygon(vertices)``: any convex polygon, vertices counter-clockwise.
+
+Faces are linear constraints: :meth:`Hole.rows` gives them as rows lo ≤ n·(v, w) ≤ hi,
+two antiparallel faces merged into one row with both bounds (a square hole is then the
+one-plane stops g1 ≤ v ≤ g2 and g1 ≤ w ≤ g2, decoupled: the projection law).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .checks import check_count, check_finite, check_positive
+from .errors import InputError
+
+
+def _pair(name: str, value) -> tuple[float, float]:
+    if isinstance(value, (str, bytes)) or not hasattr(value, "__len__") or len(value) != 2:
+        raise InputError(f"{name}={value!r} must be a pair [y, z] (m)")
+    return check_finite(f"{name}[0]", value[0]), check_finite(f"{name}[1]", value[1])
+
+
+@dataclass(frozen=True)
+class Hole:
+    """A convex hole: ``radius`` (round) or ``faces`` ((k, 3) rows ny, nz, gap with n a unit
+    vector), about ``centre`` (y, z) in m; ``shape`` names it in reports."""
+    centre: tuple[float, float] = (0.0, 0.0)
+    radius: float | None = None
+    faces_: tuple[tuple[float, float, float], ...] = ()
+    shape: str = "round"
+
+    @classmethod
+    def round(cls, radius: float, centre=(0.0, 0.0)) -> "Hole":
+        hole = cls(_pair("centre", centre), check_positive("radius", radius), (), "round")
+        hole._check_rest()
+        return hole
+
+    @classmethod
+    def faces(cls, rows, centre=(0.0, 0.0), shape: str = "faces") -> "Hole":
+        """Faces n·((v, w) − centre) ≤ gap, rows (ny, nz, gap); n is normalised."""
+        rows = np.asarray(rows, dtype=float) if _is_table(rows) else None
+        if rows is None or rows.ndim != 2 or rows.shape[1] != 3 or rows.shape[0] < 1:
+            raise InputError("hole faces must be [[ny, nz, gap], ...] (at least one face)")
+        if not np.isfinite(rows).all():
+            raise InputError("hole faces must be finite numbers")
+        norm = np.hypot(rows[:, 0], rows[:, 1])
+        if np.any(norm == 0):
+            raise InputError(f"hole face {int(np.argmin(norm))} has the normal (0, 0)")
+        n = rows[:, :2] / norm[:, None]
+        n[np.abs(n) < 1e-14] = 0.0         # cos(π/2) is 6e-17: a square's faces are exact
+        rows = np.column_stack([n / np.hypot(n[:, 0], n[:, 1])[:, None], rows[:, 2]])
+        hole = cls(_pair("centre", centre), None, tuple(map(tuple, rows.tolist())), shape)
+        hole._check_rest()
+        return hole
+
+    @classmethod
+    def regular(cls, sides: int, radius: float, angle: float = 0.0, centre=(0.0, 0.0)) \
+            -> "Hole":
+        """A regular polygon of ``sides`` faces at ``radius`` from the centre (inscribed
+        radius), the first face's outward normal at ``angle`` rad."""
+        sides = check_count("sides", sides, 3)
+        radius, angle = check_positive("radius", radius), check_finite("angle", angle)
+        a = angle + 2 * math.pi * np.arange(sides) / sides
+        return cls.faces(np.column_stack([np.cos(a), np.sin(a), np.full(sides, radius)]),
+                         centre, f"{sides}-gon")
+
+    @classmethod
+    def polygon(cls, vertices) -> "Hole":
+        """A convex polygon through ``vertices`` [[y, z], ...], counter-clockwise (m)."""
+        p = np.asarray(vertices, dtype=float) if _is_table(vertices) else None
+        if p is None or p.ndim != 2 or p.shape[1] != 2 or p.shape[0] < 3 \
+                or not np.isfinite(p).all():
+            raise InputError("hole polygon must be [[y1, z1], [y2, z2], ...] (at least three "
+                             "vertices, m)")
+        e = np.roll(p, -1, axis=0) - p
+        cross = e[:, 0] * np.roll(e, -1, axis=0)[:, 1] - e[:, 1] * np.roll(e, -1, axis=0)[:, 0]
+        if np.any(cross <= 0):
+            i = int(np.argmax(cross <= 0))
+            raise InputError(f"hole polygon is not convex and counter-clockwise at vertex "
+                             f"{(i + 1) % len(p)} ({p[(i + 1) % len(p)].tolist()})")
+        n = np.column_stack([e[:, 1], -e[:, 0]])      # outward: the edge turned clockwise
+        n /= np.hypot(n[:, 0], n[:, 1])[:, None]
+        return cls.faces(np.column_stack([n, np.einsum("ij,ij->i", n, p)]), (0.0, 0.0),
+                         "polygon")
+
+    @property
+    def is_round(self) -> bool:
+        return self.radius is not None
+
+    def _check_rest(self) -> None:
+        """The beam's rest position (0, 0) must lie strictly inside."""
+        gap = self.clearance(np.zeros(2))
+        if gap <= 0:
+            raise InputError(f"the {self.shape} hole about centre={list(self.centre)} does not "
+                             "contain the beam's rest position (0, 0) strictly inside")
+
+    def clearance(self, p) -> float:
+        """Distance from p = (v, w) to the wall, inward (< 0: outside the hole)."""
+        d = np.asarray(p, dtype=float) - np.asarray(self.centre)
+        if self.is_round:
+            return float(self.radius - np.hypot(d[0], d[1]))
+        f = np.asarray(self.faces_)
+        return float(np.min(f[:, 2] - f[:, :2] @ d))
+
+    def rows(self) -> list[tuple[float, float, float, float]]:
+        """The faces as rows (ny, nz, lo, hi): lo ≤ n·(v, w) ≤ hi, antiparallel faces
+        merged (the row of the first; lo = −∞ when a face has no opposite)."""
+        c = np.asarray(self.centre)
+        out, used = [], set()
+        f = list(self.faces_)
+        for i, (ny, nz, gap) in enumerate(f):
+            if i in used:
+                continue
+            hi = gap + ny * c[0] + nz * c[1]
+            lo = -math.inf
+            for k in range(i + 1, len(f)):
+                if k not in used and abs(f[k][0] + ny) < 1e-12 and abs(f[k][1] + nz) < 1e-12:
+                    lo = -(f[k][2] + f[k][0] * c[0] + f[k][1] * c[1])
+                    used.add(k)
+                    break
+            out.append((ny, nz, lo, hi))
+        return out
+
+    def outline(self, points: int = 361) -> np.ndarray:
+        """(points, 2) on the wall, for charts (a polygon: its vertices, closed)."""
+        c = np.asarray(self.centre)
+        if self.is_round:
+            a = np.linspace(0.0, 2 * math.pi, points)
+            return c + self.radius * np.column_stack([np.cos(a), np.sin(a)])
+        f = np.asarray(self.faces_)
+        ang = np.arctan2(f[:, 1], f[:, 0])
+        f = f[np.argsort(ang)]
+        verts = []
+        for k in range(len(f)):
+            a, b = f[k], f[(k + 1) % len(f)]
+            A = np.array([a[:2], b[:2]])
+            if abs(np.linalg.det(A)) < 1e-12:
+                continue           # parallel faces: open (flat bars)
+            verts.append(c + np.linalg.solve(A, [a[2], b[2]]))
+        return np.array(verts + verts[:1]) if verts else np.zeros((0, 2))
+
+
+def _is_table(value) -> bool:
+    return isinstance(value, (list, tuple, np.ndarray)) and not isinstance(value, (str, bytes))
+
+
+HOLE_FORMS = ("radius", "sides", "polygon", "faces")
+
+
+def hole_from_table(d: dict, where: str) -> Hole:
+    """A hole from a scene file's ``hole = { ... }``: ``radius`` alone (round; with
+    ``sides`` a regular polygon, ``angle`` its first face's normal), ``polygon``, or
+    ``faces``; ``centre`` optional."""
+    if not isinstance(d, dict):
+        raise InputError(f"{where} must be a table: {{ radius = r }}, {{ sides = n, radius = r }}, "
+                         "{ polygon = [[y, z], ...] } or { faces = [[ny, nz, gap], ...] }")
+    allowed = {"radius", "sides", "angle", "centre", "polygon", "faces"}
+    unknown = set(d) - allowed
+    if unknown:
+        raise InputError(f"unknown key {where}.{sorted(unknown)[0]}; a hole allows: "
+                         f"{', '.join(sorted(allowed))}")
+    centre = d.get("centre", (0.0, 0.0))
+    if "polygon" in d:
+        if set(d) - {"polygon"}:
+            raise InputError(f"{where} polygon stands alone (its vertices are absolute)")
+        return Hole.polygon(d["polygon"])
+    if "faces" in d:
+        if set(d) - {"faces", "centre"}:
+            raise InputError(f"{where} faces take only centre beside them")
+        return Hole.faces(d["faces"], centre)
+    if "sides" in d:
+        if "radius" not in d:
+            raise InputError(f"{where} sides = n needs radius (to the faces, m)")
+        return Hole.regular(d["sides"], d["radius"], d.get("angle", 0.0), centre)
+    if "radius" not in d:
+        raise InputError(f"{where} needs radius, sides with radius, polygon or faces")
+    if "angle" in d:
+        raise InputError(f"{where} angle applies to a regular polygon (sides)")
+    return Hole.round(d["radius"], centre)
+
+
+@dataclass(frozen=True)
+class HoleAt:
+    """A hole acting at the node x (``x_to`` None) or at every node of [x, x_to];
+    ``carried``: it moves with the moving support (else fixed to the ground)."""
+    hole: Hole
+    x: float
+    x_to: float | None = None
+    carried: bool = False
+
+    def __post_init__(self):
+        object.__setattr__(self, "x", check_finite("x", self.x))
+        if self.x_to is not None:
+            object.__setattr__(self, "x_to", check_finite("x_to", self.x_to))
+            if self.x_to <= self.x:
+                raise InputError(f"hole span [x_from={self.x:g}, x_to={self.x_to:g}] needs "
+                                 "x_from < x_to")
+        if not isinstance(self.carried, (bool, np.bool_)):
+            raise InputError(f"carried={self.carried!r} must be True or False")
+
+    @property
+    def breakpoints(self) -> tuple[float, ...]:
+        return (self.x,) if self.x_to is None else (self.x, self.x_to)
+
+    def acts_at(self, x: np.ndarray, L: float) -> np.ndarray:
+        tol = 1e-9 * max(1.0, L)
+        if self.x_to is None:
+            return np.abs(x - self.x) <= tol
+        return (x >= self.x - tol) & (x <= self.x_to + tol)

@@ -1,0 +1,92 @@
+"""Two planes: what a pipe engineer reads per support (a hole or flat obstacles at a
+node): impacts, the time in contact, where on the hole the impacts land, and the work
+rates that wear it, in summary.json's ``impact_statistics.supports``; and the orbit
+chart, the node's w against v with the hole drawn.
+
+Work rates (W, when the beam's mass per length ρS is known; else per unit mass per
+length, m³/s³), over the run's time T:
+
+- ``impact_work_rate``: −(1/T)·Σ ½λ·(y^{n+1} − y^{n−1}), the support's share of the
+  scheme's contact work (the energy lost at its impacts per second; ≥ 0 for exact
+  contact, whose contact work is ≤ 0);
+- ``normal_work_rate``: (1/T)∫|F_n||v_t| dt, |F_n| the contact force, v_t the node's
+  velocity along the wall ((y^{n+1} − y^{n−1})/(2Δt), its component along the tangent
+  of the face, or of the circle at the node); the wear work rate of Archard's law per
+  unit wear coefficient.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .charts import _frame, figure
+
+ANGLE_BINS = 12      # the impact-angle histogram: 30° bins from −180° to 180°
+
+
+def row_planes(pair, Nc) -> np.ndarray:
+    """(m, 2): each constrained row's force direction in (v, w) (its face's normal, or a
+    round hole's rows (1, 0) and (0, 1)), so that the net contact force in each plane is
+    λ @ row_planes; ``pair``, ``Nc``: the run's (kernels.Ops)."""
+    m = pair.size
+    out = np.array(Nc[:, 4:6]) if Nc.shape[0] else np.zeros((m, 2))
+    for j in range(m):
+        if pair[j] > 0:
+            out[j], out[pair[j]] = (1.0, 0.0), (0.0, 1.0)
+    return out
+
+
+def support_statistics(table: dict, run, scale: float, duration: float, T: float) \
+        -> list[dict]:
+    """Per node with a hole or flat obstacles: impacts, contact fraction (of ``duration``,
+    as the run's own), the histogram of the impact angles (ANGLE_BINS bins over [−π, π])
+    and the work rates over the run's time ``T`` (module docstring), forces times
+    ``scale`` (ρS: W)."""
+    from .events import _union_length
+    x_rows = np.asarray(run.system.x_contact, dtype=float)
+    work = run.st.rowwork
+    T = T if T > 0 else math.nan
+    edges = np.linspace(-math.pi, math.pi, ANGLE_BINS + 1)
+    out = []
+    for x in np.unique(x_rows):
+        rows = np.flatnonzero(x_rows == x)
+        ev = np.flatnonzero(table["x"] == x)
+        angles = np.asarray(table["angle"], dtype=float)[ev]
+        counts, _ = np.histogram(angles[np.isfinite(angles)], edges)
+        out.append({
+            "x": float(x), "impacts": int(ev.size),
+            "contact_fraction": _union_length(table["t_start"][ev], table["t_end"][ev])
+            / duration if ev.size and duration > 0 else 0.0,
+            "impact_angle_histogram": {"edges_rad": edges.tolist(), "counts": counts.tolist()},
+            "impact_work_rate": -scale * float(work[rows, 0].sum()) / T,
+            "normal_work_rate": scale * float(work[rows, 1].sum()) / T})
+    return out
+
+
+def work_rate_units(newtons: bool) -> dict:
+    unit = "W" if newtons else "m³/s³ (W per kg/m)"
+    return {"impact_work_rate": f"{unit}: −(1/T)Σ ½λ·(y^(n+1) − y^(n−1)) over the support's "
+                                "rows, the energy its impacts take out of the beam per second",
+            "normal_work_rate": f"{unit}: (1/T)∫|F_n||v_t| dt, the contact force times the "
+                                "node's velocity along the wall (the wear work rate)",
+            "impact_angle_histogram": "counts of impacts per angle bin, the angle of the "
+                                      "node's offset from the hole's centre (rad, from +v "
+                                      "towards +w)",
+            "angle": "rad, where on the hole (atan2(w − cz, v − cy) at the first state in "
+                     "contact)",
+            "normal_velocity": "m/s, the node's velocity before the impact along the wall's "
+                               "outward normal (> 0: towards the wall)",
+            "tangential_velocity": "m/s, its component along the wall, counter-clockwise"}
+
+
+def orbit_chart(path, v, w, outline, title: str, centre=(0.0, 0.0)) -> None:
+    """w against v at a support's node, with its hole's wall (``outline``, (k, 2))."""
+    with figure(path, figsize=(5.5, 5.5)) as (fig, ax):
+        ax.plot(np.asarray(v) * 1e3, np.asarray(w) * 1e3, lw=0.6, color="C0", label="orbit")
+        if len(outline):
+            o = np.asarray(outline) * 1e3
+            ax.plot(o[:, 0], o[:, 1], color="k", lw=1.2, label="hole wall")
+        ax.plot([centre[0] * 1e3], [centre[1] * 1e3], "k+")
+        ax.set_aspect("equal", adjustable="datalim")
+        _frame(ax, "v (mm)", "w (mm)", title, fontsize=9)

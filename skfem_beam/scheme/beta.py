@@ -58,14 +58,17 @@ def disk_rows(system) -> np.ndarray:
 
 
 def hole_arrays(system):
-    """Ops' (pair, Np, Ni, Nx, Nc) of ``system`` (kernels.Ops): the round holes' row pairs
-    and, in two planes, each row's node and hole (one plane: empty)."""
+    """Ops' (pair, disks, Np, Ni, Nx, Nc) of ``system`` (kernels.Ops): the round holes'
+    row pairs and first rows and, in two planes, each row's node and hole (one plane:
+    empty)."""
     m = system.C.shape[0]
     pair = np.zeros(m, np.int64)
-    for a, b in disk_rows(system):
+    disks = disk_rows(system)
+    for a, b in disks:
         pair[a], pair[b] = b, -1
+    first = np.ascontiguousarray(disks[:, 0])
     if getattr(system, "row_nodes", None) is None or not m:
-        return (pair, np.zeros(1, np.int64), np.zeros(0, np.int64), np.zeros(0),
+        return (pair, first, np.zeros(1, np.int64), np.zeros(0, np.int64), np.zeros(0),
                 np.zeros((0, 6)))
     Nc = np.zeros((m, 6))
     Nc[:, :4] = system.row_centres
@@ -76,7 +79,7 @@ def hole_arrays(system):
                       system.row_nodes[2 * j + c].multiply(system.row_nodes[2 * j + c]).sum()
                       for c in range(2))
             Nc[j, 4:] = nv, nw
-    return (pair, *csr_arrays(system.row_nodes), np.ascontiguousarray(Nc))
+    return (pair, first, *csr_arrays(system.row_nodes), np.ascontiguousarray(Nc))
 
 
 def two_plane_state(ops) -> dict:

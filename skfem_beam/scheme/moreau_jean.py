@@ -60,7 +60,7 @@ MJOps = namedtuple("MJOps", [
     "Kb", "Mb", "Bb", "Achol", "loads",    # K, M, B rows; Â's factor; load vectors
     "Cp", "Ci", "Cx", "W", "D",            # constraint rows, Â⁻¹Cᵀ, C Â⁻¹ Cᵀ
     "Op", "Oi", "Ox", "Sp", "Si", "Sx",    # observers, penetration samples
-    "pair", "Np", "Ni", "Nx", "Nc",        # two planes: each row's node and hole (kernels.Ops)
+    "pair", "disks", "Np", "Ni", "Nx", "Nc",   # two planes: rows, nodes, holes (kernels.Ops)
 ])
 MJState = namedtuple("MJState", [
     "u_prev", "u_cur", "v",

@@ -194,11 +194,13 @@ def hole_from_table(d: dict, where: str) -> Hole:
 @dataclass(frozen=True)
 class HoleAt:
     """A hole acting at the node x (``x_to`` None) or at every node of [x, x_to];
-    ``carried``: it moves with the moving support (else fixed to the ground)."""
+    ``carried``: it moves with the moving support (else fixed to the ground);
+    ``friction``: Coulomb's μ at its wall (round holes; Moreau–Jean)."""
     hole: Hole
     x: float
     x_to: float | None = None
     carried: bool = False
+    friction: float = 0.0
 
     def __post_init__(self):
         object.__setattr__(self, "x", check_finite("x", self.x))
@@ -209,6 +211,13 @@ class HoleAt:
                                  "x_from < x_to")
         if not isinstance(self.carried, (bool, np.bool_)):
             raise InputError(f"carried={self.carried!r} must be True or False")
+        mu = check_finite("friction", self.friction)
+        if mu < 0:
+            raise InputError(f"friction={mu:g} must be ≥ 0 (Coulomb's μ)")
+        if mu > 0 and not self.hole.is_round:
+            raise InputError(f"friction={mu:g} at the {self.hole.shape} hole: friction acts "
+                             "in round holes here (faces and flat bars are frictionless)")
+        object.__setattr__(self, "friction", mu)
 
     @property
     def breakpoints(self) -> tuple[float, ...]:

@@ -82,7 +82,7 @@ U0, V0 = {"x": V, "u": V}, {"x": V, "v": V}
 TIME_KEYS = {"dt": N, "T": N, "beta": N, "load_window": V}
 OUTPUT = {"format": V, "save_every": N, "frames": N, "flush_every": N, "checkpoint_every": N,
           "probes": V}
-CONTACT = {"law": V, "stiffness": N, "restitution": N}
+CONTACT = {"law": V, "stiffness": N, "restitution": N, "friction": N}
 G = NumberOr({"poly": V, "about": V, "x": V, "g": V})     # checked by _g
 
 BEAM_KEYS = {
@@ -95,7 +95,8 @@ BEAM_KEYS = {
     "supports": [{"x": N}],
     "motion": {"end": V, "at": N, "lifting": V, "direction": V, **TIME},
     "obstacles": [{"x": N, "x_from": N, "x_to": N, "g1": G, "g2": G, "hole": V, "carried": V,
-                   "stiffness": N, "damping": N}],
+                   "stiffness": N, "damping": N, "friction": N}],
+    "wear": {"coefficient": N, "service_years": N, "land": N, "radius": N},
     "damping": {"zeta": N, "f1": N, "f2": N, "alpha": N, "alpha_K": N, "modal": N},
     "loads": [{"x": N, "distributed": V, "per_mass": V, "gravity": N, "x_from": N, "x_to": N,
                "direction": V, "rotating": {"amplitude": N, "omega": N, "phase": N},
@@ -311,6 +312,8 @@ def _supports(data: dict) -> tuple[float, float] | None:
 def _scene(kind, problem, data, text, files) -> Scene:
     contact = data.get("contact", {})
     law, k, c = contact.get("law", "auto"), contact.get("stiffness"), 0.0
+    if any(h.friction > 0 for h in getattr(problem, "holes", ())) and "law" not in contact:
+        law = "moreau-jean"        # Coulomb friction is a velocity-level law
     supports = _supports(data)
     if supports is not None:
         law, (k, c) = "penalty", supports
@@ -510,19 +513,21 @@ def _g(value, where: str):
                      f"{{ x = [...], g = [...] }} (got keys {', '.join(value)})")
 
 
-def _hole(o: dict, i: int):
-    """A [[obstacles]] hole = {...} at x or over [x_from, x_to] (holes.HoleAt)."""
+def _hole(o: dict, i: int, friction: float = 0.0):
+    """A [[obstacles]] hole = {...} at x or over [x_from, x_to] (holes.HoleAt); its
+    ``friction`` μ, else the scene's [contact] friction."""
     from .holes import HoleAt, hole_from_table
     where = f"obstacles.{i}"
     if "g1" in o or "g2" in o:
         raise InputError(f"[{where}] a hole bounds (v, w) itself: leave out g1, g2")
     hole = hole_from_table(o["hole"], f"{where}.hole")
+    mu = o.get("friction", friction)
     if "x" in o:
         if "x_from" in o or "x_to" in o:
             raise InputError(f"[{where}] give x or x_from, x_to, not both")
-        return HoleAt(hole, o["x"], carried=o.get("carried", False))
+        return HoleAt(hole, o["x"], carried=o.get("carried", False), friction=mu)
     a, b = _need(o, ("x_from", "x_to"), where).values()
-    return HoleAt(hole, a, b, carried=o.get("carried", False))
+    return HoleAt(hole, a, b, carried=o.get("carried", False), friction=mu)
 
 
 def _obstacle(o: dict, i: int) -> Obstacles:
@@ -543,7 +548,15 @@ def _obstacle(o: dict, i: int) -> Obstacles:
 def _obstacles(data: dict) -> tuple[Obstacles, tuple]:
     """The flat obstacles (the first plane's, g1 ≤ v ≤ g2) and the holes."""
     items = list(enumerate(data.get("obstacles", [])))
-    holes = tuple(_hole(o, i) for i, o in items if "hole" in o)
+    mu = data.get("contact", {}).get("friction", 0.0)
+    holes = tuple(_hole(o, i, mu) for i, o in items if "hole" in o)
+    if (mu or any("friction" in o for _, o in items)) and _planes(data) != 2:
+        raise InputError("friction acts along the wall of a hole, in the cross-section: the "
+                         "one-plane beam has no tangential direction (planes = 2 and a hole)")
+    for i, o in items:
+        if "friction" in o and "hole" not in o:
+            raise InputError(f"[obstacles.{i}] friction acts at a hole's wall: this obstacle "
+                             "has no hole")
     if holes and _planes(data) != 2:
         raise InputError("[[obstacles]] hole bounds (v, w) in the cross-section: it needs "
                          "planes = 2 at the top of the file")
@@ -825,6 +838,29 @@ def _scene_of(path, sets, resume) -> Scene:
     return load(path or "scene.toml", sets or (), **stored)
 
 
+def _wear(scene: Scene):
+    """[wear] as output.supports.Wear (radius defaults to a tube's or rod's outer one)."""
+    from .output.supports import Wear
+    d = scene.data.get("wear")
+    if d is None:
+        return None
+    holes = getattr(scene.problem, "holes", ())
+    if not holes:
+        raise InputError("[wear] needs holes (planes = 2 and [[obstacles]] hole = ...): wear "
+                         "comes from the normal force times the sliding along a wall")
+    section = scene.data.get("section", {})
+    radius = d.get("radius")
+    if radius is None:
+        diameter = section.get("tube", {}).get("outer_diameter") or \
+            section.get("rod", {}).get("diameter")
+        if diameter is None:
+            raise InputError("[wear] radius (m, the tube's outer radius) is needed when "
+                             "[section] is not a tube or a rod")
+        radius = 0.5 * diameter
+    need = _need(d, ("coefficient", "service_years", "land"), "wear")
+    return Wear(need["coefficient"], need["service_years"], need["land"], radius)
+
+
 def _spec(scene: Scene, flags: dict, resume) -> RunSpec:
     """The scene and the command line's flags (which override its [output] and [time] T)
     as one RunSpec; summary.json's config records both, in the flags' names."""
@@ -851,7 +887,8 @@ def _spec(scene: Scene, flags: dict, resume) -> RunSpec:
               "solver": "auto" if law in methods.LAWS or restitution else law,
               "stiffness": scene.stiffness, "restitution": restitution, "mass": mass,
               "massless": stepping.massless, "probe": probes}
-    return RunSpec(stepping, scene.method, options, config, mass, tuple(probes))
+    return RunSpec(stepping, scene.method, options, config, mass, tuple(probes),
+                   _wear(scene) if scene.kind == "beam" else None)
 
 
 def _chart_stops(problem: BeamProblem) -> tuple:

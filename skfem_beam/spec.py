@@ -17,10 +17,12 @@ class RunSpec:
     ``options``: the output folder and streaming; ``config``: summary.json's record of
     what the user asked for, in the front end's own words (a resume compares it);
     ``mass``: the beam's mass matrix (consistent | redistributed); ``probes``: abscissae
-    (m) whose displacement, velocity, moment and shear are written."""
+    (m) whose displacement, velocity, moment and shear are written; ``wear``: Archard's
+    law at the supports (:class:`~skfem_beam.output.supports.Wear`, two planes) or None."""
     stepping: Stepping
     method: Method
     options: OutputOptions
     config: dict = field(default_factory=dict)
     mass: str = "consistent"
     probes: tuple = ()
+    wear: object = None

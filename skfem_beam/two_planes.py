@@ -81,7 +81,7 @@ def two_plane_system(problem, samples_per_element: int = 20):
                                np.array([[shift_at(x, c) * dy, shift_at(x, c) * dz]
                                          for x, c in zip(sv.x_contact, carried_v)])
                                .reshape(-1, 2)])]
-    disks, m = [], sv.C.shape[0]
+    disks, mu, m = [], [], sv.C.shape[0]
     free = set(space.value_nodes.tolist())
     for k, h in enumerate(problem.holes):
         at = np.flatnonzero(h.acts_at(nodes, problem.beam.L))
@@ -104,6 +104,7 @@ def two_plane_system(problem, samples_per_element: int = 20):
                 hi.append(np.array([cy + r, cz + r]))
                 shift.append(np.array([s * dy, s * dz]))
                 disks.append((m, m + 1, i))
+                mu.append(h.friction)
                 m += 2
                 xs.append(np.array([x, x]))
                 centre.append(np.repeat(c, 2, axis=0))
@@ -157,7 +158,18 @@ def two_plane_system(problem, samples_per_element: int = 20):
         view=view, bound_motion=motion, bound_shift=shift if motion is not None else None,
         sample_shift=s_shift if motion is not None else None,
         planes=2, disks=np.array([d[:2] for d in disks], dtype=np.int64).reshape(-1, 2),
+        friction=_friction(m, disks, mu),
         row_nodes=node_rows, row_centres=centre)
+
+
+def _friction(m: int, disks, mu) -> np.ndarray | None:
+    """μ per row: a round hole's at its first row (None: no friction anywhere)."""
+    if not any(mu):
+        return None
+    out = np.zeros(m)
+    for (a, _, _), value in zip(disks, mu):
+        out[a] = value
+    return out
 
 
 def _check_start(y0, lo, hi, disks, x_c, motion, shift) -> None:

@@ -49,7 +49,7 @@ def run_beam_case(case: str, problem, spec: RunSpec, stops=(), extra=None) -> in
     }
 
     def events(folder: Path, run, last: int) -> dict:
-        return beam_impacts(folder, run, problem, last)
+        return beam_impacts(folder, run, problem, last, spec.wear)
 
     two = system.planes == 2
     if two:
@@ -107,9 +107,9 @@ def beam_columns(view, rho_S):
 
 def work_columns(run, k0, k1, rho_S) -> dict:
     """The work since state 1, in the units of energy (and J): energy − energy[0] +
-    damping = input + contact (the scheme's identity, docs/design.md §3)."""
+    damping = input + contact (+ friction) (the scheme's identity, docs/design.md §3)."""
     work = run.work[k0:k1]
-    terms = {f"work_{name}": work[:, i] for i, name in enumerate(WORK_TERMS)}
+    terms = {f"work_{name}": work[:, i] for i, name in enumerate(run.work_terms)}
     if rho_S:
         terms.update({f"{k}_J": v * rho_S for k, v in list(terms.items())})
     return terms
@@ -136,6 +136,8 @@ def two_plane_columns(view, rho_S):
                 cols[name] = physical_at(view, x, t, run.obs[k0:k1, names.index(name)],
                                          share)
         cols["energy"] = run.energy[k0:k1]
+        if "friction" in run.work_terms:     # the friction's Gauss–Seidel at each saved step
+            cols["friction_residual"] = run.resid[k0:k1]
         force = run.lam[k0:k1] @ row_planes(run.ops.pair, run.ops.Nc)   # net, per plane
         for c, suffix in enumerate(PLANE_SUFFIXES):
             cols[f"contact_force{suffix}"] = force[:, c]
@@ -157,6 +159,12 @@ def two_plane_units(rho_S) -> dict:
            "contact_force_w": "net contact force along z, as contact_force"}
     if rho_S:
         out.update({"contact_force_v_N": "N", "contact_force_w_N": "N"})
+    out.update({"work_friction": "as energy: the work of Coulomb friction (≤ 0), cumulative "
+                                 "since t = 0; energy − energy[0] + work_damping = "
+                                 "work_input + work_contact + work_friction",
+                "friction_residual": "the friction's Gauss–Seidel residual at the saved "
+                                     "step (largest impulse change of its last sweep, "
+                                     "relative; 0 with one contact: exact)"})
     return out
 
 
@@ -219,8 +227,8 @@ def two_plane_charts(folder, data, run, case, problem, about, where, what, rho_S
     joules = "energy_J" in data
     energy_chart(folder / "energy.png", t, data["energy_J" if joules else "energy"],
                  title=f"{case}: discrete energy ½E_β ({about})",
-                 work={k: data[f"work_{k}" + ("_J" if joules else "")] for k in WORK_TERMS},
-                 joules=joules)
+                 work={k: data[f"work_{k}" + ("_J" if joules else "")]
+                       for k in run.work_terms}, joules=joules)
     newtons = "contact_force_v_N" in data
     forces = {f"net contact force, {p}": data[f"contact_force_{p}" + ("_N" if newtons else "")]
               for p in ("v", "w")}

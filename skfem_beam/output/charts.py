@@ -96,7 +96,8 @@ def energy_chart(path, t, energy, title="discrete energy ½E_β", work=None, jou
     series = {"½E_β" + ("" if joules else " (per unit mass per length)"): energy}
     if work is not None and any(np.any(w) for w in work.values()):
         labels = {"input": "work of the loads (support motion included)",
-                  "damping": "work lost in damping", "contact": "work of the contact forces"}
+                  "damping": "work lost in damping", "contact": "work of the contact forces",
+                  "friction": "work of friction"}
         series.update({labels[k]: w for k, w in work.items() if np.any(w)})
     trajectory_chart(path, t, series, title=title,
                      ylabel="energy (J)" if joules else "energy (m³/s²)")

@@ -43,11 +43,13 @@ IMPACTS = "impacts.csv"
 COLUMNS = ("t_start", "t_end", "x", "bound", "velocity", "peak_force", "impulse",
            "max_violation", "open")
 HOLE_COLUMNS = ("angle", "normal_velocity", "tangential_velocity")   # two planes
+FRICTION_COLUMNS = ("slip", "friction_impulse")                      # ... with friction
 TWO_PLANE_COLUMNS = COLUMNS[:-1] + HOLE_COLUMNS + COLUMNS[-1:]
 
 
 def impact_table(events: dict, lo: np.ndarray, hi: np.ndarray, scale: float = 1.0,
-                 sign: float = 1.0, planes: int = 1) -> dict[str, np.ndarray]:
+                 sign: float = 1.0, planes: int = 1, friction: bool = False) \
+        -> dict[str, np.ndarray]:
     """The impacts.csv columns of ``events`` (``Run.impact_events()``): forces and impulses
     times ``scale`` (ρS for a beam in N), impulses times ``sign`` (the bar's R = sign·λ);
     ``lo``, ``hi``: the bounds of the constrained values (which side each contact is on)."""
@@ -61,6 +63,10 @@ def impact_table(events: dict, lo: np.ndarray, hi: np.ndarray, scale: float = 1.
              "impulse": sign * scale * impulse, "max_violation": events["max_violation"]}
     if planes == 2:
         table.update({k: np.asarray(events[k], dtype=float) for k in HOLE_COLUMNS})
+    if friction:
+        table.update({"slip": np.asarray(events["slip"], dtype=float),
+                      "friction_impulse": scale * np.asarray(events["friction_impulse"],
+                                                             dtype=float)})
     return {**table, "open": np.asarray(events["open"], dtype=int)}
 
 
@@ -124,7 +130,7 @@ def impact_statistics(table: dict, duration: float, obstacles=None) -> dict:
 
 
 def write_impacts(folder: Path, run, units: dict, scale: float = 1.0, sign: float = 1.0,
-                  obstacles=None, last: int | None = None) -> dict:
+                  obstacles=None, last: int | None = None, wear=None) -> dict:
     """Write ``folder/impacts.csv`` from ``run`` (a :class:`~skfem_beam.scheme.Run`) and
     return the summary entry ``{"impact_statistics": ...}``; ``units``: the force and
     impulse units (``{"force": "N", "impulse": "N·s"}``), see :func:`impact_table`.
@@ -137,8 +143,12 @@ def write_impacts(folder: Path, run, units: dict, scale: float = 1.0, sign: floa
     keep = np.asarray(events["t_start"]) <= (last + 0.5) * run.dt
     events = {k: np.asarray(v)[keep] for k, v in events.items()}
     planes = getattr(s, "planes", 1)
-    table = impact_table(events, np.asarray(s.lo), np.asarray(s.hi), scale, sign, planes)
+    friction = "friction" in run.work_terms
+    table = impact_table(events, np.asarray(s.lo), np.asarray(s.hi), scale, sign, planes,
+                         friction)
     columns = list(COLUMNS if planes == 1 else TWO_PLANE_COLUMNS)
+    if friction:
+        columns[-1:-1] = FRICTION_COLUMNS
     path = Path(folder) / IMPACTS
     atomic_write(path, lambda fh: fh.write(",".join(columns) + "\n"
                                            + (csv_rows(table, columns, ("bound", "open"))
@@ -157,19 +167,28 @@ def write_impacts(folder: Path, run, units: dict, scale: float = 1.0, sign: floa
                       "contact_fraction": "of the run's time"}
     if planes == 2:
         from .supports import support_statistics, work_rate_units
-        stats["supports"] = support_statistics(table, run, scale, duration, last * run.dt)
-        stats["units"].update(work_rate_units(units["force"] == "N"))
+        stats["supports"] = support_statistics(table, run, scale, duration, last * run.dt,
+                                               wear)
+        stats["units"].update(work_rate_units(units["force"] == "N", wear))
+    if friction:
+        stats["units"].update({"slip": "m, Σ|u_t|Δt over the contact",
+                               "friction_impulse": i + ", Σ|p_t| over the contact"})
+        from ..scheme.moreau_jean import NSGS_TOL
+        return {"impact_statistics": stats, "friction": {
+            "coefficients": sorted({float(m) for m in run.system.friction if m > 0}),
+            "nsgs_tolerance": NSGS_TOL, "nsgs_max_residual": float(run.st.fres[1])}}
         stats["units"]["peak_force"] += "; a round hole's: the force's magnitude"
         stats["units"]["impulse"] += "; a round hole's: Σ|force|Δt"
     return {"impact_statistics": stats}
 
 
-def beam_impacts(folder: Path, run, problem, last: int | None = None) -> dict:
-    """:func:`write_impacts` for a beam scene, in N and N·s when ρS is known."""
+def beam_impacts(folder: Path, run, problem, last: int | None = None, wear=None) -> dict:
+    """:func:`write_impacts` for a beam scene, in N and N·s when ρS is known (``wear``:
+    output.supports.Wear, two planes)."""
     rho_S = problem.beam.rho_S
     units = {"force": "N", "impulse": "N·s"} if rho_S else \
         {"force": "m²/s² (N per kg/m)", "impulse": "m²/s (N·s per kg/m)"}
-    return write_impacts(folder, run, units, rho_S or 1.0, 1.0, problem.obstacles, last)
+    return write_impacts(folder, run, units, rho_S or 1.0, 1.0, problem.obstacles, last, wear)
 
 
 def bar_impacts(folder: Path, run, bar, last: int | None = None) -> dict:

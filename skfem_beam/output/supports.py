@@ -12,17 +12,64 @@ length, m³/s³), over the run's time T:
 - ``normal_work_rate``: (1/T)∫|F_n||v_t| dt, |F_n| the contact force, v_t the node's
   velocity along the wall ((y^{n+1} − y^{n−1})/(2Δt), its component along the tangent
   of the face, or of the circle at the node); the wear work rate of Archard's law per
-  unit wear coefficient.
+  unit wear coefficient;
+- ``friction_work_rate`` (with friction): −(1/T) × the support's share of the friction
+  work (the energy its friction takes per second, ≥ 0).
+
+**Wear** (:class:`Wear`, ``[wear]`` of a scene file): Archard's law, the worn volume
+V = K·∫|F_n||v_t| dt, so a wear volume rate K × the normal work rate (m³/s), the volume
+after the service life, and a depth from the stated assumptions: the wear spreads over
+the tube's surface in contact, the land's width b (axial) times the arc the contact
+covers: uniformly round the tube, d = V/(2πRb); per 30° sector k of the hole (the node's
+angle when the work is done, as Code_Aster's POST_USURE sums it per sector),
+d_k = V_k/(R·(π/6)·b).  The tube does not turn about its axis, so a sector of the hole
+wears the same sector of the tube.
 """
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
+
+from ..checks import check_positive
+
+YEAR = 365.25 * 86400.0     # s
+
+
+@dataclass(frozen=True)
+class Wear:
+    """Archard's law at the supports: ``coefficient`` K (m³/(N·m)), ``service_years`` Y,
+    ``land`` b (m, the support's axial contact width), ``radius`` R (m, the tube's outer
+    radius); the module docstring says what each number assumes."""
+    coefficient: float
+    service_years: float
+    land: float
+    radius: float
+
+    def __post_init__(self):
+        for name in ("coefficient", "service_years", "land", "radius"):
+            object.__setattr__(self, name, check_positive(f"[wear] {name}",
+                                                          getattr(self, name)))
+
+    def of(self, normal_work_rate: float, sectors: np.ndarray, T: float) -> dict:
+        """The support's wear from its normal work rate (W) and its normal work per
+        sector over the run's time T (J)."""
+        life = self.service_years * YEAR
+        rate = self.coefficient * normal_work_rate
+        arc = 2 * math.pi / SECTORS_PER_TURN
+        volumes = self.coefficient * np.asarray(sectors) / T * life
+        return {"volume_rate": rate, "volume": rate * life,
+                "depth_uniform": rate * life / (2 * math.pi * self.radius * self.land),
+                "sectors": [{"from_rad": -math.pi + k * arc, "to_rad": -math.pi + (k + 1) * arc,
+                             "volume": float(v), "depth": float(v / (self.radius * arc
+                                                                      * self.land))}
+                            for k, v in enumerate(volumes)]}
 
 from .charts import _frame, figure
 
 ANGLE_BINS = 12      # the impact-angle histogram: 30° bins from −180° to 180°
+SECTORS_PER_TURN = 12   # the wear sectors (kernels.SECTORS)
 
 
 def row_planes(pair, Nc) -> np.ndarray:
@@ -37,12 +84,12 @@ def row_planes(pair, Nc) -> np.ndarray:
     return out
 
 
-def support_statistics(table: dict, run, scale: float, duration: float, T: float) \
-        -> list[dict]:
+def support_statistics(table: dict, run, scale: float, duration: float, T: float,
+                       wear: Wear | None = None) -> list[dict]:
     """Per node with a hole or flat obstacles: impacts, contact fraction (of ``duration``,
     as the run's own), the histogram of the impact angles (ANGLE_BINS bins over [−π, π])
     and the work rates over the run's time ``T`` (module docstring), forces times
-    ``scale`` (ρS: W)."""
+    ``scale`` (ρS: W); with friction its work rate, with ``wear`` the support's wear."""
     from .events import _union_length
     x_rows = np.asarray(run.system.x_contact, dtype=float)
     work = run.st.rowwork
@@ -54,19 +101,31 @@ def support_statistics(table: dict, run, scale: float, duration: float, T: float
         ev = np.flatnonzero(table["x"] == x)
         angles = np.asarray(table["angle"], dtype=float)[ev]
         counts, _ = np.histogram(angles[np.isfinite(angles)], edges)
-        out.append({
+        entry = {
             "x": float(x), "impacts": int(ev.size),
             "contact_fraction": _union_length(table["t_start"][ev], table["t_end"][ev])
             / duration if ev.size and duration > 0 else 0.0,
             "impact_angle_histogram": {"edges_rad": edges.tolist(), "counts": counts.tolist()},
             "impact_work_rate": -scale * float(work[rows, 0].sum()) / T,
-            "normal_work_rate": scale * float(work[rows, 1].sum()) / T})
+            "normal_work_rate": scale * float(work[rows, 1].sum()) / T}
+        if run.st.fc.shape[0]:
+            entry["friction_work_rate"] = -scale * float(work[rows, 2].sum()) / T
+        if wear is not None:
+            entry["wear"] = wear.of(entry["normal_work_rate"],
+                                    scale * run.st.sectors[rows].sum(axis=0), T)
+        out.append(entry)
     return out
 
 
-def work_rate_units(newtons: bool) -> dict:
+def work_rate_units(newtons: bool, wear: Wear | None = None) -> dict:
     unit = "W" if newtons else "m³/s³ (W per kg/m)"
-    return {"impact_work_rate": f"{unit}: −(1/T)Σ ½λ·(y^(n+1) − y^(n−1)) over the support's "
+    out = {} if wear is None else {"wear": (
+        "volume_rate m³/s = K × normal_work_rate, volume m³ after service_years, "
+        "depth_uniform m = volume/(2πRb) (worn evenly round the tube over the land b), "
+        "sectors: per 30° of the hole (rad from +v towards +w) the volume and depth "
+        "volume/(R·(π/6)·b); K = coefficient m³/(N·m), R = radius, b = land (m), "
+        "as given in [wear]")}
+    return {**out, "friction_work_rate": f"{unit}: −(1/T) × the support's friction work","impact_work_rate": f"{unit}: −(1/T)Σ ½λ·(y^(n+1) − y^(n−1)) over the support's "
                                 "rows, the energy its impacts take out of the beam per second",
             "normal_work_rate": f"{unit}: (1/T)∫|F_n||v_t| dt, the contact force times the "
                                 "node's velocity along the wall (the wear work rate)",

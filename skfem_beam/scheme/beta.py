@@ -16,7 +16,8 @@ from ..contact.base import NoContact, no_explicit
 from ..contact.registry import Auto
 from ..errors import InputError, SolverError
 from ..linalg import band_solve, rows_matvec
-from .kernels import (EVENT_COLUMNS, IMPACT_FIELDS, Inputs, Ops, PythonLaw, Series, State,
+from .kernels import (EVENT_COLUMNS, IMPACT_FIELDS, SECTORS, Inputs, Ops, PythonLaw, Series,
+                      State,
                       csr_product, energy_beta, move_bounds, record, run_steps,
                       run_steps_python)
 from .operators import csr_arrays, load_norms, step_operators
@@ -48,6 +49,12 @@ def observers(system) -> scipy.sparse.csr_matrix:
     if system.observe:
         return scipy.sparse.csr_matrix(np.vstack(list(system.observe.values())))
     return scipy.sparse.csr_matrix((0, system.n))
+
+
+def friction(system) -> bool:
+    """Whether some contact of the system has Coulomb friction (μ > 0)."""
+    mu = getattr(system, "friction", None)
+    return mu is not None and bool(np.any(np.asarray(mu) > 0))
 
 
 def disk_rows(system) -> np.ndarray:
@@ -82,10 +89,13 @@ def hole_arrays(system):
     return (pair, first, *csr_arrays(system.row_nodes), np.ascontiguousarray(Nc))
 
 
-def two_plane_state(ops) -> dict:
-    """State's pos, rowwork (rows × 4, × 2 in two planes; none in one) and hk."""
+def two_plane_state(ops, friction: bool = False) -> dict:
+    """State's pos, rowwork, sectors (rows × 4, 3, SECTORS in two planes; none in one),
+    hk, and fc (rows × 6 with friction, else none)."""
     m = ops.Nc.shape[0]
-    return {"pos": np.zeros((m, 4)), "rowwork": np.zeros((m, 2)), "hk": np.zeros(4)}
+    return {"pos": np.zeros((m, 4)), "rowwork": np.zeros((m, 3)),
+            "sectors": np.zeros((m, SECTORS)), "hk": np.zeros(4),
+            "fc": np.zeros((ops.pair.size if friction else 0, 6))}
 
 
 def start_positions(ops, st, u0, u1) -> None:
@@ -115,7 +125,7 @@ class BetaScheme:
     CHECKPOINT = {"u_prev": "u_prev", "u_cur": "u_cur", "state": "law_state",
                   "active_prev": "active_prev", "stats": "stats", "counters": "counters",
                   "lo": "lo", "hi": "hi", "slo": "slo", "shi": "shi", "work_sums": "work",
-                  "impact": "impact", "pos": "pos", "rowwork": "rowwork"}
+                  "impact": "impact", "pos": "pos", "rowwork": "rowwork", "sectors": "sectors"}
 
     def __init__(self, system, stepping: Stepping, law: str | ContactLaw = "auto"):
         s, m = stepping, system.C.shape[0]
@@ -128,6 +138,9 @@ class BetaScheme:
                              np.ascontiguousarray(system.hi, dtype=float), s.dt, s.beta,
                              disk_rows(system))
         self.law = law = self._law(law, m)
+        if friction(system):
+            raise InputError("Coulomb friction is a velocity-level law: run it with law = "
+                             "moreau-jean (the β-scheme's contact is frictionless)")
         if self.step.disks.size and not law.round_holes:
             raise InputError(f"the {law.name} law takes flat faces only; round holes need "
                              "the exact round-hole law (solver auto or round-hole) or the "
@@ -172,7 +185,7 @@ class BetaScheme:
                      y_cur=np.empty(m), lo=ops.lo.copy(), hi=ops.hi.copy(),
                      slo=ops.slo.copy(), shi=ops.shi.copy(), law_state=z(m, np.int8),
                      active=z(m, np.bool_), active_prev=z(m, np.bool_), stats=z(4),
-                     counters=z(6, np.int64), work=z(3),
+                     counters=z(6, np.int64), work=z(4),
                      impact=np.full((m, IMPACT_FIELDS), -1.0), **two_plane_state(ops),
                      r_e=z(m), x=np.empty(n), yf=np.empty(m), mu=z(m), Ku=np.empty(n),
                      d=np.empty(n), dy=z(m), ez=z(self.op.Z.size))
@@ -181,10 +194,10 @@ class BetaScheme:
         """Saved-series buffers of ``rows`` rows and ``nframes`` field frames."""
         n, m, nobs = self.system.n, self.system.C.shape[0], self.Orows.shape[0]
         return Series(np.full((rows, nobs), np.nan), np.full((rows, nobs), np.nan),
-                      np.full(rows, np.nan), np.zeros((rows, 3)), np.zeros((rows, m)),
+                      np.full(rows, np.nan), np.zeros((rows, 4)), np.zeros((rows, m)),
                       np.full((nframes, n), np.nan), np.full((nframes, n), np.nan),
                       np.zeros((nframes, m)),
-                      np.zeros((max(4096, 4 * m), len(EVENT_COLUMNS))))
+                      np.zeros((max(4096, 4 * m), len(EVENT_COLUMNS))), np.zeros(rows))
 
     @property
     def _kernels(self):

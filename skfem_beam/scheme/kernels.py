@@ -53,27 +53,35 @@ State = namedtuple("State", [
     "stats",      # [max nodal violation, max (g1−u)⁺ sampled, max (u−g2)⁺ sampled, φ now]
     "counters",   # [impacts, steps in contact, law iterations, step where it stopped,
                   #  impact events written, first saved row held in the Series buffers]
-    "work",       # Σ over the steps of [damping, load input, contact] work (energy units)
+    "work",       # Σ over the steps of [damping, load input, contact, friction] work
+                  # (energy units)
     "impact",     # per constrained value: [start step, approach velocity, peak |λ|,
                   #  Σ λΔt, max violation, first step off (−1: in contact), and in two
                   #  planes the angle on the hole, the normal and tangential approach
-                  #  velocities] of the event under way (start −1: none)
+                  #  velocities, the slip Σ|u_t|Δt and the friction impulse Σ|p_t|] of
+                  #  the event under way (start −1: none)
     "pos",        # two planes: each row's node (v, w) at states n−1 and n (m × 4)
-    "rowwork",    # two planes: per row, Σ contact work and Σ |F_n||v_t|Δt (m × 2)
+    "rowwork",    # two planes: per row, Σ contact work, Σ |F_n||v_t|Δt, Σ friction work
     "hk",         # scratch (4) of hole_kinematics
+    "sectors",    # two planes: per row, Σ |F_n||v_t|Δt per 30° sector of the hole (m × 12)
+    "fc",         # friction (Moreau–Jean): per round hole's first row [p_n, p_t, u_n, u_t,
+                  # n_y, n_z] of the step (contact.friction.nsgs); none without
     "r_e",                            # the law's explicit force (see contact.base)
     "x", "yf", "mu", "Ku", "d", "dy", # the step's free solution (then uⁿ⁺¹), C x, μ, K uⁿ,
                                       # scratch (n), C(uⁿ⁺¹ − uⁿ⁻¹)
     "ez",                             # the massless rows' explicit force of the step
 ])
 Series = namedtuple("Series", ["obs", "obsv", "energy", "work", "lam", "frames_u", "frames_v",
-                               "frames_f", "events"])
+                               "frames_f", "events", "resid"])   # resid: friction's residual
 # H: the load at the quasi-static massless rows, (1−2β)fⁿ + βfⁿ⁻¹ there (0 rows: none)
 Inputs = namedtuple("Inputs", ["G", "phi", "H"], defaults=(np.zeros((0, 0)),))
 WORK_TERMS = ("damping", "input", "contact")   # the columns of State.work and Series.work
+FRICTION = 3           # ... and the friction work's (Moreau–Jean with friction only)
+SECTORS = 12           # the hole's angular sectors of the normal work (State.sectors)
 EVENT_COLUMNS = ("value", "start_step", "end_step", "velocity", "peak_force", "impulse",
-                 "max_violation", "angle", "normal_velocity", "tangential_velocity")
-IMPACT_FIELDS = 9      # State.impact's columns
+                 "max_violation", "angle", "normal_velocity", "tangential_velocity", "slip",
+                 "friction_impulse")
+IMPACT_FIELDS = 11     # State.impact's columns
 FAILED, UNSTABLE, EVENTS_FULL = 1, 2, 3
 # State.counters by name (the compiled loops index them by these numbers)
 IMPACTS, CONTACT_STEPS, ITERATIONS, STOPPED_AT, EVENTS_WRITTEN, ROW0 = range(6)
@@ -245,7 +253,7 @@ def record(n, ops, st, out):
             out.obs[k, r] = s
             out.obsv[k, r] = sv / dt
         out.energy[k] = 0.5 * energy_beta(ops.Eb, u_prev, u_cur, st.Ku, st.d)
-        for c in range(3):
+        for c in range(4):
             out.work[k, c] = st.work[c]
         for j in range(st.mu.size):
             out.lam[k, j] = st.mu[j] / dt2
@@ -312,7 +320,7 @@ def write_event(events, counters, j, e):
     events[k, 2] = e[5]
     for c in range(1, 5):
         events[k, c + 2] = e[c]
-    for c in range(6, 9):
+    for c in range(6, IMPACT_FIELDS):
         events[k, c + 1] = e[c]
     counters[4] = k + 1
     e[0] = -1.0
@@ -345,7 +353,9 @@ def normal_of(ops, j, px, py):
 @internal
 def hole_kinematics(ops, st, step, dt, p):
     """Two planes, after state step+1: every row's node position, its impact angle and
-    velocities when a contact starts, and its work rates' sums (State.pos, rowwork)."""
+    velocities when a contact starts, and its work rates' sums (State.pos, rowwork,
+    sectors: |F_n||v_t|Δt with F_n the force's normal part, in the sector of the node's
+    angle)."""
     for j in range(st.active.size):
         if ops.pair[j] < 0:
             continue
@@ -358,11 +368,14 @@ def hole_kinematics(ops, st, step, dt, p):
             ev[6] = np.arctan2(p[3], p[2])
             ev[7] = vx * nx + vy * ny
             ev[8] = -vx * ny + vy * nx
-        f = row_force(ops.pair, st.mu, j) / (dt * dt)
+        f = abs(st.mu[j]) if ops.pair[j] == 0 else abs(st.mu[j] * nx + st.mu[ops.pair[j]] * ny)
         if f != 0.0:                     # |F_n||v_t|Δt, v_t of the central difference
             vx = (p[0] - st.pos[j, 0]) / (2.0 * dt)
             vy = (p[1] - st.pos[j, 1]) / (2.0 * dt)
-            st.rowwork[j, 1] += f * abs(-vx * ny + vy * nx) * dt
+            w = f / (dt * dt) * abs(-vx * ny + vy * nx) * dt
+            st.rowwork[j, 1] += w
+            k = int((np.arctan2(p[3], p[2]) + np.pi) / (2.0 * np.pi) * SECTORS)
+            st.sectors[j, min(max(k, 0), SECTORS - 1)] += w
         st.pos[j, 0], st.pos[j, 1] = st.pos[j, 2], st.pos[j, 3]
         st.pos[j, 2], st.pos[j, 3] = p[0], p[1]
 
@@ -394,6 +407,8 @@ def track_impacts(ops, st, out, step):
             ev[j, 5] = -1.0
             for c in range(6, 9):
                 ev[j, c] = np.nan
+            ev[j, 9] = 0.0
+            ev[j, 10] = 0.0
         elif st.active_prev[j] and not a:
             ev[j, 5] = step + 1          # the first state off the obstacle
         if ev[j, 0] >= 0.0:
@@ -403,6 +418,9 @@ def track_impacts(ops, st, out, step):
                     row_force(ops.pair, st.mu, j) / (dt * dt)
                 ev[j, 2] = max(ev[j, 2], abs(lam))
                 ev[j, 3] += lam * dt
+            if st.fc.shape[0] and ops.pair[j] > 0:     # friction: slip and its impulse
+                ev[j, 9] += abs(st.fc[j, 3]) * dt
+                ev[j, 10] += abs(st.fc[j, 1])
             if a:
                 ev[j, 4] = max(ev[j, 4], violation(ops.pair, st.lo, st.hi, st.y_cur, j))
             elif step + 1 > ev[j, 5]:    # the second state off: no force can trail further

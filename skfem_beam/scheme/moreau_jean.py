@@ -49,8 +49,9 @@ from ..errors import Deferred, InputError
 from ..linalg import Banded, band_solve, rows_dot, rows_matvec
 from .beta import (disk_rows, hole_arrays, observers, penetration_samples, start_positions,
                    two_plane_state)
-from .kernels import (EVENT_COLUMNS, FAILED, IMPACT_FIELDS, ITERATIONS, ROW0, STOPPED_AT,
-                      UNSTABLE, Inputs, Series, csr_product, track_impacts)
+from ..contact.friction import MAX_SWEEPS, nsgs
+from .kernels import (EVENT_COLUMNS, FAILED, FRICTION, IMPACT_FIELDS, ITERATIONS, ROW0,
+                      STOPPED_AT, UNSTABLE, Inputs, Series, csr_product, track_impacts)
 from .operators import csr_arrays, load_norms, step_operators
 from .run import Run
 from .stepping import Result, Stepping
@@ -61,13 +62,15 @@ MJOps = namedtuple("MJOps", [
     "Cp", "Ci", "Cx", "W", "D",            # constraint rows, Â⁻¹Cᵀ, C Â⁻¹ Cᵀ
     "Op", "Oi", "Ox", "Sp", "Si", "Sx",    # observers, penetration samples
     "pair", "disks", "Np", "Ni", "Nx", "Nc",   # two planes: rows, nodes, holes (kernels.Ops)
+    "fric", "tol",                         # round holes: μ per first row; the NSGS tolerance
 ])
 MJState = namedtuple("MJState", [
     "u_prev", "u_cur", "v",
     "y_prev", "y_cur", "dy", "yv", "yp",   # C uⁿ⁻¹, C uⁿ, C(uⁿ⁺¹ − uⁿ⁻¹), C vⁿ, predicted C u
     "lo", "hi", "slo", "shi", "lo_e", "hi_e",
     "law_state", "active", "active_prev", "stats", "counters", "work", "impact",
-    "pos", "rowwork", "hk",                # two planes (kernels.State)
+    "pos", "rowwork", "sectors", "hk", "fc",   # two planes (kernels.State)
+    "fres",                                # round holes: [the step's NSGS residual, max]
     "mu",                                  # Δt·p (so that mu/Δt² is the force p/Δt)
     "p", "wf", "x", "dv", "Ku", "Kv",      # scratch
 ])
@@ -106,6 +109,7 @@ def mj_record(n, ops, st, out):
                                                                         st.u_cur))
         out.work[k, :] = st.work
         out.lam[k, :] = st.mu / dt2
+        out.resid[k] = st.fres[0]
     if n % ops.frame_every == 0:
         k = n // ops.frame_every
         for i in range(st.u_cur.size):
@@ -136,6 +140,24 @@ def mj_impulse(ops, st):
     return box_qp(ops.D, st.wf, st.lo_e, st.hi_e, st.law_state, st.p)
 
 
+@njit(cache=True, inline="always")
+def mj_holes(ops, st):
+    """Round holes: the impulses of contact.friction.nsgs (Coulomb friction, and the box
+    rows beside them) from y_θ = uⁿ + (1−θ)Δt vⁿ; st.fres ← its residual.  st.x holds
+    v_free on entry."""
+    dt, th = ops.dt, ops.theta
+    for i in range(st.x.size):
+        st.dv[i] = st.u_cur[i] + (1.0 - th) * dt * st.v[i]
+    csr_product(ops.Cp, ops.Ci, ops.Cx, st.dv, st.yp)
+    csr_product(ops.Cp, ops.Ci, ops.Cx, st.x, st.wf)
+    its, res = nsgs(ops.D, (ops.pair, ops.fric, st.lo, st.hi),
+                    (st.wf, st.yv, st.yp, st.y_cur, ops.e, ops.tol, th * dt),
+                    (st.p, st.fc, st.lo_e, st.hi_e))
+    st.fres[0] = res
+    st.fres[1] = max(st.fres[1], res)
+    return its
+
+
 @njit(cache=True)
 def mj_steps(ops, st, out, n0, n1, inputs, Ebound):
     """Steps n = n0..n1−1 of Moreau–Jean (module docstring); the codes of
@@ -157,7 +179,7 @@ def mj_steps(ops, st, out, n0, n1, inputs, Ebound):
         band_solve(ops.Achol, x)
         for i in range(n):
             x[i] += st.v[i]                      # v_free
-        its = mj_impulse(ops, st)
+        its = mj_holes(ops, st) if ops.disks.size else mj_impulse(ops, st)
         if its < 0:
             st.counters[STOPPED_AT] = step + 1
             return FAILED
@@ -196,6 +218,18 @@ def mj_steps(ops, st, out, n0, n1, inputs, Ebound):
                 st.rowwork[j, 0] += st.p[j] * (st.y_cur[j] - st.y_prev[j]) / dt
             st.mu[j] = st.p[j] * dt
             st.active[j] = st.p[j] != 0.0
+        for a in ops.disks:              # a round hole's friction part of its work
+            b = ops.pair[a]
+            st.active[b] = False
+            st.active[a] = st.p[a] != 0.0 or st.p[b] != 0.0
+            if st.fc.shape[0] and st.fc[a, 1] != 0.0:
+                f = st.fc[a, 1] * (-st.fc[a, 5] * (st.y_cur[a] - st.y_prev[a])
+                                   + st.fc[a, 4] * (st.y_cur[b] - st.y_prev[b])) / dt
+                st.work[2] -= f
+                st.work[FRICTION] += f
+                if st.rowwork.shape[0]:
+                    st.rowwork[a, 0] -= f
+                    st.rowwork[a, 2] += f
         full = track_impacts(ops, st, out, step)
         mj_record(step + 1, ops, st, out)
         if (step + 1) % ops.save_every == 0 \
@@ -206,6 +240,16 @@ def mj_steps(ops, st, out, n0, n1, inputs, Ebound):
             st.counters[STOPPED_AT] = step + 1
             return full
     return 0
+
+
+NSGS_TOL = 1e-12     # friction's Gauss–Seidel: a sweep's largest change, relative
+
+
+def friction_of(system) -> np.ndarray:
+    """μ per constrained row (a round hole's first row; 0 elsewhere)."""
+    mu = getattr(system, "friction", None)
+    return np.zeros(system.C.shape[0]) if mu is None else \
+        np.ascontiguousarray(mu, dtype=float)
 
 
 def check_theta(theta) -> float:
@@ -235,9 +279,9 @@ class MoreauJeanScheme:
         if system.bound_motion is not None:
             raise InputError(f"law={NAME!r} does not handle obstacles that move with a "
                              "support: use the position-level scheme")
-        if disk_rows(system).size:
-            raise InputError(f"law={NAME!r} takes flat faces only; round holes need the "
-                             "position-level scheme (exact) or the penalty law")
+        if disk_rows(system).size and self.e > 0:
+            raise InputError(f"restitution={self.e:g} with round holes: {NAME} holds a node "
+                             "on the wall at the step's end there (e = 0)")
         s, th = stepping, self.theta
         self.system, self.stepping, self.law = system, s, MoreauJeanLaw()
         self.solver = self.law.name
@@ -260,7 +304,8 @@ class MoreauJeanScheme:
         return MJOps(s.dt, self.theta, self.e, s.save_every, s.frame_every, op.Kb.rows,
                      Banded(system.M).rows, Banded(B).rows if B is not None
                      else np.zeros((0, 1)), op.Ab.chol, self.loads, *csr_arrays(op.C),
-                     op.W, op.D, *csr_arrays(self.Orows), *samples, *hole_arrays(system))
+                     op.W, op.D, *csr_arrays(self.Orows), *samples, *hole_arrays(system),
+                     friction_of(system), NSGS_TOL)
 
     def _state(self) -> MJState:
         system, op, z = self.system, self.op, np.zeros
@@ -273,8 +318,9 @@ class MoreauJeanScheme:
                        lo=lo, hi=hi, slo=np.array(slo, float), shi=np.array(shi, float),
                        lo_e=z(m), hi_e=z(m), law_state=z(m, np.int8), active=z(m, np.bool_),
                        active_prev=z(m, np.bool_), stats=z(4), counters=z(6, np.int64),
-                       work=z(3), impact=np.full((m, IMPACT_FIELDS), -1.0),
-                       **two_plane_state(self.ops), mu=z(m), p=z(m), wf=z(m),
+                       work=z(4), impact=np.full((m, IMPACT_FIELDS), -1.0),
+                       **two_plane_state(self.ops, bool(disk_rows(system).size)),
+                       fres=z(2), mu=z(m), p=z(m), wf=z(m),
                        x=z(n), dv=z(n), Ku=z(n), Kv=z(n))
 
     def series(self, rows: int, nframes: int) -> Series:
@@ -282,9 +328,9 @@ class MoreauJeanScheme:
         n, m, nobs = self.system.n, self.system.C.shape[0], self.Orows.shape[0]
         z = np.zeros
         return Series(np.full((rows, nobs), np.nan), np.full((rows, nobs), np.nan),
-                      np.full(rows, np.nan), z((rows, 3)), z((rows, m)),
+                      np.full(rows, np.nan), z((rows, 4)), z((rows, m)),
                       np.full((nframes, n), np.nan), np.full((nframes, n), np.nan),
-                      z((nframes, m)), z((max(4096, 4 * m), len(EVENT_COLUMNS))))
+                      z((nframes, m)), z((max(4096, 4 * m), len(EVENT_COLUMNS))), z(rows))
 
     def start(self, out) -> int:
         """State 0 is the data themselves: recorded; the driver steps on from there."""
@@ -310,6 +356,13 @@ class MoreauJeanScheme:
 
     def restored(self) -> None:
         """Every field it needs is in the checkpoint."""
+
+    def failure(self) -> str:
+        """Why a step failed, when friction's Gauss–Seidel missed its tolerance."""
+        if not self.ops.disks.size:
+            return ""
+        return (f": friction's Gauss–Seidel did not reach {self.ops.tol:g} in "
+                f"{MAX_SWEEPS} sweeps (residual {self.st.fres[0]:.3g})")
 
 
 class MoreauJean(Run):

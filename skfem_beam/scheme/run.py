@@ -17,7 +17,7 @@ from .kernels import (EVENT_COLUMNS, EVENTS_FULL, EVENTS_WRITTEN, FAILED, ROW0, 
 from .stepping import Result, Stepping
 
 FIRST_ROWS = 1 << 15      # saved rows allocated at first; more as a chunk needs them
-SAVED = ("obs", "obsv", "energy", "work", "lam")   # the saved series (rows × columns)
+SAVED = ("obs", "obsv", "energy", "work", "lam", "resid")   # the saved series, by row
 
 
 class SavedRows:
@@ -105,6 +105,12 @@ class Run:
         return f"theta={self.theta:g}" if self.theta is not None else f"beta={self.beta:g}"
 
     @property
+    def work_terms(self) -> tuple[str, ...]:
+        """The work terms of the run: WORK_TERMS, and "friction" when it has friction."""
+        from .beta import friction
+        return WORK_TERMS + (("friction",) if friction(self.system) else ())
+
+    @property
     def stopped_at(self) -> int:
         """The step where the compiled loop last stopped (a failed step: the one after)."""
         return int(self.st.counters[STOPPED_AT])
@@ -165,7 +171,8 @@ class Run:
         those so far.  Two planes add ``angle`` (rad, of the node's offset from its hole's
         centre at the first state in contact), ``normal_velocity`` and
         ``tangential_velocity`` (m/s, the node's velocity before it, along the wall's
-        outward normal and counter-clockwise along the wall); NaN in one plane."""
+        outward normal and counter-clockwise along the wall), NaN in one plane; with
+        friction ``slip`` (Σ|u_t|Δt, m) and ``friction_impulse`` (Σ|p_t|), else 0."""
         last = self.n if last is None else int(last)
         done = self._all_events()
         rows = [np.column_stack([done, np.zeros(len(done))])]
@@ -174,7 +181,7 @@ class Run:
             j = np.flatnonzero(open_)
             e = self.st.impact[j]
             end = np.where(e[:, 5] >= 0, e[:, 5], last)
-            rows.append(np.column_stack([j, e[:, 0], end, e[:, 1:5], e[:, 6:9],
+            rows.append(np.column_stack([j, e[:, 0], end, e[:, 1:5], e[:, 6:],
                                          np.ones(j.size)]))
         table = np.concatenate(rows)
         table = table[np.lexsort((table[:, 0], table[:, 1]))]
@@ -184,7 +191,8 @@ class Run:
                 "t_end": table[:, 2] * self.dt, "velocity": table[:, 3],
                 "peak_force": table[:, 4], "impulse": table[:, 5], "max_violation": table[:, 6],
                 "angle": table[:, 7], "normal_velocity": table[:, 8],
-                "tangential_velocity": table[:, 9], "open": table[:, 10].astype(int)}
+                "tangential_velocity": table[:, 9], "slip": table[:, 10],
+                "friction_impulse": table[:, 11], "open": table[:, 12].astype(int)}
 
     @property
     def done(self) -> bool:
@@ -224,7 +232,8 @@ class Run:
         self.wall += time.perf_counter() - t0
         k = self.stopped_at
         if code == FAILED:
-            why = f": {PythonLaw.error}" if PythonLaw.error is not None else ""
+            why = f": {PythonLaw.error}" if PythonLaw.error is not None else \
+                getattr(self.scheme, "failure", str)()
             if PythonLaw.error is not None and not isinstance(PythonLaw.error, SolverError):
                 raise PythonLaw.error     # a bug in a user's law: its own traceback
             raise SolverError(f"the {self.solver} contact solver failed at step {k} "
@@ -249,6 +258,7 @@ class Run:
     energy = property(lambda self: SavedRows(self, "energy"))
     work = property(lambda self: SavedRows(self, "work"))
     lam = property(lambda self: SavedRows(self, "lam"))
+    resid = property(lambda self: SavedRows(self, "resid"))
     fr = property(lambda self: self.out.frames_u)
     frv = property(lambda self: self.out.frames_v)
     frf = property(lambda self: self.out.frames_f)
@@ -322,5 +332,5 @@ class Run:
             max_penetration_below=float(st[1]), max_penetration_above=float(st[2]),
             impacts=int(c[0]), contact_fraction=float(c[1]) / max(1, self.n - 1),
             qp_iterations=int(c[2]),
-            work={k: out.work[:keep, i] for i, k in enumerate(WORK_TERMS)},
+            work={k: out.work[:keep, i] for i, k in enumerate(self.work_terms)},
             impact_events=self.impact_events(), system=self.system)

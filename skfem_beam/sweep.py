@@ -409,8 +409,9 @@ def dask_client(workers: int | None = None, scheduler: str | None = None):
     try:
         from distributed import Client, LocalCluster
     except ImportError:
-        raise InputError("Dask is not installed: pip install 'dask[distributed]', "
-                         "or run without it with --workers 0") from None
+        raise InputError("a sweep on workers or a --scheduler needs Dask, which a run does "
+                         "not: pip install \"skfem_beam[cluster]\", or run without it with "
+                         "--workers 0") from None
     import logging
     if scheduler:
         try:

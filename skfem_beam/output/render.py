@@ -41,7 +41,11 @@ def _pyvista():
     """Import pyvista set up for off-screen rendering (see the module docstring)."""
     if sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
         os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-    import pyvista as pv
+    try:
+        import pyvista as pv
+    except ImportError:
+        raise InputError("rendering needs PyVista and VTK, which a run does not: "
+                         "pip install \"skfem_beam[render]\"") from None
     pv.OFF_SCREEN = True
     return pv
 
@@ -204,7 +208,7 @@ def animate(path, result, fps: float = 20, every: int = 1, scale=None,
         try:
             import imageio_ffmpeg  # noqa: F401
         except ImportError:
-            raise InputError("MP4 needs imageio-ffmpeg (pip install imageio-ffmpeg); "
+            raise InputError("MP4 needs imageio-ffmpeg (pip install \"skfem_beam[video]\"); "
                              "or write a .gif") from None
     frames = list(range(0, result.frames_t.size, int(every)))
     sc = _Scene(result, frames, scale, samples_per_element)

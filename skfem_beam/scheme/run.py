@@ -232,10 +232,10 @@ class Run:
         self.wall += time.perf_counter() - t0
         k = self.stopped_at
         if code == FAILED:
-            why = f": {PythonLaw.error}" if PythonLaw.error is not None else \
-                getattr(self.scheme, "failure", str)()
-            if PythonLaw.error is not None and not isinstance(PythonLaw.error, SolverError):
-                raise PythonLaw.error     # a bug in a user's law: its own traceback
+            error = PythonLaw.error if self.pysolver is not None else None   # this run's
+            why = f": {error}" if error is not None else getattr(self.scheme, "failure", str)()
+            if error is not None and not isinstance(error, SolverError):
+                raise error               # a bug in a user's law: its own traceback
             raise SolverError(f"the {self.solver} contact solver failed at step {k} "
                               f"(t={k * self.dt:.6g} s){why}")
         if code == UNSTABLE:

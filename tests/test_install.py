@@ -1,0 +1,42 @@
+"""What a run needs and what it does not: the base install runs every scene; a sweep on a
+cluster and a render need their extras, and say which in one line."""
+import subprocess
+import sys
+
+import pytest
+
+from skfem_beam.errors import InputError
+
+CHECK = """
+import sys
+from skfem_beam.cases import flat_obstacles, point_stops
+from skfem_beam.scenefile import run_main
+from skfem_beam.cli import main_guard
+for argv, main in ((["--out", sys.argv[1] + "/a", "--format", "both"], flat_obstacles.main),
+                   (["--out", sys.argv[1] + "/b", "--T", "0.05"], point_stops.main)):
+    try:
+        main_guard(lambda: main(argv))
+    except SystemExit as e:
+        assert e.code == 0, e.code
+heavy = sorted(m for m in sys.modules if m.split(".")[0] in ("dask", "distributed", "pyvista",
+                                                            "vtk", "vtkmodules", "imageio"))
+print("extras:", " ".join(heavy))
+"""
+
+
+def test_a_run_imports_no_extra(tmp_path):
+    out = subprocess.run([sys.executable, "-c", CHECK, str(tmp_path)], capture_output=True,
+                         text=True, check=True).stdout.splitlines()[-1]
+    assert out == "extras: "          # neither Dask nor PyVista, VTK or imageio
+
+
+def test_a_missing_extra_is_named_in_one_line(monkeypatch):
+    from skfem_beam.output import render
+    from skfem_beam.sweep import dask_client
+    monkeypatch.setitem(sys.modules, "pyvista", None)        # as if not installed
+    with pytest.raises(InputError, match=r'pip install "skfem_beam\[render\]"'):
+        render._pyvista()
+    monkeypatch.setitem(sys.modules, "distributed", None)
+    with pytest.raises(InputError, match=r'pip install "skfem_beam\[cluster\]"'):
+        with dask_client(scheduler="tcp://127.0.0.1:1"):
+            pass

@@ -74,11 +74,13 @@ class Penalty:
     per unit cross-section; ``equation_units``: the number is already in the units of the
     semi-discrete equation (per unit mass for a beam), as ``solve(stiffness=)`` takes it.
     ``damping``: a dashpot beside each spring (Kelvin–Voigt, N·s/m in the same units as
-    ``stiffness``), the supports' own damping."""
+    ``stiffness``), the supports' own damping; ``implicit``: the whole spring force at
+    t_{n+1} (contact.penalty: the regularisation whose limit is the exact step)."""
     stiffness: float
     equation_units: bool = False
     massless: str = "beta"
     damping: float = 0.0
+    implicit: bool = False
     name: ClassVar[str] = "penalty"
     default_beta: ClassVar[float] = 0.25
     theta: ClassVar[None] = None
@@ -90,7 +92,8 @@ class Penalty:
 
     def law(self, system) -> ContactLaw:
         scale = 1.0 if self.equation_units or system is None else mass_scale(system)
-        return PenaltyLaw(self.stiffness / scale, self.damping / scale)  # the one conversion
+        return PenaltyLaw(self.stiffness / scale, self.damping / scale,  # the one conversion
+                          self.implicit)
 
     def build(self, system, stepping):
         from .scheme import Run     # the quasi-static massless rows refuse springs there

@@ -22,6 +22,14 @@ implicit step is the minimiser of a strictly convex function and Newton solves i
 (`disk_compliance_solve`); a dashpot there is not modelled (refused).
 
 The start step weights the spring at u⁰ by ½(1−2β) instead (see scheme.run).
+
+``implicit=True`` takes the whole spring force at t_{n+1} instead (weights 1, 0, 0): the
+step is then min ½|x − x_free|²_A + ½Δt²κ·dist²(Cx, K), the Moreau–Yosida regularisation
+of the exact step, which it approaches at rate 1/κ as κ → ∞ (at the same Δt and mesh);
+the β-weighted springs do not: their limit keeps the β-weighted forces of uⁿ and uⁿ⁻¹
+and returns the energy an exact (e = 0) contact takes (docs/design.md §1, *Springs →
+exact contact*).  It dissipates where the springs act: a check of the limit, not a
+spring model.
 """
 import numpy as np
 from numba import njit
@@ -124,11 +132,39 @@ def penalty_explicit(y_cur, y_prev, lo, hi, params, r):
 
 
 @njit(cache=True)
+def _springs(y, lo, hi, c, kind, mu_y, Jm):
+    """μ(y) = c·r(y) of every row (radial on the disks of ``kind``) and, if Jm has rows,
+    its Jacobian ∂μ/∂y."""
+    m = y.size
+    for j in range(m):
+        mu_y[j] = 0.0
+    if Jm.shape[0]:
+        Jm[:, :] = 0.0
+    for j in range(m):
+        if kind[j] == 0:
+            if y[j] > hi[j] or y[j] < lo[j]:
+                mu_y[j] = -c * (y[j] - (hi[j] if y[j] > hi[j] else lo[j]))
+                if Jm.shape[0]:
+                    Jm[j, j] = -c
+        elif kind[j] > 0:
+            a, b = j, kind[j]
+            pa, pb, rho, rad = radial(y[a], y[b], lo[a], hi[a], lo[b], hi[b])
+            if rho > rad:
+                f = 1.0 - rad / rho
+                mu_y[a], mu_y[b] = -c * f * pa, -c * f * pb
+                if Jm.shape[0]:
+                    ea, eb, g = pa / rho, pb / rho, rad / rho
+                    Jm[a, a] = -c * (f + g * ea * ea)
+                    Jm[b, b] = -c * (f + g * eb * eb)
+                    Jm[a, b] = Jm[b, a] = -c * g * ea * eb
+
+
+@njit(cache=True)
 def disk_compliance_solve(D, yf, lo, hi, c, kind, mu):
     """y = yf + D μ(y) with μ = c·r(y) (c = Δt²β, r the one-sided springs: radial on the
-    disks of ``kind``, round_hole.cone_solve's), by Newton on
-    G(y) = y − yf − D μ(y); μ is the gradient of a convex energy, so G is the gradient
-    of a strictly convex function and its Newton steps are halved until |G| decreases.
+    disks of ``kind``, round_hole.cone_solve's), by Newton on G(y) = y − yf − D μ(y), the
+    step halved until |G| decreases (μ is the gradient of a concave function, so G = 0
+    has one root; a full step may overshoot the kink where a spring starts).
     Returns iterations (< 0: failed)."""
     m = yf.size
     y = yf.copy()
@@ -136,49 +172,33 @@ def disk_compliance_solve(D, yf, lo, hi, c, kind, mu):
     for j in range(m):
         scale = max(scale, abs(yf[j]), abs(lo[j]) if np.isfinite(lo[j]) else 0.0,
                     abs(hi[j]) if np.isfinite(hi[j]) else 0.0)
+    mu_y, Jm, none = np.zeros(m), np.zeros((m, m)), np.zeros((0, 0))
+    _springs(y, lo, hi, c, kind, mu_y, Jm)
+    G = y - yf - D @ mu_y
+    gn = np.abs(G).max()
     its = 0
     for its in range(1, 200):
-        mu_y = np.zeros(m)
-        Jm = np.zeros((m, m))           # ∂μ/∂y
-        for j in range(m):
-            if kind[j] == 0:
-                if y[j] > hi[j]:
-                    mu_y[j] = -c * (y[j] - hi[j])
-                    Jm[j, j] = -c
-                elif y[j] < lo[j]:
-                    mu_y[j] = -c * (y[j] - lo[j])
-                    Jm[j, j] = -c
-            elif kind[j] > 0:
-                a, b = j, kind[j]
-                pa, pb, rho, rad = radial(y[a], y[b], lo[a], hi[a], lo[b], hi[b])
-                if rho > rad:
-                    f = 1.0 - rad / rho
-                    ea, eb = pa / rho, pb / rho
-                    mu_y[a], mu_y[b] = -c * f * pa, -c * f * pb
-                    g = rad / rho
-                    Jm[a, a] = -c * (f + g * ea * ea)
-                    Jm[b, b] = -c * (f + g * eb * eb)
-                    Jm[a, b] = Jm[b, a] = -c * g * ea * eb
-        G = y - yf - D @ mu_y
-        gn = np.abs(G).max()
         if gn <= 1e-15 * scale:
             break
         dy = np.linalg.solve(np.eye(m) - D @ Jm, G)
-        y = y - dy
-        if np.abs(dy).max() <= 1e-16 * scale:
+        t = 1.0
+        for _ in range(60):
+            trial = y - t * dy
+            _springs(trial, lo, hi, c, kind, mu_y, none)
+            Gt = trial - yf - D @ mu_y
+            if np.abs(Gt).max() < gn or t < 1e-12:
+                break
+            t *= 0.5
+        if np.abs(trial - y).max() <= 1e-16 * scale:
+            y = trial
             break
+        y = trial
+        _springs(y, lo, hi, c, kind, mu_y, Jm)
+        G = y - yf - D @ mu_y
+        gn = np.abs(G).max()
     else:
         return -1
-    for j in range(m):
-        mu[j] = 0.0
-        if kind[j] == 0:
-            mu[j] = -c * (max(y[j] - hi[j], 0.0) - max(lo[j] - y[j], 0.0))
-        elif kind[j] > 0:
-            a, b = j, kind[j]
-            pa, pb, rho, rad = radial(y[a], y[b], lo[a], hi[a], lo[b], hi[b])
-            if rho > rad:
-                mu[a] = -c * (1.0 - rad / rho) * pa
-                mu[b] = -c * (1.0 - rad / rho) * pb
+    _springs(y, lo, hi, c, kind, mu, none)
     return its
 
 
@@ -213,13 +233,16 @@ class Penalty(ContactLaw):
     explicit = penalty_explicit
     round_holes = True
 
-    def __init__(self, stiffness: float, damping: float = 0.0):
+    def __init__(self, stiffness: float, damping: float = 0.0, implicit: bool = False):
         self.stiffness = check_positive("stiffness", stiffness)
         self.damping = check_nonnegative("damping", damping)
+        self.implicit = bool(implicit)
 
     def setup(self, step, first=False):
         beta, k = step.beta, self.stiffness
         w_cur, w_prev = (0.5 * (1 - 2 * beta), 0.0) if first else (1 - 2 * beta, beta)
+        if self.implicit:           # the whole force at t_{n+1} (module docstring)
+            beta, w_cur, w_prev = 1.0, 0.0, 0.0
         params = np.array([k, step.dt ** 2 * beta * k, w_cur, w_prev,
                            0.5 * step.dt * self.damping])
         if not step.disks.size:

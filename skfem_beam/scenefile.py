@@ -10,7 +10,7 @@
 output options).  Every value is checked by the object it builds; this module checks only
 the file's shape: an unknown section or key is refused in one line naming it and the
 allowed ones.  Relative paths (tables) are relative to the scene file.  The keys are
-:data:`BEAM_KEYS` and :data:`BAR_KEYS` (README, *Scene files*).
+:data:`BEAM_KEYS` and :data:`BAR_KEYS` (docs/scene_files.md, generated from them).
 
 Choices a TOML file forces:
 
@@ -790,7 +790,7 @@ def _bar(data: dict, reader: _Reader) -> Bar:
 def _run_parser() -> argparse.ArgumentParser:
     from .cli import Parser
     p = Parser(prog="python -m skfem_beam run",
-               description="Run the scene a TOML file describes (README, Scene files).")
+               description="Run the scene a TOML file describes (docs/scene_files.md).")
     p.add_argument("scene", nargs="?", default=None, help="the scene file (TOML)")
     p.add_argument("--set", action="append", default=None, metavar="KEY=VALUE",
                    help="override a key of the file, e.g. time.dt=1e-5 (repeatable)")

@@ -183,7 +183,7 @@ def test_periodic_rod_scene_inputs():
         scenes.periodic_rod(gap=-0.1)
 
 
-# --- every class on the rod: the README's headline (docs/rod_study.csv, N = 80) --------
+# --- every class on the rod: the headline of docs/methods.md (docs/rod_study.csv, N = 80) --------
 
 def setting(label):
     from skfem_beam.bench.rod_study import SETTINGS
@@ -192,7 +192,7 @@ def setting(label):
 
 @pytest.fixture(scope="module")
 def classes80():
-    """The rows of `rod_study --classes` that the README's claims rest on (N = 80, T = 12)."""
+    """The rows of `rod_study --classes` that docs/methods.md's claims rest on (N = 80, T = 12)."""
     from skfem_beam.bench.work_precision import rung
     picks = {("position, average, β=1/4, e=0", 0.04), ("position, average, β=1/4, e=0", 0.4),
              ("position, consistent, β=1/2, e=0", 0.4), ("position, average, β=1/2, e=1", 0.04),

@@ -21,7 +21,7 @@ SWEEP = [sys.executable, "-m", "skfem_beam.sweep"]
 # short runs: 3 forcing periods after 0.2 s, the paper's Δt
 SHORT = dict(transient=0.2, periods=3)
 OUTPUTS = ("poincare.csv", "runs.csv", "bifurcation.png")
-# the README's damped bifurcation diagram: ζ = 2 %, 60 s transient, 50 periods
+# the damped bifurcation diagram of docs/methods.md: ζ = 2 %, 60 s transient, 50 periods
 DAMPED_RUNS = Path(__file__).parents[1] / "docs" / "bifurcation_point_stops_damped_runs.csv"
 DAMPED = dict(transient=60.0, periods=50, zeta=0.02)
 

@@ -1,0 +1,155 @@
+"""What every key of a scene file means: the text of the reference the documentation
+generates (docs/scene_files.md includes :func:`reference`), one entry per section of
+:data:`skfem_beam.scenefile.BEAM_KEYS` and :data:`~skfem_beam.scenefile.BAR_KEYS`.
+
+The keys themselves are read from those tables, so a key added to the code appears in the
+docs; tests/test_docs.py fails when a key is not named in its section's text here.
+"""
+from __future__ import annotations
+
+SECTION_DOCS = {
+    '(top level)': (
+        '`kind = "beam"` (default) or `"bar"`; `planes = 2`: a beam bending in two planes, v '
+        'along y and w along z (below)'
+    ),
+    'material': (
+        '`E`, `rho`'
+    ),
+    'section': (
+        '`I`, `A`, or `I_y`, `I_z`, `A` (v along y bends with I_z, w along z with I_y), or '
+        '`tube = {outer_diameter, wall}`, `rod = {diameter}`, `rect = {b, h}` (h along y; '
+        'bar: optional, then forces in N)'
+    ),
+    'mass_normalised': (
+        "`k2` (EI/ρA, m⁴/s²), `rho_S` (kg/m): the papers' form, instead of material and "
+        'section'
+    ),
+    'mass': (
+        '`added` (kg/m): mass carried along the whole beam, e.g. the fluid inside and around '
+        'a tube (its hydrodynamic mass); ρA + added is the inertia, and converts forces to N'
+    ),
+    'geometry': (
+        '`L` (m)'
+    ),
+    'ends': (
+        '`left`, `right`: `clamped` \\| `pinned` \\| `sliding` \\| `free` (default clamped–free;'
+        ' bar: the far end free or clamped)'
+    ),
+    'supports': (
+        '`x`: a rigid pinned support'
+    ),
+    'motion': (
+        '`end = "left"\\|"right"` or `at = x` (a support); `amplitude`, `omega` (φ = A sin ωt)'
+        ' or `sines = [[A, ω, phase], ...]`, `table = "phi.csv"` (t, φ rows), `random = {rms,'
+        ' f_low, f_high, seed, count}` (band-limited, `count` sines), `psd = { table, seed, df }`, `value` '
+        '(constant), as for loads; `phase` with `amplitude`, `omega`; `lifting`; two planes: '
+        '`direction = [dy, dz]`'
+    ),
+    'obstacles': (
+        '`x` (point stops) or `x_from`, `x_to` (a span) or neither (the whole beam); `g1`, '
+        '`g2`: numbers, `{ poly = [c0, c1, ...], about = x0 }` (Σ c_k (x − x0)^k) or `{ x = '
+        '[...], g = [...] }` (linear between points); `carried = true` moves with the '
+        'support; `stiffness` (N/m) and `damping` (N·s/m, optional), the same on every '
+        "obstacle: elastic supports, the penalty law's springs with Kelvin–Voigt dashpots. "
+        'Two planes: g1, g2 bound v; `hole = {...}` at `x` or over `x_from`, `x_to` bounds '
+        '(v, w): `{ radius = r }` (drilled, `centre = [cy, cz]` optional), `{ sides = n, '
+        'radius = r, angle = a }` (a regular polygon, r to its faces: a trefoil is 3), `{ '
+        'polygon = [[y, z], ...] }` (convex, counter-clockwise), `{ faces = [[ny, nz, gap], '
+        '...] }` (flat bars: n·(v, w) ≤ gap). Bar: one, `x = 0` or `L`, `stiffness` for an '
+        'elastic obstacle `friction` (μ at this hole, overriding `[contact] friction`).'
+    ),
+    'damping': (
+        '`zeta`, `f1`, `f2` (Hz) or `alpha`, `alpha_K` (Rayleigh), or `modal = ζ` (every mode'
+        ' at ζ: a dense damping matrix); ζ is a ratio below 1 (0.02 for 2 %); bar: '
+        '`viscosity` (Kelvin–Voigt b)'
+    ),
+    'loads': (
+        '`x` (a point force, N) or `distributed = true` (N/m) or `per_mass = true` (m/s², the'
+        " papers' f̃) or `gravity = 9.81`; the time: `amplitude`/`omega`, `value`, `sines`, "
+        '`table = "f.csv"`, `random = {rms, f_low, f_high, seed, count}`, `psd = "S.csv"` or '
+        '`psd = { table = "S.csv", seed = 1, df = 0.1 }` (a one-sided PSD, columns f in Hz '
+        'and S in N²/m²/Hz for a distributed force, synthesised with the seed: '
+        '`timefunctions.from_psd`); a distributed load over part of the beam: `x_from`, '
+        '`x_to` (exact when they are nodes); two planes: `direction = [dy, dz]` (default the '
+        'first plane), or `rotating = {amplitude, omega, phase}` instead of a time function '
+        '(amplitude·cos(ωt + phase) along y, ·sin along z). Bar: `value` (a body force, N/m³)'
+    ),
+    'initial': (
+        "(two planes: the first plane's; w starts at rest) `mode = k`, `amplitude` (u0 = "
+        'amplitude × the k-th mode shape, its largest \\|u\\| 1) or `u0 = {x = [...], u = '
+        '[...]}` (cubic spline; bar: linear, or a number), `v0 = {x, v}`; beams read them in '
+        'the fixed frame (ũ, ũ_t) unless `fixed_frame = false`: no `[initial]` is at rest'
+    ),
+    'mesh': (
+        '`J`, `element = "hermite"\\|"bspline"`, `nodes = [...]` (non-uniform), `mass = '
+        '"consistent"\\|"redistributed"`; bar: `J` (P1 elements), `mass = '
+        '"average"\\|"consistent"\\|"lumped"\\|"redistributed"`; both: `massless = '
+        '"beta"\\|"quasi-static"` (only with `mass = "redistributed"`, as `--massless`)'
+    ),
+    'time': (
+        '`dt`, `T` (required), `beta` (default 1/2; 1/4 for a bar or penalty), `load_window` '
+        '(`"forward"`, the papers\': fⁿ averages f over [tₙ, tₙ + Δt]; `"centered"`: over [tₙ '
+        '− Δt/2, tₙ + Δt/2], second order)'
+    ),
+    'contact': (
+        "`law`: `position` (default, the papers' scheme; or one of its solvers `auto`, "
+        '`projection`, `active-set`, `osqp`, `daqp`, `round-hole`), `moreau-jean`, `penalty` '
+        '(as `--law`); round holes take `auto` (the exact round-hole law) or `penalty` '
+        '(radial springs); `stiffness` (N/m, the penalty spring), `restitution` (e in [0, 1],'
+        " position and moreau-jean) `friction` (Coulomb's μ at the holes' walls, two planes: "
+        'runs Moreau–Jean)'
+    ),
+    'output': (
+        '`format`, `save_every`, `frames`, `flush_every`, `checkpoint_every`, `probes` (x in '
+        'm, e.g. `[0.5, 0.75]`: probe columns as `--probe`, which `run` also takes)'
+    ),
+    'segments': (
+        'a stepped beam instead of `[geometry]`: one `[[segments]]` per part, left to right, '
+        'with `length`, `material = {E, rho}`, `section = {...}` (as `[section]`)'
+    ),
+    'wear': (
+        "Archard's law at the holes (two planes): `coefficient` K (m³/(N·m)), "
+        "`service_years`, `land` (the support's axial width b, m), `radius` (the tube's outer"
+        " radius, m; default from a tube or rod `[section]`); summary.json's supports get the"
+        ' wear volume rate, volume, depth spread evenly and per 30° sector'
+    ),
+}
+
+
+def _keys(schema, prefix: str = "") -> list[str]:
+    """The section's keys, nested tables as table.key."""
+    out = []
+    for key, sub in schema.items():
+        out.append(prefix + key)
+        sub = sub[0] if isinstance(sub, list) else sub
+        if isinstance(sub, dict):
+            out += _keys(sub, prefix + key + ".")
+    return out
+
+
+def sections() -> dict[str, dict[str, list[str]]]:
+    """section → {"beam": keys, "bar": keys} ("(top level)": the scalar keys)."""
+    from .scenefile import BAR_KEYS, BEAM_KEYS
+    out: dict[str, dict[str, list[str]]] = {}
+    for kind, schema in (("beam", BEAM_KEYS), ("bar", BAR_KEYS)):
+        for key, sub in schema.items():
+            inner = sub[0] if isinstance(sub, list) else sub
+            if isinstance(inner, dict) and not type(inner).__name__ in ("Either", "NumberOr"):
+                out.setdefault(key, {})[kind] = _keys(inner)
+            else:
+                out.setdefault("(top level)", {}).setdefault(kind, []).append(key)
+    return out
+
+
+def reference() -> str:
+    """The scene-file reference as a Markdown table: section, its keys (from the code),
+    what they mean."""
+    from .scenefile import BAR_KEYS, BEAM_KEYS
+    rows = ["| section | keys (from the code) | what they mean (SI units) |", "|---|---|---|"]
+    for name, kinds in sections().items():
+        array = isinstance(BEAM_KEYS.get(name, BAR_KEYS.get(name)), list)
+        label = name if name == "(top level)" else (f"`[[{name}]]`" if array else f"`[{name}]`")
+        keys = "; ".join(f"{kind}: " + ", ".join(f"`{k}`" for k in ks)
+                         for kind, ks in kinds.items())
+        rows.append(f"| {label} | {keys} | {SECTION_DOCS[name]} |")
+    return "\n".join(rows) + "\n"

@@ -35,3 +35,20 @@ def assert_refused(main, argv, word, capsys, folder) -> None:
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and word in err, err
     assert not list(folder.iterdir())
+
+
+def resumed(make, cut: int):
+    """(a run driven to its end, the same run restored from a checkpoint at state ``cut``
+    and driven to its end); ``make()`` builds a fresh run.  Asserts that the restored one
+    went on bit for bit: the same last state and impact events."""
+    import numpy as np
+    from skfem_beam.scheme.solve import drive
+    a, b, c = make(), make(), make()
+    drive(a)
+    b.advance(cut)
+    c.restore(b.checkpoint())
+    drive(c)
+    assert np.array_equal(a.u_cur, c.u_cur) and np.array_equal(a.u_prev, c.u_prev)
+    ea, ec = a.impact_events(), c.impact_events()
+    assert all(np.array_equal(ea[k], ec[k], equal_nan=True) for k in ea)
+    return a, c

@@ -8,7 +8,7 @@ import json
 import numpy as np
 import pytest
 
-from conftest import assert_refused, exit_code
+from conftest import assert_refused, exit_code, resumed
 from skfem_beam import methods
 from skfem_beam.contact.round_hole import cone_solve, disk_kinds, disk_root
 from skfem_beam.holes import Hole, HoleAt
@@ -17,7 +17,6 @@ from skfem_beam.problem import (Beam, BeamProblem, Damping, Load, Material, Obst
 from skfem_beam.reference import whirl_force
 from skfem_beam.scenefile import example, run_main
 from skfem_beam.scheme import Run, Stepping, solve
-from skfem_beam.scheme.solve import drive
 from skfem_beam.semidiscrete import beam_system
 from skfem_beam.timefunctions import Sine
 
@@ -310,18 +309,8 @@ def test_bad_two_plane_scenes_are_refused_in_one_line(tmp_path, capsys, extra, w
 def test_a_restored_two_plane_run_goes_on_bit_for_bit():
     from skfem_beam.scenefile import load
     system = beam_system(load(example("tube_round_holes")).problem)
-    stepping = Stepping(1e-4, 0.3)
-    a = Run(system, stepping)
-    drive(a)
-    b = Run(system, stepping)
-    b.advance(1234)
-    c = Run(system, stepping)
-    c.restore(b.checkpoint())
-    drive(c)
-    assert np.array_equal(a.u_cur, c.u_cur) and np.array_equal(a.st.rowwork, c.st.rowwork)
-    ea, ec = a.impact_events(), c.impact_events()
-    assert len(ea["t_start"]) > 20
-    assert all(np.array_equal(ea[k], ec[k], equal_nan=True) for k in ea)
+    a, c = resumed(lambda: Run(system, Stepping(1e-4, 0.3)), 1234)
+    assert np.array_equal(a.st.rowwork, c.st.rowwork) and a.result().impacts > 20
 
 
 def test_modes_of_two_planes_list_each_planes_own(tmp_path, capsys):

@@ -361,3 +361,21 @@ def test_a_carried_round_hole_moves_with_its_support_and_is_never_penetrated():
     fixed = solve(beam_system(BeamProblem(TUBE, J=10, planes=2, support=scene.support,
                                           holes=(HoleAt(Hole.round(R), 1.5),))), 1e-4, 0.3)
     assert fixed.impacts != r.impacts
+
+
+def test_the_linear_laws_take_a_polygons_faces():
+    """Trefoil holes (three faces a node: rows that depend on one another): OSQP gives the
+    active set's run, springs and Moreau–Jean run, daqp (which inverts D) refuses."""
+    from skfem_beam.errors import InputError
+    from skfem_beam.scenefile import load
+    system = beam_system(load(example("tube_trefoil_holes")).problem)
+    ref = solve(system, 1e-4, 0.2)
+    osqp = solve(system, 1e-4, 0.2, solver="osqp")
+    assert ref.solver == "active-set" and osqp.impacts == ref.impacts > 20
+    k = int(round(ref.impact_events["t_start"][2] / 1e-4))     # before the second impact
+    assert np.abs(orbit(osqp, 0.5)[:k] - orbit(ref, 0.5)[:k]).max() <= 1e-12 * R
+    for method in (methods.Penalty(1e7), methods.MoreauJean()):
+        r = solve(system, 1e-4, 0.2, method=method)
+        assert r.success and r.impacts > 20
+    with pytest.raises(InputError, match="independent constraint rows"):
+        solve(system, 1e-4, 0.2, solver="daqp")

@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg
 
-from ..errors import SolverError
+from ..errors import InputError, SolverError
 from .active_set import bound_scale, exact_finish
 from .base import ContactLaw
 
@@ -82,6 +82,16 @@ class DAQPSolver:
 class DAQP(ContactLaw):
     """daqp's exact dual active set, called from Python each step."""
     name = "daqp"
+
+    def setup(self, step, first=False):
+        # the reduced problem inverts D: rows that depend on one another (a polygon's
+        # faces on a node's two values, two planes) leave it singular
+        D = step.D
+        if D.size and np.linalg.cond(D) > 1e12:
+            raise InputError("solver='daqp' needs independent constraint rows; this scene "
+                             "has more faces at a node than the node has values (a polygon "
+                             "hole): use active-set or osqp")
+        return super().setup(step, first)
 
     def solver(self, step):
         return DAQPSolver(step.lo, step.hi, step.D)

@@ -9,10 +9,10 @@ length, m³/s³), over the run's time T:
 - ``impact_work_rate``: −(1/T)·Σ ½λ·(y^{n+1} − y^{n−1}), the support's share of the
   scheme's contact work (the energy lost at its impacts per second; ≥ 0 for exact
   contact, whose contact work is ≤ 0);
-- ``normal_work_rate``: (1/T)∫|F_n||v_t| dt, |F_n| the contact force, v_t the node's
-  velocity along the wall ((y^{n+1} − y^{n−1})/(2Δt), its component along the tangent
-  of the face, or of the circle at the node); the wear work rate of Archard's law per
-  unit wear coefficient;
+- ``normal_work_rate``: (1/T)∫|F_n||v_t| dt, |F_n| the contact force's normal part, v_t
+  the node's velocity along the wall ((y^{n+1} − y^{n−1})/(2Δt), its component along the
+  tangent of the face, or of the circle at the node); the wear work rate of Archard's law
+  per unit wear coefficient;
 - ``friction_work_rate`` (with friction): −(1/T) × the support's share of the friction
   work (the energy its friction takes per second, ≥ 0).
 
@@ -33,6 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..checks import check_positive
+from ..scheme.kernels import SECTORS
 
 YEAR = 365.25 * 86400.0     # s
 
@@ -57,7 +58,7 @@ class Wear:
         sector over the run's time T (J)."""
         life = self.service_years * YEAR
         rate = self.coefficient * normal_work_rate
-        arc = 2 * math.pi / SECTORS_PER_TURN
+        arc = 2 * math.pi / SECTORS
         volumes = self.coefficient * np.asarray(sectors) / T * life
         return {"volume_rate": rate, "volume": rate * life,
                 "depth_uniform": rate * life / (2 * math.pi * self.radius * self.land),
@@ -69,7 +70,6 @@ class Wear:
 from .charts import _frame, figure
 
 ANGLE_BINS = 12      # the impact-angle histogram: 30° bins from −180° to 180°
-SECTORS_PER_TURN = 12   # the wear sectors (kernels.SECTORS)
 
 
 def row_planes(pair, Nc) -> np.ndarray:

@@ -326,7 +326,7 @@ def write_event(events, counters, j, e):
     e[0] = -1.0
 
 
-@internal
+@njit(cache=True, inline="always")
 def node_position(ops, st, j, out):
     """out ← the value j's node (v, w) at uⁿ⁺¹ (st.u_cur) minus its hole's centre now."""
     for c in range(2):
@@ -338,7 +338,7 @@ def node_position(ops, st, j, out):
     out[3] = out[1] - (ops.Nc[j, 1] + ops.Nc[j, 3] * st.stats[3])
 
 
-@internal
+@njit(cache=True, inline="always")
 def normal_of(ops, j, px, py):
     """The unit normal of the value j's wall at the offset (px, py) from the centre."""
     nx, ny = ops.Nc[j, 4], ops.Nc[j, 5]

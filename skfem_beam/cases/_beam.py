@@ -10,7 +10,7 @@ from .. import cli
 from ..scheme.kernels import CONTACT_STEPS
 from ..output.charts import energy_chart, shape_chart, trajectory_chart
 from ..output.events import beam_impacts
-from ..output.fields import physical_tip
+from ..output.fields import physical_at, physical_tip
 from ..output.probes import probe_columns, probe_units
 from ..output.series import Series, execute, prepare
 from ..methods import Penalty
@@ -134,7 +134,7 @@ def two_plane_columns(view, rho_S):
                 x = float(name.split("_")[1])
                 share = view.direction[name.endswith("_w")]
                 cols[name] = physical_at(view, x, t, run.obs[k0:k1, names.index(name)],
-                                         share)
+                                         share=share)[0]
         cols["energy"] = run.energy[k0:k1]
         if "friction" in run.work_terms:     # the friction's Gauss–Seidel at each saved step
             cols["friction_residual"] = run.resid[k0:k1]
@@ -166,15 +166,6 @@ def two_plane_units(rho_S) -> dict:
                                      "step (largest impulse change of its last sweep, "
                                      "relative; 0 with one contact: exact)"})
     return out
-
-
-def physical_at(view, x: float, t, u, share: float):
-    """ũ(x, t) = u + share·h(x)φ(t) (the support's motion along its direction)."""
-    lift = view.lift
-    h = 0.0 if lift is None else float(lift.h(np.array([x]))[0])
-    if abs(h) <= 1e-9 or share == 0.0:
-        return u
-    return np.asarray(u) + share * h * np.asarray(lift.motion.phi(np.asarray(t)), dtype=float)
 
 
 def beam_charts(case, problem, rho_S, stops, extra, observed_x=None):

@@ -143,20 +143,18 @@ def _springs(y, lo, hi, c, kind, mu_y, Jm):
     for j in range(m):
         if kind[j] == 0:
             if y[j] > hi[j] or y[j] < lo[j]:
-                mu_y[j] = -c * (y[j] - (hi[j] if y[j] > hi[j] else lo[j]))
+                mu_y[j] = spring(y[j], lo[j], hi[j], c)
                 if Jm.shape[0]:
                     Jm[j, j] = -c
         elif kind[j] > 0:
             a, b = j, kind[j]
+            mu_y[a], mu_y[b] = disk_spring(y[a], y[b], lo[a], hi[a], lo[b], hi[b], c)
             pa, pb, rho, rad = radial(y[a], y[b], lo[a], hi[a], lo[b], hi[b])
-            if rho > rad:
-                f = 1.0 - rad / rho
-                mu_y[a], mu_y[b] = -c * f * pa, -c * f * pb
-                if Jm.shape[0]:
-                    ea, eb, g = pa / rho, pb / rho, rad / rho
-                    Jm[a, a] = -c * (f + g * ea * ea)
-                    Jm[b, b] = -c * (f + g * eb * eb)
-                    Jm[a, b] = Jm[b, a] = -c * g * ea * eb
+            if rho > rad and Jm.shape[0]:
+                f, ea, eb, g = 1.0 - rad / rho, pa / rho, pb / rho, rad / rho
+                Jm[a, a] = -c * (f + g * ea * ea)
+                Jm[b, b] = -c * (f + g * eb * eb)
+                Jm[a, b] = Jm[b, a] = -c * g * ea * eb
 
 
 @njit(cache=True)

@@ -52,22 +52,27 @@ from ..semidiscrete import SceneView
 FORMATS = ("xdmf", "vtu", "both", "none")
 
 
-def physical_tip(view, t, u_tip, v_tip, share: float = 1.0):
-    """(ũ(X, t), ũ_t(X, t)) from the lifted observed values u(X), v(X) at times t, X the
-    tip L (or ``view.observed_x`` where the end at L is held): u + h(X)φ(t) and
-    v + h(X)φ'(t) for any lifting (``view.lift``).  h(X) within 1e-9 of 0 is 0 (the
+def physical_at(view, x: float, t, u, v=None, share: float = 1.0):
+    """(ũ(x, t), ũ_t(x, t)) from the lifted values u(x), v(x) at times t: u + h(x)φ(t) and
+    v + h(x)φ'(t) for any lifting (``view.lift``); ``share``: the plane's part of the
+    support's direction (two planes); v None: (ũ, None).  h(x) within 1e-9 of 0 is 0 (the
     paper's h(L) is −5.6e-17 in floating point), and then u, v are returned as they are:
-    the papers' columns stay bit for bit.  ``share``: the plane's part of the support's
-    direction (two planes)."""
+    the papers' columns stay bit for bit."""
     lift = None if view is None else view.lift
-    X = view.L if view is None or view.observed_x is None else view.observed_x
-    hL = 0.0 if lift is None else float(lift.h(np.array([X]))[0])
-    if abs(hL) <= 1e-9 or share == 0.0:
-        return u_tip, v_tip
-    hL *= share
+    h = 0.0 if lift is None else float(lift.h(np.array([x]))[0])
+    if abs(h) <= 1e-9 or share == 0.0:
+        return u, v
+    h *= share
     t = np.asarray(t, dtype=float)
-    return (np.asarray(u_tip) + hL * np.asarray(lift.motion.phi(t), dtype=float),
-            np.asarray(v_tip) + hL * np.asarray(lift.motion.phi_d(t), dtype=float))
+    return (np.asarray(u) + h * np.asarray(lift.motion.phi(t), dtype=float),
+            None if v is None else np.asarray(v) + h * np.asarray(lift.motion.phi_d(t),
+                                                                    dtype=float))
+
+
+def physical_tip(view, t, u_tip, v_tip, share: float = 1.0):
+    """:func:`physical_at` the tip L, or ``view.observed_x`` where the end at L is held."""
+    X = view.L if view.observed_x is None else view.observed_x
+    return physical_at(view, X, t, u_tip, v_tip, share)
 
 
 @dataclass

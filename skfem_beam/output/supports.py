@@ -34,6 +34,7 @@ import numpy as np
 
 from ..checks import check_positive
 from ..scheme.kernels import SECTORS
+from .charts import _frame, figure
 
 YEAR = 365.25 * 86400.0     # s
 
@@ -67,9 +68,8 @@ class Wear:
                                                                       * self.land))}
                             for k, v in enumerate(volumes)]}
 
-from .charts import _frame, figure
 
-ANGLE_BINS = 12      # the impact-angle histogram: 30° bins from −180° to 180°
+ANGLE_BINS = SECTORS   # the impact-angle histogram: the wear's 30° sectors, −180° to 180°
 
 
 def row_planes(pair, Nc) -> np.ndarray:

@@ -14,6 +14,7 @@ from numba.core import event
 from ..contact import ContactLaw, StepData, resolve
 from ..contact.base import NoContact, no_explicit
 from ..contact.registry import Auto
+from ..contact.round_hole import disk_kinds
 from ..errors import InputError, SolverError
 from ..linalg import band_solve, rows_matvec
 from .kernels import (EVENT_COLUMNS, IMPACT_FIELDS, SECTORS, Inputs, Ops, PythonLaw, Series,
@@ -51,10 +52,16 @@ def observers(system) -> scipy.sparse.csr_matrix:
     return scipy.sparse.csr_matrix((0, system.n))
 
 
+def friction_of(system) -> np.ndarray:
+    """Coulomb's μ per constrained row (a round hole's first row; 0 elsewhere)."""
+    mu = getattr(system, "friction", None)
+    return np.zeros(system.C.shape[0]) if mu is None else \
+        np.ascontiguousarray(mu, dtype=float)
+
+
 def friction(system) -> bool:
     """Whether some contact of the system has Coulomb friction (μ > 0)."""
-    mu = getattr(system, "friction", None)
-    return mu is not None and bool(np.any(np.asarray(mu) > 0))
+    return bool(np.any(friction_of(system) > 0))
 
 
 def disk_rows(system) -> np.ndarray:
@@ -69,10 +76,8 @@ def hole_arrays(system):
     row pairs and first rows and, in two planes, each row's node and hole (one plane:
     empty)."""
     m = system.C.shape[0]
-    pair = np.zeros(m, np.int64)
     disks = disk_rows(system)
-    for a, b in disks:
-        pair[a], pair[b] = b, -1
+    pair = disk_kinds(m, disks)
     first = np.ascontiguousarray(disks[:, 0])
     if getattr(system, "row_nodes", None) is None or not m:
         return (pair, first, np.zeros(1, np.int64), np.zeros(0, np.int64), np.zeros(0),
@@ -89,24 +94,23 @@ def hole_arrays(system):
     return (pair, first, *csr_arrays(system.row_nodes), np.ascontiguousarray(Nc))
 
 
-def two_plane_state(ops, friction: bool = False) -> dict:
+def two_plane_state(ops, nsgs: bool = False) -> dict:
     """State's pos, rowwork, sectors (rows × 4, 3, SECTORS in two planes; none in one),
-    hk, and fc (rows × 6 with friction, else none)."""
+    hk, and fc (rows × 6 for Moreau–Jean's round holes, ``nsgs``: contact.friction.nsgs
+    keeps each contact's impulses, velocities and normal there; else none)."""
     m = ops.Nc.shape[0]
     return {"pos": np.zeros((m, 4)), "rowwork": np.zeros((m, 3)),
             "sectors": np.zeros((m, SECTORS)), "hk": np.zeros(4),
-            "fc": np.zeros((ops.pair.size if friction else 0, 6))}
+            "fc": np.zeros((ops.pair.size if nsgs else 0, 6))}
 
 
 def start_positions(ops, st, u0, u1) -> None:
     """State.pos of states 0 and 1 (two planes): each row's node (v, w) in u⁰ and u¹."""
-    if not ops.Nc.shape[0]:
-        return
-    for k, u in ((0, u0), (2, u1)):
-        for j in range(ops.Nc.shape[0]):
-            for c in range(2):
-                r = 2 * j + c
-                st.pos[j, k + c] = ops.Nx[ops.Np[r]:ops.Np[r + 1]] @ u[ops.Ni[ops.Np[r]:ops.Np[r + 1]]]
+    m = ops.Nc.shape[0]
+    if m:
+        nodes = scipy.sparse.csr_matrix((ops.Nx, ops.Ni, ops.Np), shape=(2 * m, u0.size))
+        st.pos[:, :2] = (nodes @ u0).reshape(m, 2)
+        st.pos[:, 2:] = (nodes @ u1).reshape(m, 2)
 
 
 def penetration_samples(system):

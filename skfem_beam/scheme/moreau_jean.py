@@ -47,8 +47,8 @@ from ..contact.base import ContactLaw
 from ..contact.restitution import Restitution
 from ..errors import Deferred, InputError
 from ..linalg import Banded, band_solve, rows_dot, rows_matvec
-from .beta import (disk_rows, hole_arrays, observers, penetration_samples, start_positions,
-                   two_plane_state)
+from .beta import (disk_rows, friction_of, hole_arrays, observers, penetration_samples,
+                   start_positions, two_plane_state)
 from ..contact.friction import MAX_SWEEPS, nsgs
 from .kernels import (EVENT_COLUMNS, FAILED, FRICTION, IMPACT_FIELDS, ITERATIONS, ROW0,
                       STOPPED_AT, UNSTABLE, Inputs, Series, csr_product, track_impacts)
@@ -214,10 +214,11 @@ def mj_steps(ops, st, out, n0, n1, inputs, Ebound):
         for j in range(m):
             st.dy[j] += st.y_cur[j]
             st.work[2] += st.p[j] * (st.y_cur[j] - st.y_prev[j]) / dt
-            if st.rowwork.shape[0]:
-                st.rowwork[j, 0] += st.p[j] * (st.y_cur[j] - st.y_prev[j]) / dt
             st.mu[j] = st.p[j] * dt
             st.active[j] = st.p[j] != 0.0
+        if st.rowwork.shape[0]:          # two planes: each row's share
+            for j in range(m):
+                st.rowwork[j, 0] += st.p[j] * (st.y_cur[j] - st.y_prev[j]) / dt
         for a in ops.disks:              # a round hole's friction part of its work
             b = ops.pair[a]
             st.active[b] = False
@@ -243,13 +244,6 @@ def mj_steps(ops, st, out, n0, n1, inputs, Ebound):
 
 
 NSGS_TOL = 1e-12     # friction's Gauss–Seidel: a sweep's largest change, relative
-
-
-def friction_of(system) -> np.ndarray:
-    """μ per constrained row (a round hole's first row; 0 elsewhere)."""
-    mu = getattr(system, "friction", None)
-    return np.zeros(system.C.shape[0]) if mu is None else \
-        np.ascontiguousarray(mu, dtype=float)
 
 
 def check_theta(theta) -> float:

@@ -156,9 +156,6 @@ def _is_table(value) -> bool:
     return isinstance(value, (list, tuple, np.ndarray)) and not isinstance(value, (str, bytes))
 
 
-HOLE_FORMS = ("radius", "sides", "polygon", "faces")
-
-
 def hole_from_table(d: dict, where: str) -> Hole:
     """A hole from a scene file's ``hole = { ... }``: ``radius`` alone (round; with
     ``sides`` a regular polygon, ``angle`` its first face's normal), ``polygon``, or

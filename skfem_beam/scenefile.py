@@ -633,8 +633,8 @@ def _loads(data: dict, reader: _Reader) -> tuple[Load, Load]:
             continue
         if "gravity" in d:
             if len(d) > 1:
-                raise InputError(f"[{where}] gravity = g stands alone (got {', '.join(d)}; "
-                                 "and direction)")
+                raise InputError(f"[{where}] gravity = g stands alone, with a direction in "
+                                 f"two planes (got {', '.join(d)})")
             part = Load.gravity(d["gravity"])
         else:
             time = _time_function(d, where, reader)

@@ -40,8 +40,9 @@ REPAIR_TOL = 1e-6
 internal = njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 
 
-@internal
-def _scale(yf, lo, hi):
+@njit(cache=True)      # also called from Python (the round-hole law's start step)
+def data_scale(yf, lo, hi):
+    """The data's scale: the largest |y_free| and finite |bound| (1 if all are 0)."""
     s = 0.0
     for i in range(yf.size):
         s = max(s, abs(yf[i]))
@@ -141,7 +142,7 @@ def _values(D, W, k, yf, mu, y):
 @internal
 def _gi(D, yf, lo, hi, state, mu, maxit):
     m = yf.size
-    tol = REL_TOL * _scale(yf, lo, hi)
+    tol = REL_TOL * data_scale(yf, lo, hi)
     k0 = 0
     for i in range(m):
         k0 += state[i] != 0

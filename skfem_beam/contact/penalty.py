@@ -36,6 +36,7 @@ from numba import njit
 
 from ..checks import check_nonnegative, check_positive
 from ..errors import InputError
+from .active_set import data_scale
 from .base import ContactLaw, compiled_explicit, compiled_law
 from .round_hole import disk_params, kinds_of
 
@@ -166,10 +167,7 @@ def disk_compliance_solve(D, yf, lo, hi, c, kind, mu):
     Returns iterations (< 0: failed)."""
     m = yf.size
     y = yf.copy()
-    scale = 1e-300
-    for j in range(m):
-        scale = max(scale, abs(yf[j]), abs(lo[j]) if np.isfinite(lo[j]) else 0.0,
-                    abs(hi[j]) if np.isfinite(hi[j]) else 0.0)
+    scale = data_scale(yf, lo, hi)
     mu_y, Jm, none = np.zeros(m), np.zeros((m, m)), np.zeros((0, 0))
     _springs(y, lo, hi, c, kind, mu_y, Jm)
     G = y - yf - D @ mu_y

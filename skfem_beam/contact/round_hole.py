@@ -31,6 +31,7 @@ import numpy as np
 from numba import njit
 
 from ..errors import InputError
+from .active_set import data_scale
 from .base import ContactLaw, compiled_law
 
 internal = njit(cache=True)   # also called from Python: the start step runs the law uncompiled
@@ -168,13 +169,8 @@ def cone_solve(D, yf, lo, hi, kind, mu, active):
     for j in range(m):
         mu[j] = 0.0
     root = np.empty(3)
-    scale = 0.0
-    for j in range(m):
-        scale = max(scale, abs(yf[j]), abs(lo[j]) if np.isfinite(lo[j]) else 0.0,
-                    abs(hi[j]) if np.isfinite(hi[j]) else 0.0)
-    scale = max(scale, 1e-300)
+    scale = data_scale(yf, lo, hi)
     tol = 1e-13 * scale
-    sweeps = 0
     blocks = 0
     for j in range(m):
         if kind[j] >= 0:

@@ -32,6 +32,23 @@ def exit_on_signals() -> None:
             signal.signal(sig, _leave)
 
 
+# the commands that draw charts: their chart process starts with them (chart_process)
+CHARTING = ("skfem_beam.cases.", "skfem_beam run")
+
+
+def command_starting() -> None:
+    """A ``python -m skfem_beam...`` command is starting: signals end it in one line
+    (`exit_on_signals`), and one that draws charts starts its chart process now, to load
+    matplotlib beside the command's own imports."""
+    exit_on_signals()
+    argv = getattr(sys, "orig_argv", [])
+    i = argv.index("-m") if "-m" in argv else -1
+    command = " ".join(argv[i + 1:i + 3]) if i >= 0 else ""
+    if command.startswith(CHARTING):
+        from . import chart_process
+        chart_process.start()
+
+
 def _ending(signum, frame):
     name = signal.Signals(signum).name
     os.write(2, f"interrupted by {name} while exiting: the command had finished\n".encode())

@@ -35,7 +35,6 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from .bar import Bar
 from .errors import InputError
@@ -694,6 +693,7 @@ def _spline(d: dict, name: str, value: str):
     """(f, f') of a {x, u} table: a not-a-knot cubic spline."""
     pairs = _need(d, ("x", value), f"initial.{name}")
     try:
+        from scipy.interpolate import CubicSpline
         s = CubicSpline(np.asarray(pairs["x"], dtype=float),
                         np.asarray(pairs[value], dtype=float), bc_type="not-a-knot")
     except ValueError as e:

@@ -24,7 +24,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from .checks import check_count, check_finite, check_nonnegative, check_positive
 from .errors import InputError
@@ -254,6 +253,7 @@ class Table(_FromEval):
                              f"(t={t[i]:g} after {t[i - 1]:g})")
         object.__setattr__(self, "t", tuple(t))
         object.__setattr__(self, "phi", tuple(v))
+        from scipy.interpolate import CubicSpline   # 0.15 s: only a tabulated φ needs it
         object.__setattr__(self, "_spline", CubicSpline(t, v, bc_type="not-a-knot"))
 
     @classmethod

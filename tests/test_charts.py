@@ -11,7 +11,8 @@ from conftest import exit_code
 from skfem_beam import beam_system, scenes, solve
 from skfem_beam.cases import point_stops
 from skfem_beam.output import charts
-from skfem_beam.output.charts import envelope, plot_reduced, shape_chart, trajectory_chart
+from skfem_beam.output.charts import (envelope, plot_reduced, shape_chart, shapes,
+                                      trajectory_chart)
 
 N = 2_000_000
 
@@ -91,7 +92,7 @@ def test_beam_shapes_show_the_physical_displacement_and_the_stops(monkeypatch, t
     r = solve(beam_system(scenes.point_stops()), dt=5e-5, T=0.6, beta=0.5, frames=12)
     store = {}
     monkeypatch.setattr(charts, "figure", lambda *a, **k: kept_figure(store))
-    shape_chart(tmp_path / "shapes.png", r, count=6)
+    shape_chart(tmp_path / "shapes.png", shapes(r, count=6))
     ax = store["ax"]
     curves = [ln for ln in ax.lines if ln.get_xdata().size > 2]
     assert len(curves) == 6
@@ -116,7 +117,7 @@ def test_flat_obstacles_are_lines(monkeypatch, tmp_path):
     r = solve(beam_system(scenes.flat_obstacles(J=20)), dt=1e-3, T=0.05, beta=0.5, frames=5)
     store = {}
     monkeypatch.setattr(charts, "figure", lambda *a, **k: kept_figure(store))
-    shape_chart(tmp_path / "shapes.png", r)
+    shape_chart(tmp_path / "shapes.png", shapes(r))
     g = {ln.get_label(): ln for ln in store["ax"].lines if ln.get_label().startswith("obstacle")}
     assert set(g) == {"obstacle g1 (lower)", "obstacle g2 (upper)"}
     x, g2 = np.asarray(g["obstacle g2 (upper)"].get_xdata()), \
@@ -178,7 +179,7 @@ def test_carried_obstacles_move_with_the_support(monkeypatch, tmp_path):
     r = solve(beam_system(_shaken(obstacles=obs)), dt=1e-5, T=0.05, frames=10)
     store = {}
     monkeypatch.setattr(charts, "figure", lambda *a, **k: kept_figure(store))
-    shape_chart(tmp_path / "shapes.png", r, count=6)
+    shape_chart(tmp_path / "shapes.png", shapes(r, count=6))
     marks = [ln for ln in store["ax"].lines if ln.get_marker() in ("^", "v")]
     moving = sorted((float(ln.get_ydata()[0]) for ln in marks if ln.get_xdata()[0] == 0.5))
     times = r.frames_t[np.unique(np.linspace(0, r.frames_t.size - 1, 6).astype(int))]

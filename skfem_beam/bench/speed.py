@@ -99,30 +99,50 @@ def child(scene: str, p: dict, solver: str, repeat: int) -> dict:
             "peak_rss_MB": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}
 
 
-COMMANDS = [   # whole commands: wall time and peak memory of the process, beside its loop
+COMMANDS = [   # whole commands: wall time and peak memory of the process, beside its loop,
+    # and the target each must meet: seconds, or a function of its loop's seconds
     ("point stops dt=1e-6 T=2, every step saved (command)",
-     ["skfem_beam.cases.point_stops", "--dt", "1e-6", "--format", "none"], 9.0),
+     ["skfem_beam.cases.point_stops", "--dt", "1e-6", "--format", "none"],
+     ("2(loop + 2)", lambda loop: 2 * (loop + 2.0))),
+    ("point stops dt=5e-5 T=2 (command)", ["skfem_beam.cases.point_stops", "--dt", "5e-5"],
+     ("loop + 1", lambda loop: loop + 1.0)),
     ("flat obstacles, the README's main job (command)", ["skfem_beam.cases.flat_obstacles"],
-     None),
+     ("1.5", lambda loop: 1.5)),
 ]
 # the first command's folder resumed near its end: 2,000,000 rows on disk checked (CRC,
 # block by block), the chart envelope from the checkpoint, 40,000 more steps
 RESUME = ("  its --resume DIR --T 2.04 (40,000 more steps)", ["--T", "2.04"])
 
 
-def command_row(label: str, args: list[str], target, folder: str, fresh=True) -> dict:
+def command_row(label: str, args: list[str], target, folder: str, fresh=True,
+                repeat: int = 1) -> dict:
     """Runs ``python -m ARGS --out folder`` (``fresh``; else ARGS as they are, e.g. a
-    ``--resume folder``) in a child: its wall time, and its time loop and peak resident
-    memory (from its summary.json)."""
-    t0 = time.perf_counter()
-    out = ["--out", folder, "--overwrite"] if fresh else []
-    subprocess.run([sys.executable, "-m", *args, *out], check=True, capture_output=True)
-    wall = time.perf_counter() - t0
-    summary = json.loads((Path(folder) / "summary.json").read_text())
+    ``--resume folder``) in a child, ``repeat`` times: its best wall time, and its time
+    loop and peak resident memory (from its summary.json); ``target``: (text, function of
+    the loop's seconds) or None."""
+    best = None
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = ["--out", folder, "--overwrite"] if fresh else []
+        subprocess.run([sys.executable, "-m", *args, *out], check=True, capture_output=True)
+        wall = time.perf_counter() - t0
+        summary = json.loads((Path(folder) / "summary.json").read_text())
+        if best is None or wall < best[0]:
+            best = (wall, summary)
+    wall, summary = best
     loop = summary["wall_time_s"]
     return {"configuration": label, "command_s": wall, "wall_time_s": loop,
-            "budget_s": 2 * (loop + 2.0), "peak_rss_MB": summary["peak_rss_MB"],
-            "steps": summary["steps"], "target_s": target}
+            "target": target[0] if target else None,
+            "target_s": target[1](loop) if target else None,
+            "peak_rss_MB": summary["peak_rss_MB"], "steps": summary["steps"]}
+
+
+def command_line(res: dict) -> str:
+    met = "-" if res["target_s"] is None else \
+        ("yes" if res["command_s"] <= res["target_s"] else "NO")
+    target = "-" if res["target"] is None else f"{res['target']} = {res['target_s']:.2f}"
+    return (f"{res['configuration']:56s} {res['command_s']:9.2f} {res['wall_time_s']:7.3f} "
+            f"{target:>18s} {met:>4s} {res['peak_rss_MB']:8.0f}")
 
 
 def osqp_table(rows: list[dict]) -> None:
@@ -197,23 +217,21 @@ def main(argv=None) -> int:
                   f"{res['peak_rss_MB']:6.0f}", flush=True)
     osqp_table(rows)
     planes_table(rows)
-    print(f"\n{'whole command':56s} {'command s':>9s} {'loop s':>7s} {'2(loop+2) s':>11s} "
-          f"{'peak MB':>8s}")
+    print(f"\n{'whole command (best of ' + str(repeat) + ')':56s} {'command s':>9s} "
+          f"{'loop s':>7s} {'target s':>18s} {'met':>4s} {'peak MB':>8s}")
     with tempfile.TemporaryDirectory() as tmp:
         for i, (label, cmd, target) in enumerate(COMMANDS):
             if args.quick and i == 0:
                 continue
-            res = command_row(label, cmd, target, str(Path(tmp) / f"run{i}"))
+            folder = str(Path(tmp) / f"run{i}")
+            res = command_row(label, cmd, target, folder, repeat=1 if i == 0 else repeat)
             rows.append(res)
-            print(f"{label:56s} {res['command_s']:9.2f} {res['wall_time_s']:7.2f} "
-                  f"{res['budget_s']:11.2f} {res['peak_rss_MB']:8.0f}", flush=True)
+            print(command_line(res), flush=True)
             if i == 0:
-                folder = str(Path(tmp) / f"run{i}")
                 res = command_row(RESUME[0], [cmd[0], "--resume", folder, *RESUME[1]], None,
                                   folder, fresh=False)
                 rows.append(res)
-                print(f"{RESUME[0]:56s} {res['command_s']:9.2f} {res['wall_time_s']:7.2f} "
-                      f"{'-':>11s} {res['peak_rss_MB']:8.0f}", flush=True)
+                print(command_line(res), flush=True)
     with open(args.out, "w") as fh:
         json.dump({"machine": "see README (2-core CI machine)", "rows": rows}, fh, indent=2)
     print(f"written {args.out}")

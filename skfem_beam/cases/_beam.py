@@ -7,8 +7,9 @@ from pathlib import Path
 import numpy as np
 
 from .. import cli
+from ..chart_process import draw
 from ..scheme.kernels import CONTACT_STEPS
-from ..output.charts import energy_chart, shape_chart, trajectory_chart
+from ..output.charts import energy_chart, shape_chart, shapes, trajectory_chart
 from ..output.events import beam_impacts
 from ..output.fields import physical_at, physical_tip
 from ..output.probes import probe_columns, probe_units
@@ -182,12 +183,12 @@ def beam_charts(case, problem, rho_S, stops, extra, observed_x=None):
             if extra is not None:
                 extra(folder, data, run)
             return
-        trajectory_chart(folder / "tip_displacement.png", t,
+        draw(trajectory_chart, folder / "tip_displacement.png", t,
                          {f"ũ({where}, t)": data["tip_displacement"]},
                          stops=stops if observed_x is None else (),
                          title=f"{case}: {what} ({about})")
         joules = "energy_J" in data         # in J when the mass per length ρS is known
-        energy_chart(folder / "energy.png", t, data["energy_J" if joules else "energy"],
+        draw(energy_chart, folder / "energy.png", t, data["energy_J" if joules else "energy"],
                      title=f"{case}: discrete energy ½E_β ({about})",
                      work={k: data[f"work_{k}" + ("_J" if joules else "")] for k in WORK_TERMS},
                      joules=joules)
@@ -195,11 +196,11 @@ def beam_charts(case, problem, rho_S, stops, extra, observed_x=None):
             # in newtons when the mass per length ρS is known (the column is λ·ρS)
             newtons = "contact_force_N" in data
             force = data["contact_force_N" if newtons else "contact_force"]
-            trajectory_chart(folder / "contact_force.png", t, {"net contact force λ": force},
+            draw(trajectory_chart, folder / "contact_force.png", t, {"net contact force λ": force},
                              title=f"{case}: net contact force on the beam ({about})"
                                    + (f", ρS={rho_S:g} kg/m" if newtons else ""),
                              ylabel="force (N)" if newtons else "force per mass (m²/s² = N per kg/m)")
-        shape_chart(folder / "beam_shapes.png", run.result(),
+        draw(shape_chart, folder / "beam_shapes.png", shapes(run.result()),
                     title=f"{case}: displacement ũ(x, t) at saved times ({about})")
         if extra is not None:
             extra(folder, data, run)
@@ -211,12 +212,12 @@ def two_plane_charts(folder, data, run, case, problem, about, where, what, rho_S
     contact force per plane, and an orbit per hole node (w against v, the wall drawn)."""
     from ..output.supports import orbit_chart
     t = data["t"]
-    trajectory_chart(folder / "tip_displacement.png", t,
+    draw(trajectory_chart, folder / "tip_displacement.png", t,
                      {f"v({where}, t)": data["tip_displacement_v"],
                       f"w({where}, t)": data["tip_displacement_w"]},
                      title=f"{case}: {what}, both planes ({about})")
     joules = "energy_J" in data
-    energy_chart(folder / "energy.png", t, data["energy_J" if joules else "energy"],
+    draw(energy_chart, folder / "energy.png", t, data["energy_J" if joules else "energy"],
                  title=f"{case}: discrete energy ½E_β ({about})",
                  work={k: data[f"work_{k}" + ("_J" if joules else "")]
                        for k in run.work_terms}, joules=joules)
@@ -224,14 +225,14 @@ def two_plane_charts(folder, data, run, case, problem, about, where, what, rho_S
     forces = {f"net contact force, {p}": data[f"contact_force_{p}" + ("_N" if newtons else "")]
               for p in ("v", "w")}
     if any(np.any(f) for f in forces.values()):
-        trajectory_chart(folder / "contact_force.png", t, forces,
+        draw(trajectory_chart, folder / "contact_force.png", t, forces,
                          title=f"{case}: net contact force on the beam ({about})",
                          ylabel="force (N)" if newtons else
                          "force per mass (m²/s² = N per kg/m)")
     for h in problem.holes:
         for x in problem.nodes[h.acts_at(problem.nodes, problem.beam.L)]:
             key = f"hole_{float(x):g}_displacement"
-            orbit_chart(folder / f"orbit_{float(x):g}.png", data[f"{key}_v"],
+            draw(orbit_chart, folder / f"orbit_{float(x):g}.png", data[f"{key}_v"],
                         data[f"{key}_w"], h.hole.outline(),
                         f"{case}: orbit at x = {float(x):g} m, {h.hole.shape} hole\n({about})",
                         h.hole.centre)

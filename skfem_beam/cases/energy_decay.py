@@ -13,6 +13,7 @@ import numpy as np
 from .. import cli, scenes
 from ..scheme import solve
 from ..output.folder import write_timeseries
+from ..chart_process import draw
 from ..output.charts import trajectory_chart
 from ..checks import check_beta
 from ..semidiscrete import beam_system
@@ -37,7 +38,7 @@ def main(argv=None) -> int:
                        save_every=args.save_every, frames=2)
             columns[f"energy_beta_{other:g}"] = r2.energy[:data["t"].size]
         write_timeseries(folder, columns, "energy.csv")
-        trajectory_chart(folder / "energy_decay.png", data["t"],
+        draw(trajectory_chart, folder / "energy_decay.png", data["t"],
                          {k: v for k, v in columns.items() if k != "t"},
                          title=f"discrete energy ½E_β, f = 0 (J={pb.J}, {pb.element}, Δt={args.dt:g} s)",
                          ylabel="energy (m³/s²)")

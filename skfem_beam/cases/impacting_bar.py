@@ -34,6 +34,7 @@ from dataclasses import replace
 from .. import cli
 from ..bar import (Bar, BarSeries, bar_run, contact_periods, describe, energy_report, errors,
                    read_profile, spring_step_ratio)
+from ..chart_process import draw
 from ..output.charts import compare_chart
 from ..output.events import bar_impacts
 from ..output.series import Series, execute, prepare
@@ -154,13 +155,13 @@ def bar_charts(bar: Bar, series, exact, T: float):
             f" at x={'0' if bar.obstacle_at == 'left' else 'L'}, {bar.far_end} far end"
         title = (f"{bar.obstacle} obstacle{f' k={bar.k:g}' if spring else ''}{side}, f={bar.f:g}, "
                  f"N={bar.N}, Δt={run.dt:g}, {run.label}, {bar.mass} mass")
-        compare_chart(folder / "displacement.png", b.t, {"u(0, t)": b.u0, "u(L, t)": b.uL},
+        draw(compare_chart, folder / "displacement.png", b.t, {"u(0, t)": b.u0, "u(L, t)": b.uL},
                       {"u(0, t) exact": data.get("u_0_exact"),
                        "u(L, t) exact": data.get("u_L_exact")}, title, "displacement (m)")
-        compare_chart(folder / "contact_force.png", b.t, {"reaction R": b.force},
+        draw(compare_chart, folder / "contact_force.png", b.t, {"reaction R": b.force},
                       {"R exact": data.get("contact_force_exact")}, title,
                       "R (Pa)" if bar.A is None else "R (N)")
-        compare_chart(folder / "energy.png", b.t,
+        draw(compare_chart, folder / "energy.png", b.t,
                       {"kinetic": b.kinetic, "strain": b.strain, "obstacle": b.obstacle,
                        "total": b.energy + b.load_potential},
                       {"exact total": data.get("energy_exact")}, title,

@@ -6,16 +6,24 @@ draws, and on leaving the block it is laid out, saved and closed.
 from __future__ import annotations
 
 from contextlib import contextmanager
+from dataclasses import dataclass
 
-# no matplotlib.use(): without a display matplotlib falls back to Agg by itself, and
-# forcing it here would switch off inline figures in the notebooks that import us
-import matplotlib.pyplot as plt
 import numpy as np
+
+
+def pyplot():
+    """matplotlib.pyplot, imported at the first chart (0.3 s: a run that draws in the chart
+    process, see :mod:`.chart_process`, never imports it).  No matplotlib.use(): without a
+    display matplotlib falls back to Agg by itself, and forcing it would switch off inline
+    figures in the notebooks that import us."""
+    import matplotlib.pyplot as plt
+    return plt
 
 
 @contextmanager
 def figure(path, figsize=(9, 4), dpi=110, **subplots):
     """``with figure(path) as (fig, ax): ...``: draw, then it is laid out, saved, closed."""
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=figsize, dpi=dpi, **subplots)
     try:
         yield fig, ax
@@ -134,44 +142,68 @@ def _obstacle(ax, x, g, name, marker, color="k", label=True):
                 ls="--" if name.startswith("g1") else "-.", label=text)
 
 
-def shape_chart(path, result, count=14, title=""):
-    """The physical displacement ũ(x, t_k) = u + h(x)φ(t_k) at ``count`` saved frames, with
-    the obstacles g1, g2 (papers' Figs 1–3): what ParaView shows, support motion included,
-    for any lifting.  Obstacles carried by a moving support are drawn at every frame's
-    time in that frame's colour, fixed ones once."""
+@dataclass
+class Shapes:
+    """What beam_shapes.png draws, as plain arrays (computed in the command, drawn in the
+    chart process): the physical displacement ũ at the points ``x`` at times ``t`` (one
+    row of ``u`` each), the obstacles fixed to the ground (NaN: none) and, when the
+    support carries some, those at rest (``carried``) and the support's φ at each time."""
+    x: np.ndarray
+    t: np.ndarray
+    u: np.ndarray
+    fixed: tuple
+    carried: tuple | None
+    phi: np.ndarray | None
+    ylim: tuple
+
+
+def shapes(result, count=14) -> Shapes:
+    """ũ(x, t_k) = u + h(x)φ(t_k) at ``count`` saved frames of ``result`` (finite ones,
+    spread over the run), with the obstacles g1, g2: what ParaView shows, support motion
+    included, for any lifting."""
     from .fields import sample_line
     line = sample_line(result.system)
     good = np.flatnonzero(np.isfinite(result.frames_u).all(axis=1))
     idx = good[np.unique(np.linspace(0, good.size - 1, min(count, good.size)).astype(int))]
+    t = result.frames_t[idx]
+    u = np.array([line.fields(result.frames_t[k], result.frames_u[k], result.frames_v[k],
+                              result.frames_force[k])["displacement"] for k in idx])
+    carried = phi = None
+    fixed = (line.g1, line.g2)
+    if line.carried is not None:
+        carried = tuple(np.where(np.isfinite(g), g, np.nan) for g in line.carried)
+        fixed = tuple(np.where(np.isfinite(g), g, np.nan) for g in line.fixed)
+        phi = np.array([float(line.motion.phi(tk)) for tk in t])
+    # the beam's range and the narrowest gap: obstacles far from the beam (the convex
+    # ones reach ±0.75 m at the ends) would squash the curves to a line
+    span = [u.min(), u.max()]
+    for g, pick in ((line.g1, max), (line.g2, min)):
+        if np.isfinite(g).any():
+            span = [min(span[0], pick(np.nanmin(g), np.nanmax(g))),
+                    max(span[1], pick(np.nanmin(g), np.nanmax(g)))]
+    pad = 0.08 * (span[1] - span[0]) or 1e-3
+    return Shapes(line.x, t, u, fixed, carried, phi, (span[0] - pad, span[1] + pad))
+
+
+def shape_chart(path, shapes: Shapes, title=""):
+    """The :class:`Shapes` of a run (papers' Figs 1–3), a colour per time.  Obstacles
+    carried by a moving support are drawn at every time in that time's colour, fixed ones
+    once."""
     with figure(path, figsize=(9, 4.4)) as (fig, ax):
+        plt = pyplot()
         cmap = plt.get_cmap("viridis")
-        times = result.frames_t[idx]
-        norm = plt.Normalize(times.min(), max(times.max(), times.min() + 1e-300))
-        span = [np.inf, -np.inf]
-        for k in idx:
-            tk = result.frames_t[k]
-            f = line.fields(tk, result.frames_u[k], result.frames_v[k], result.frames_force[k])
-            ut = f["displacement"]
-            ax.plot(line.x, ut, lw=1.0, color=cmap(norm(tk)),
-                    label=f"ũ(x, t) at {idx.size} times" if k == idx[0] else None)
-            span = [min(span[0], ut.min()), max(span[1], ut.max())]
-            if line.carried is not None:    # obstacles carried by the support move with it:
-                phi = float(line.motion.phi(tk))                     # drawn at each time
-                for g, name, marker in zip(line.carried, ("g1", "g2"), ("^", "v")):
-                    _obstacle(ax, line.x, np.where(np.isfinite(g), g + phi, np.nan),
-                              f"{name} carried", marker, cmap(norm(tk)), label=k == idx[-1])
-        fixed = (line.g1, line.g2) if line.carried is None else \
-            [np.where(np.isfinite(g), g, np.nan) for g in line.fixed]
-        _obstacle(ax, line.x, fixed[0], "g1", "^")
-        _obstacle(ax, line.x, fixed[1], "g2", "v")
-        # the beam's range and the narrowest gap: obstacles far from the beam (the
-        # convex ones reach ±0.75 m at the ends) would squash the curves to a line
-        for g, pick in ((line.g1, max), (line.g2, min)):
-            if np.isfinite(g).any():
-                span = [min(span[0], pick(np.nanmin(g), np.nanmax(g))),
-                        max(span[1], pick(np.nanmin(g), np.nanmax(g)))]
-        pad = 0.08 * (span[1] - span[0]) or 1e-3
-        ax.set_ylim(span[0] - pad, span[1] + pad)
+        t = shapes.t
+        norm = plt.Normalize(t.min(), max(t.max(), t.min() + 1e-300))
+        for k, (tk, ut) in enumerate(zip(t, shapes.u)):
+            ax.plot(shapes.x, ut, lw=1.0, color=cmap(norm(tk)),
+                    label=f"ũ(x, t) at {t.size} times" if k == 0 else None)
+            if shapes.carried is not None:
+                for g, name, marker in zip(shapes.carried, ("g1", "g2"), ("^", "v")):
+                    _obstacle(ax, shapes.x, g + shapes.phi[k], f"{name} carried", marker,
+                              cmap(norm(tk)), label=k == t.size - 1)
+        _obstacle(ax, shapes.x, shapes.fixed[0], "g1", "^")
+        _obstacle(ax, shapes.x, shapes.fixed[1], "g2", "v")
+        ax.set_ylim(*shapes.ylim)
         bar = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax, pad=0.01)
         bar.set_label("t (s)")
         _frame(ax, "x (m)", "ũ (m)", title, fontsize=9)

@@ -34,6 +34,7 @@ from typing import Callable
 
 import numpy as np
 
+from .. import chart_process
 from ..errors import InputError, SolverError
 from ..scheme import Run, drive
 from .fields import FieldWriter
@@ -599,7 +600,7 @@ class _Stream:
             self.rows.append(self.series.columns(run, self.used, k1))
             self.used = k1
             run.release(self.used - 1)   # written: memory stays flat (one row kept before)
-        if self.fields is not None:
+        if self.fields is not None and not run.done:   # the last frames: after the charts
             self.fields.update()
         if self.stop.signum is not None and not run.done:
             raise Interrupted(self.stop.signum)
@@ -610,7 +611,8 @@ class _Stream:
 
     def to_the_end(self, finish) -> dict:
         """Stream the run to its end, then the charts and impacts.csv: the summary's
-        entries."""
+        entries.  The charts are sent to the chart process (:mod:`..chart_process`) before
+        the last chunk's field frames are written, so that both are made at once."""
         run, series, fmt = self.run, self.series, self.options.format
         try:
             self.rows = SeriesFile(self.folder / "timeseries.csv",
@@ -619,18 +621,25 @@ class _Stream:
             self.fields = _Fields(self.folder.path, run, fmt, series) if fmt != "none" else None
             self.on_chunk(run)              # state 1 (and, on resume, the frames so far)
             drive(run, chunk=self.options.flush_every, on_chunk=self.on_chunk)
-            phase("last-chunk")
-            if self.can_checkpoint and run.status == "success":
-                self.save_checkpoint()      # so that --resume DIR --T longer extends it
-                phase("final-checkpoint")
+            data = self.rows.data()
+            entries = outcome(run.result(), data)
+            try:
+                entries.update(finish(self.folder.path, data, run) or {})
+                if self.fields is not None:
+                    self.fields.update()
+                phase("last-chunk")
+                if self.can_checkpoint and run.status == "success":
+                    self.save_checkpoint()  # so that --resume DIR --T longer extends it
+                    phase("final-checkpoint")
+            except BaseException:
+                chart_process.wait(quiet=True)   # no chart is drawn after the folder's end
+                raise
         finally:
             if self.rows is not None:
                 self.rows.close()
             if self.fields is not None:
                 self.fields.close()
-        data = self.rows.data()
-        entries = outcome(run.result(), data)
-        entries.update(finish(self.folder.path, data, run) or {})
+        chart_process.wait()
         phase("charts")
         entries.update(self.write_events(run.n, quiet=False))
         phase("impacts")

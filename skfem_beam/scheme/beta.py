@@ -160,6 +160,9 @@ class BetaScheme:
         self.Orows = observers(system)
         self.ops = self._ops(params)
         self.st = self._state()
+        # the loop's hole kinematics: compiled only for a run with holes (kernels.run_steps)
+        self.holes = self.st.hk if self.ops.Nc.shape[0] else None
+        self.massless = self.st.ez if self.ops.Zr.size else None
 
     def _law(self, law, m: int) -> ContactLaw:
         """The law object: none without constraints; "auto" decided for this step."""
@@ -219,7 +222,8 @@ class BetaScheme:
         # the types of the arguments exactly as _steps passes them: the same compiled loop
         loop = (types.FunctionType(kernel.signature), types.FunctionType(explicit.signature))
         args = (self.ops, self.st, out, 1, 1,
-                Inputs(np.zeros((0, self.loads.shape[1])), np.zeros(0)), 0.0)
+                Inputs(np.zeros((0, self.loads.shape[1])), np.zeros(0)), 0.0, self.holes,
+                self.massless)
         loop += tuple(typeof(a) for a in args)
         if loop in run_steps.overloads:
             return
@@ -365,7 +369,7 @@ class BetaScheme:
         if self.pysolver is None:
             try:
                 return run_steps(*self._kernels, self.ops, self.st, out, n0, n1, inputs,
-                                 Ebound)
+                                 Ebound, self.holes, self.massless)
             except TypeError as e:
                 # numba 0.68: a Ctrl-C landing while the dispatcher unboxes the law's C
                 # callback surfaces as this TypeError (seen once in CI): it is the interrupt
@@ -375,7 +379,8 @@ class BetaScheme:
         PythonLaw.solver, PythonLaw.state, PythonLaw.error = self.pysolver, self.st, None
         try:
             return run_steps_python(self.ops, self.st, out, n0, n1, inputs, Ebound,
-                                    bool(getattr(self.law, "free_inside", True)))
+                                    bool(getattr(self.law, "free_inside", True)), self.holes,
+                                    self.massless)
         finally:
             PythonLaw.solver = PythonLaw.state = None
 

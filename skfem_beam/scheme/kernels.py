@@ -128,7 +128,7 @@ def massless_work(Zr, ez, d, mu, Cp, Ci, Cx, beta, dt):
 
 
 @njit(cache=True, inline="always")
-def free_step(ops, st, Gn, H, row):
+def free_step(ops, st, Gn, H, row, massless):
     """st.x ← the step without contact, st.yf ← C x, st.Ku ← K uⁿ (reused by the energy);
     ``Gn``: the load coefficients Gⁿ of this step; st.r_e: the law's explicit force;
     ``H[row]``: the load at the quasi-static massless rows (see massless_force)."""
@@ -148,9 +148,9 @@ def free_step(ops, st, Gn, H, row):
         for i in range(st.d.size):
             st.d[i] = u_cur[i] - u_prev[i]
         rows_matvec(ops.Bb, st.d, x, -ops.dt, np.bool_(True))
-    if ops.Zr.size:
+    if massless is not None:
         massless_force(ops.Zr, ops.Zp, ops.Zi, ops.Zx, ops.beta, st.Ku, st.u_prev, H, row,
-                       st.ez)
+                       massless)
         for q in range(ops.Zr.size):
             x[ops.Zr[q]] += dt2 * st.ez[q]
     band_solve(ops.Achol, x)
@@ -160,7 +160,7 @@ def free_step(ops, st, Gn, H, row):
 
 
 @njit(cache=True, inline="always")
-def finish_step(ops, st, Gn):
+def finish_step(ops, st, Gn, massless):
     """uⁿ⁺¹ = x_free + W μ; the step's damping and load work (below); shift
     (uⁿ⁻¹, uⁿ) ← (uⁿ, uⁿ⁺¹) and their constrained values, st.dy ← C(uⁿ⁺¹ − uⁿ⁻¹); then
     μ ← the whole contact force (the law's explicit part added) and its work.
@@ -183,8 +183,8 @@ def finish_step(ops, st, Gn):
         for i in range(x.size):
             s += ops.loads[i, k] * d[i]
         st.work[1] += 0.5 * Gn[k] * s
-    if ops.Zr.size:    # quasi-static massless rows
-        st.work[2] += massless_work(ops.Zr, st.ez, d, mu, ops.Cp, ops.Ci, ops.Cx, ops.beta,
+    if massless is not None:    # quasi-static massless rows
+        st.work[2] += massless_work(ops.Zr, massless, d, mu, ops.Cp, ops.Ci, ops.Cx, ops.beta,
                                     ops.dt)
     for i in range(x.size):
         st.u_prev[i] = st.u_cur[i]
@@ -429,8 +429,6 @@ def track_impacts(ops, st, out, step):
         any_active = any_active or a
     if any_active:
         counters[1] += 1
-    if ops.Nc.shape[0]:
-        hole_kinematics(ops, st, step, dt, st.hk)
     return EVENTS_FULL if counters[4] + st.active.size > out.events.shape[0] else 0
 
 
@@ -454,11 +452,13 @@ def stop_code(ops, st, out, step, Ebound, full):
 # nogil: the output pipeline writes the last chunk's rows while this computes the next.
 # No C entry wrapper: it is never passed as a first-class function.
 @njit(cache=True, _nrt=False, nogil=True, no_cfunc_wrapper=True)
-def run_steps(law, explicit, ops, st, out, n0, n1, inputs, Ebound):
+def run_steps(law, explicit, ops, st, out, n0, n1, inputs, Ebound, holes, massless):
     """Steps n = n0..n1−1 (computing uⁿ⁺¹) with a compiled law: the bounds at t_{n+1},
     the law's explicit force, the free step, the law, then `finish_step`, the impact
     events, the diagnostics and `stop_code`.  ``inputs`` (Inputs) hold Gⁿ and φ(t_{n+1})
-    at row n − n0.
+    at row n − n0.  ``holes``: None, or the scratch of `hole_kinematics` (two planes with
+    holes); numba prunes the branch of a None argument before typing it, so a run without
+    holes does not compile `hole_kinematics` (0.5 s of a first run).
 
     Returns 0, FAILED (the law failed at step counters[3]), UNSTABLE (the energy saved
     at state counters[3] is non-finite or above Ebound) or EVENTS_FULL (stopped after
@@ -468,14 +468,16 @@ def run_steps(law, explicit, ops, st, out, n0, n1, inputs, Ebound):
         Gn = inputs.G[step - n0]
         move_bounds(ops, st, inputs.phi[step - n0])
         explicit(st.y_cur, st.y_prev, st.lo, st.hi, ops.params, st.r_e)
-        free_step(ops, st, Gn, inputs.H, step - n0)
+        free_step(ops, st, Gn, inputs.H, step - n0, massless)
         its = call_law(law, ops, st)
         if its < 0:
             st.counters[3] = step + 1
             return FAILED
         st.counters[2] += its
-        finish_step(ops, st, Gn)
+        finish_step(ops, st, Gn, massless)
         full = track_impacts(ops, st, out, step)
+        if holes is not None:
+            hole_kinematics(ops, st, step, ops.dt, holes)
         record(step + 1, ops, st, out)
         code = stop_code(ops, st, out, step, Ebound, full)
         if code:
@@ -513,7 +515,8 @@ def _solve_in_python() -> int:
 
 
 @njit(cache=True)
-def run_steps_python(ops, st, out, n0, n1, inputs, Ebound, free_inside):
+def run_steps_python(ops, st, out, n0, n1, inputs, Ebound, free_inside, holes,
+                     massless):
     """The same steps as `run_steps` with the law solved in Python (`PythonLaw.solver`,
     e.g. OSQP or daqp, given the step's bounds): the compiled loop calls it for μ when
     the free step leaves its bounds.  When it does not and ``free_inside`` (the law's:
@@ -523,7 +526,7 @@ def run_steps_python(ops, st, out, n0, n1, inputs, Ebound, free_inside):
     for step in range(n0, n1):
         Gn = inputs.G[step - n0]
         move_bounds(ops, st, inputs.phi[step - n0])
-        free_step(ops, st, Gn, inputs.H, step - n0)
+        free_step(ops, st, Gn, inputs.H, step - n0, massless)
         if free_inside and inside(st.yf, st.lo, st.hi):
             its = 0
             st.mu[:] = 0.0
@@ -536,8 +539,10 @@ def run_steps_python(ops, st, out, n0, n1, inputs, Ebound, free_inside):
         for j in range(st.mu.size):
             st.active[j] = st.mu[j] != 0.0
         st.counters[2] += its
-        finish_step(ops, st, Gn)
+        finish_step(ops, st, Gn, massless)
         full = track_impacts(ops, st, out, step)
+        if holes is not None:
+            hole_kinematics(ops, st, step, ops.dt, holes)
         record(step + 1, ops, st, out)
         code = stop_code(ops, st, out, step, Ebound, full)
         if code:

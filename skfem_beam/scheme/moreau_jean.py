@@ -51,7 +51,8 @@ from .beta import (disk_rows, friction_of, hole_arrays, observers, penetration_s
                    start_positions, two_plane_state)
 from ..contact.friction import MAX_SWEEPS, nsgs
 from .kernels import (EVENT_COLUMNS, FAILED, FRICTION, IMPACT_FIELDS, ITERATIONS, ROW0,
-                      STOPPED_AT, UNSTABLE, Inputs, Series, csr_product, track_impacts)
+                      STOPPED_AT, UNSTABLE, Inputs, Series, csr_product, hole_kinematics,
+                      track_impacts)
 from .operators import csr_arrays, load_norms, step_operators
 from .run import Run
 from .stepping import Result, Stepping
@@ -232,6 +233,8 @@ def mj_steps(ops, st, out, n0, n1, inputs, Ebound):
                     st.rowwork[a, 0] -= f
                     st.rowwork[a, 2] += f
         full = track_impacts(ops, st, out, step)
+        if ops.Nc.shape[0]:
+            hole_kinematics(ops, st, step, dt, st.hk)
         mj_record(step + 1, ops, st, out)
         if (step + 1) % ops.save_every == 0 \
                 and not abs(out.energy[(step + 1) // ops.save_every - st.counters[ROW0]]) <= Ebound:

@@ -1,0 +1,171 @@
+"""A command's charts, drawn in a process of their own beside the run.
+
+Charts cost a short run most of its time: 0.3 s to import matplotlib and ~0.1 s a chart,
+against a time loop of milliseconds.  A command therefore starts a chart process as it
+starts (:func:`start`, from ``skfem_beam._startup``): it imports matplotlib while the
+command imports its own modules and runs.  :func:`draw` sends it one chart (a module-level
+chart function and its arguments, plain arrays, pickled) and returns; :func:`wait` returns
+once every chart sent is drawn, raising the first chart's error as drawing it in the
+command would have.  Without a chart process (the Python API, notebooks, tests calling a
+command's ``main``), or should it fail to start or die, :func:`draw` draws here: the same
+functions, the same files.
+
+The process cannot outlive its command: it reads its work from a pipe, whose end ends it,
+and on Linux the kernel kills it when the command's process dies (PR_SET_PDEATHSIG), so no
+chart is written into a folder after its command was killed.  It runs in a session of its
+own, so a Ctrl-C at the terminal goes to the command alone, which stops it.  Its
+standard output is the command's standard error (its pipe to the command is a file of its
+own), so a library's warning is seen as it would be in the command.
+
+Only the standard library is imported here: the command imports this module first.
+"""
+from __future__ import annotations
+
+import atexit
+import os
+import pickle
+import signal
+import subprocess
+import sys
+
+_SERVE = "import sys, skfem_beam.chart_process as c; c.serve(int(sys.argv[1]))"
+_process: subprocess.Popen | None = None
+_pending: list = []        # the jobs sent and not yet reported drawn, in order
+PIPE_BYTES = 1 << 20       # Linux's default limit for an unprivileged process
+NICE = 10                  # the chart process's priority below its command's
+
+
+def start() -> None:
+    """Start the chart process (once; nothing when it cannot be started)."""
+    global _process
+    if _process is not None:
+        return
+    # the child imports the same package: this process's sys.path, '' as the cwd
+    path = os.pathsep.join(os.path.abspath(p or os.curdir) for p in sys.path)
+    try:
+        _process = subprocess.Popen(
+            [sys.executable, "-c", _SERVE, str(os.getpid())], stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE, env={**os.environ, "PYTHONPATH": path},
+            start_new_session=True)
+    except OSError:
+        return
+    try:    # room for a short run's charts while the process is still importing (Linux)
+        import fcntl
+        fcntl.fcntl(_process.stdin.fileno(), fcntl.F_SETPIPE_SZ, PIPE_BYTES)
+    except (ImportError, AttributeError, OSError):
+        pass
+    atexit.register(stop)
+
+
+def running() -> bool:
+    return _process is not None and _process.poll() is None
+
+
+def draw(chart, *args, **kwargs) -> None:
+    """``chart(*args, **kwargs)`` in the chart process when one runs, else here."""
+    if running():
+        job = (chart, args, kwargs)
+        try:
+            data = pickle.dumps(job, protocol=pickle.HIGHEST_PROTOCOL)
+        except (pickle.PicklingError, TypeError, AttributeError):
+            data = None                 # not a module-level function: drawn here
+        if data is not None:
+            try:
+                _process.stdin.write(data)
+                _process.stdin.flush()
+                _pending.append(job)
+                return
+            except OSError:             # it died: this and the pending ones drawn here
+                _lost()
+    chart(*args, **kwargs)
+
+
+def wait(quiet: bool = False) -> None:
+    """Return once every chart sent is drawn; raise the first one's error (``quiet``:
+    none, for a command already failing for its own reason)."""
+    errors = []
+    while _pending:
+        try:
+            result = pickle.load(_process.stdout)
+        except (EOFError, OSError, pickle.UnpicklingError):
+            _lost(quiet)
+            break
+        _pending.pop(0)
+        if result is not None:
+            errors.append(result)
+    if errors and not quiet:
+        raise errors[0]
+
+
+def _lost(quiet: bool = False) -> None:
+    """The chart process died: the charts it did not report are drawn here."""
+    global _process
+    jobs = list(_pending)
+    _pending.clear()
+    stop()
+    _process = None
+    for chart, args, kwargs in jobs:
+        try:
+            chart(*args, **kwargs)
+        except Exception:
+            if not quiet:
+                raise
+
+
+def stop() -> None:
+    """End the chart process (killed: it holds nothing to save, and the ~0.1 s of its
+    interpreter's teardown would add to its command's)."""
+    if _process is not None and _process.poll() is None:
+        _process.kill()
+        _process.wait()
+
+
+def serve(parent: int) -> None:
+    """The chart process: draw the charts that arrive on stdin, one report each on the
+    pipe that was stdout (None, or the chart's exception), until stdin ends."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _die_with(parent)
+    # below the command: on a first run it compiles its kernels on every core it has
+    os.nice(NICE)
+    report = os.fdopen(os.dup(1), "wb")
+    os.dup2(2, 1)                       # print() and warnings go to the command's stderr
+    import matplotlib.pyplot  # noqa: F401  (what every chart needs, loaded while waiting)
+    import skfem_beam.output.charts  # noqa: F401
+    import skfem_beam.output.supports  # noqa: F401
+    while True:
+        try:
+            chart, args, kwargs = pickle.load(sys.stdin.buffer)
+        except EOFError:
+            os._exit(0)                 # nothing to tear down: the command has ended
+        try:
+            chart(*args, **kwargs)
+            result = None
+        except Exception as e:          # noqa: BLE001  (reported to the command, raised there)
+            result = _picklable(e)
+        pickle.dump(result, report, protocol=pickle.HIGHEST_PROTOCOL)
+        report.flush()
+
+
+def _picklable(e: Exception) -> Exception:
+    """``e`` if it can be sent back (an OSError keeps its errno: a full disk is reported as
+    the command reports one), else a RuntimeError that says what it was."""
+    import traceback
+    text = "".join(traceback.format_exception(e))
+    try:
+        e.add_note(f"(in the chart process)\n{text}")
+        pickle.loads(pickle.dumps(e))
+        return e
+    except Exception:                   # noqa: BLE001
+        return RuntimeError(f"a chart failed in the chart process:\n{text}")
+
+
+def _die_with(parent: int) -> None:
+    """Be killed when ``parent`` dies (Linux); exit now if it already has."""
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+            ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)   # PR_SET_PDEATHSIG
+        except (OSError, AttributeError):
+            pass
+    if os.getppid() != parent:
+        os._exit(0)

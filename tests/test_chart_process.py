@@ -1,0 +1,110 @@
+"""The charts a command draws beside its run (skfem_beam.chart_process): the same pictures
+as drawn in the command, its errors raised in the command, nothing left behind when the
+command is killed, and a process that dies is replaced by drawing in the command."""
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from skfem_beam import chart_process
+from skfem_beam.cases import flat_obstacles
+from skfem_beam.output.charts import trajectory_chart
+
+ARGS = ["--T", "0.2", "--J", "8", "--format", "none"]
+CHARTS = ("tip_displacement.png", "energy.png", "contact_force.png", "beam_shapes.png")
+
+
+def pixels(path: Path) -> np.ndarray:
+    return np.asarray(Image.open(path), dtype=float)
+
+
+def servers(parent: int) -> list[int]:
+    """The pids of the chart processes serving ``parent`` (their argv names it)."""
+    found = []
+    for proc in Path("/proc").iterdir():
+        try:
+            argv = (proc / "cmdline").read_bytes().split(b"\0")
+        except OSError:
+            continue
+        if b"skfem_beam.chart_process" in b" ".join(argv) and str(parent).encode() in argv:
+            found.append(int(proc.name))
+    return found
+
+
+@pytest.fixture
+def process():
+    """A chart process for this test process, stopped after it."""
+    chart_process.start()
+    assert chart_process.running()
+    yield chart_process
+    chart_process.stop()
+    chart_process._process = None
+
+
+def test_a_command_draws_in_its_chart_process_the_pictures_drawn_in_it(tmp_path):
+    """``python -m`` draws in the chart process, ``main()`` here: the same pixels."""
+    p = subprocess.run([sys.executable, "-m", "skfem_beam.cases.flat_obstacles", *ARGS,
+                        "--out", str(tmp_path / "command")], capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    assert not chart_process.running()
+    assert flat_obstacles.main([*ARGS, "--out", str(tmp_path / "here")]) == 0
+    for name in CHARTS:
+        a, b = pixels(tmp_path / "command" / name), pixels(tmp_path / "here" / name)
+        assert a.shape == b.shape and np.abs(a - b).max() == 0.0, name
+
+
+def test_a_chart_error_is_raised_in_the_command_with_its_errno(tmp_path, process):
+    t = np.linspace(0, 1, 11)
+    process.draw(trajectory_chart, tmp_path / "no such folder" / "x.png", t, {"y": t})
+    process.draw(trajectory_chart, tmp_path / "drawn.png", t, {"y": t})
+    with pytest.raises(FileNotFoundError) as e:
+        process.wait()
+    assert "in the chart process" in "".join(getattr(e.value, "__notes__", []))
+    assert (tmp_path / "drawn.png").stat().st_size > 0     # the next chart is still drawn
+
+
+def test_charts_of_a_process_that_died_are_drawn_here(tmp_path, process):
+    t = np.linspace(0, 1, 11)
+    os.kill(process._process.pid, signal.SIGSTOP)   # it takes the job but draws nothing
+    process.draw(trajectory_chart, tmp_path / "a.png", t, {"y": t})
+    process._process.kill()
+    process.wait()
+    assert (tmp_path / "a.png").stat().st_size > 0 and not process._pending
+    process.draw(trajectory_chart, tmp_path / "b.png", t, {"y": t})   # no process: here
+    assert (tmp_path / "b.png").stat().st_size > 0
+
+
+def test_a_killed_command_leaves_no_chart_process(tmp_path):
+    """SIGKILL at the run's last chunk (SKFEM_BEAM_KILL_AT): its chart process goes with
+    it (PR_SET_PDEATHSIG), as it does when the command ends normally."""
+    for kill_at, code in (("last-chunk", -signal.SIGKILL), (None, 0)):
+        env = {**os.environ, **({"SKFEM_BEAM_KILL_AT": kill_at} if kill_at else {})}
+        p = subprocess.Popen([sys.executable, "-m", "skfem_beam.cases.flat_obstacles", *ARGS,
+                              "--out", str(tmp_path / str(kill_at))], env=env,
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        time.sleep(0.3)
+        assert servers(p.pid), "the command started no chart process"
+        assert p.wait(timeout=120) == code
+        deadline = time.monotonic() + 5
+        while servers(p.pid) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert servers(p.pid) == [], kill_at
+
+
+def test_commands_that_draw_no_chart_start_no_process():
+    """Only the scenes (``skfem_beam.cases.*``) and ``python -m skfem_beam run`` draw charts."""
+    code = ("import sys; sys.orig_argv = [sys.executable, '-m', *sys.orig_argv[3:]]; "
+            "from skfem_beam import _startup, chart_process; _startup.command_starting(); "
+            "print(chart_process.running()); chart_process.stop()")
+    for command, expected in (("skfem_beam.cases.point_stops --T 1", "True"),
+                              ("skfem_beam run scene.toml", "True"),
+                              ("skfem_beam.sweep", "False"), ("skfem_beam export DIR", "False")):
+        p = subprocess.run([sys.executable, "-c", code, *command.split()], capture_output=True,
+                           text=True, timeout=60)
+        assert p.stdout.strip() == expected, (command, p.stdout, p.stderr)

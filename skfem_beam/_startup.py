@@ -1,7 +1,8 @@
 """A command's first and last moments, when its own signal handlers do not exist.
 
-First: the imports (numpy, scipy, matplotlib, ...) run before ``cli.main_guard``
-installs its handlers, and a Ctrl-C there would end in an ImportError traceback.
+First: the imports (numpy, scipy, numba, ...) run before ``cli.main_guard`` installs its
+handlers, and a Ctrl-C there would end in an ImportError traceback; a scene command also
+starts its chart process then (``chart_process``), to load matplotlib beside them.
 Last: Python's finalisation resets the signal handlers to the default before it tears
 the modules down (~0.2 s with numba and matplotlib loaded), so a SIGTERM then killed
 the finished command silently; a command process therefore runs its exit handlers

@@ -184,24 +184,24 @@ def beam_charts(case, problem, rho_S, stops, extra, observed_x=None):
                 extra(folder, data, run)
             return
         draw(trajectory_chart, folder / "tip_displacement.png", t,
-                         {f"ũ({where}, t)": data["tip_displacement"]},
-                         stops=stops if observed_x is None else (),
-                         title=f"{case}: {what} ({about})")
+             {f"ũ({where}, t)": data["tip_displacement"]},
+             stops=stops if observed_x is None else (),
+             title=f"{case}: {what} ({about})")
         joules = "energy_J" in data         # in J when the mass per length ρS is known
         draw(energy_chart, folder / "energy.png", t, data["energy_J" if joules else "energy"],
-                     title=f"{case}: discrete energy ½E_β ({about})",
-                     work={k: data[f"work_{k}" + ("_J" if joules else "")] for k in WORK_TERMS},
-                     joules=joules)
+             title=f"{case}: discrete energy ½E_β ({about})",
+             work={k: data[f"work_{k}" + ("_J" if joules else "")] for k in WORK_TERMS},
+             joules=joules)
         if np.any(data["contact_force"]):
             # in newtons when the mass per length ρS is known (the column is λ·ρS)
             newtons = "contact_force_N" in data
             force = data["contact_force_N" if newtons else "contact_force"]
             draw(trajectory_chart, folder / "contact_force.png", t, {"net contact force λ": force},
-                             title=f"{case}: net contact force on the beam ({about})"
-                                   + (f", ρS={rho_S:g} kg/m" if newtons else ""),
-                             ylabel="force (N)" if newtons else "force per mass (m²/s² = N per kg/m)")
+                 title=f"{case}: net contact force on the beam ({about})"
+                       + (f", ρS={rho_S:g} kg/m" if newtons else ""),
+                 ylabel="force (N)" if newtons else "force per mass (m²/s² = N per kg/m)")
         draw(shape_chart, folder / "beam_shapes.png", shapes(run.result()),
-                    title=f"{case}: displacement ũ(x, t) at saved times ({about})")
+             title=f"{case}: displacement ũ(x, t) at saved times ({about})")
         if extra is not None:
             extra(folder, data, run)
     return finish
@@ -213,29 +213,29 @@ def two_plane_charts(folder, data, run, case, problem, about, where, what, rho_S
     from ..output.supports import orbit_chart
     t = data["t"]
     draw(trajectory_chart, folder / "tip_displacement.png", t,
-                     {f"v({where}, t)": data["tip_displacement_v"],
-                      f"w({where}, t)": data["tip_displacement_w"]},
-                     title=f"{case}: {what}, both planes ({about})")
+         {f"v({where}, t)": data["tip_displacement_v"],
+          f"w({where}, t)": data["tip_displacement_w"]},
+         title=f"{case}: {what}, both planes ({about})")
     joules = "energy_J" in data
     draw(energy_chart, folder / "energy.png", t, data["energy_J" if joules else "energy"],
-                 title=f"{case}: discrete energy ½E_β ({about})",
-                 work={k: data[f"work_{k}" + ("_J" if joules else "")]
-                       for k in run.work_terms}, joules=joules)
+         title=f"{case}: discrete energy ½E_β ({about})",
+         work={k: data[f"work_{k}" + ("_J" if joules else "")]
+               for k in run.work_terms}, joules=joules)
     newtons = "contact_force_v_N" in data
     forces = {f"net contact force, {p}": data[f"contact_force_{p}" + ("_N" if newtons else "")]
               for p in ("v", "w")}
     if any(np.any(f) for f in forces.values()):
         draw(trajectory_chart, folder / "contact_force.png", t, forces,
-                         title=f"{case}: net contact force on the beam ({about})",
-                         ylabel="force (N)" if newtons else
-                         "force per mass (m²/s² = N per kg/m)")
+             title=f"{case}: net contact force on the beam ({about})",
+             ylabel="force (N)" if newtons else
+             "force per mass (m²/s² = N per kg/m)")
     for h in problem.holes:
         for x in problem.nodes[h.acts_at(problem.nodes, problem.beam.L)]:
             key = f"hole_{float(x):g}_displacement"
             draw(orbit_chart, folder / f"orbit_{float(x):g}.png", data[f"{key}_v"],
-                        data[f"{key}_w"], h.hole.outline(),
-                        f"{case}: orbit at x = {float(x):g} m, {h.hole.shape} hole\n({about})",
-                        h.hole.centre)
+                 data[f"{key}_w"], h.hole.outline(),
+                 f"{case}: orbit at x = {float(x):g} m, {h.hole.shape} hole\n({about})",
+                 h.hole.centre)
 
 
 def units(rho_S, system) -> dict:

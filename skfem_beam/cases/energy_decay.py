@@ -8,7 +8,6 @@ energy history ½E_β^n of --beta and of --compare-beta side by side.
 """
 from __future__ import annotations
 
-import numpy as np
 
 from .. import cli, scenes
 from ..scheme import solve
@@ -39,9 +38,9 @@ def main(argv=None) -> int:
             columns[f"energy_beta_{other:g}"] = r2.energy[:data["t"].size]
         write_timeseries(folder, columns, "energy.csv")
         draw(trajectory_chart, folder / "energy_decay.png", data["t"],
-                         {k: v for k, v in columns.items() if k != "t"},
-                         title=f"discrete energy ½E_β, f = 0 (J={pb.J}, {pb.element}, Δt={args.dt:g} s)",
-                         ylabel="energy (m³/s²)")
+             {k: v for k, v in columns.items() if k != "t"},
+             title=f"discrete energy ½E_β, f = 0 (J={pb.J}, {pb.element}, Δt={args.dt:g} s)",
+             ylabel="energy (m³/s²)")
 
     config = {"f": "0", "u0": "0.005 x²", "v0": "-x", "g": "±(0.2 + 0.3 (x − L/2)²)"}
     return run_beam_case("energy_decay", pb, cli.spec(args, config), extra=energy_files)

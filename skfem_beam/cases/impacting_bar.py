@@ -156,16 +156,16 @@ def bar_charts(bar: Bar, series, exact, T: float):
         title = (f"{bar.obstacle} obstacle{f' k={bar.k:g}' if spring else ''}{side}, f={bar.f:g}, "
                  f"N={bar.N}, Δt={run.dt:g}, {run.label}, {bar.mass} mass")
         draw(compare_chart, folder / "displacement.png", b.t, {"u(0, t)": b.u0, "u(L, t)": b.uL},
-                      {"u(0, t) exact": data.get("u_0_exact"),
-                       "u(L, t) exact": data.get("u_L_exact")}, title, "displacement (m)")
+             {"u(0, t) exact": data.get("u_0_exact"),
+              "u(L, t) exact": data.get("u_L_exact")}, title, "displacement (m)")
         draw(compare_chart, folder / "contact_force.png", b.t, {"reaction R": b.force},
-                      {"R exact": data.get("contact_force_exact")}, title,
-                      "R (Pa)" if bar.A is None else "R (N)")
+             {"R exact": data.get("contact_force_exact")}, title,
+             "R (Pa)" if bar.A is None else "R (N)")
         draw(compare_chart, folder / "energy.png", b.t,
-                      {"kinetic": b.kinetic, "strain": b.strain, "obstacle": b.obstacle,
-                       "total": b.energy + b.load_potential},
-                      {"exact total": data.get("energy_exact")}, title,
-                      "energy (J/m²)" if bar.A is None else "energy (J)")
+             {"kinetic": b.kinetic, "strain": b.strain, "obstacle": b.obstacle,
+              "total": b.energy + b.load_potential},
+             {"exact total": data.get("energy_exact")}, title,
+             "energy (J/m²)" if bar.A is None else "energy (J)")
         return {
             "T": float(b.t[-1]), "steps": min(run.n, series.n_steps),
             "max_penetration": b.penetration, "max_nodal_violation": b.penetration,

@@ -160,7 +160,7 @@ class BetaScheme:
         self.Orows = observers(system)
         self.ops = self._ops(params)
         self.st = self._state()
-        # the loop's hole kinematics: compiled only for a run with holes (kernels.run_steps)
+        # the loop's code for holes and massless rows: compiled for a run that has them
         self.holes = self.st.hk if self.ops.Nc.shape[0] else None
         self.massless = self.st.ez if self.ops.Zr.size else None
 

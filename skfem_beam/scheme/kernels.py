@@ -152,7 +152,7 @@ def free_step(ops, st, Gn, H, row, massless):
         massless_force(ops.Zr, ops.Zp, ops.Zi, ops.Zx, ops.beta, st.Ku, st.u_prev, H, row,
                        massless)
         for q in range(ops.Zr.size):
-            x[ops.Zr[q]] += dt2 * st.ez[q]
+            x[ops.Zr[q]] += dt2 * massless[q]
     band_solve(ops.Achol, x)
     for i in range(x.size):
         x[i] += 2.0 * u_cur[i] - u_prev[i]
@@ -457,8 +457,9 @@ def run_steps(law, explicit, ops, st, out, n0, n1, inputs, Ebound, holes, massle
     the law's explicit force, the free step, the law, then `finish_step`, the impact
     events, the diagnostics and `stop_code`.  ``inputs`` (Inputs) hold Gⁿ and φ(t_{n+1})
     at row n − n0.  ``holes``: None, or the scratch of `hole_kinematics` (two planes with
-    holes); numba prunes the branch of a None argument before typing it, so a run without
-    holes does not compile `hole_kinematics` (0.5 s of a first run).
+    holes); ``massless``: None, or State.ez (quasi-static massless rows).  numba prunes the
+    branch of a None argument before typing it, so a run without holes or massless rows
+    does not compile their code (0.5 and 0.15 s of a first run).
 
     Returns 0, FAILED (the law failed at step counters[3]), UNSTABLE (the energy saved
     at state counters[3] is non-finite or above Ebound) or EVENTS_FULL (stopped after

@@ -28,7 +28,20 @@ import signal
 import subprocess
 import sys
 
-_SERVE = "import sys, skfem_beam.chart_process as c; c.serve(int(sys.argv[1]))"
+# The chart process loads the chart functions (output/charts.py: numpy and matplotlib) and
+# nothing else of the package: the packages' __init__ would import numba, scipy and
+# scikit-fem (~100 MB and 0.5 s it has no use for).  They are entered in sys.modules as
+# bare modules with their folder, so that importing a submodule does not run them.
+_SERVE = """
+import sys, types
+for name, path in (("skfem_beam", sys.argv[2]), ("skfem_beam.output", sys.argv[3])):
+    package = types.ModuleType(name)
+    package.__path__ = [path]
+    sys.modules[name] = package
+from skfem_beam.chart_process import serve
+serve(int(sys.argv[1]))
+"""
+_HERE = os.path.dirname(os.path.abspath(__file__))
 _process: subprocess.Popen | None = None
 _pending: list = []        # the jobs sent and not yet reported drawn, in order
 PIPE_BYTES = 1 << 20       # Linux's default limit for an unprivileged process
@@ -40,13 +53,10 @@ def start() -> None:
     global _process
     if _process is not None:
         return
-    # the child imports the same package: this process's sys.path, '' as the cwd
-    path = os.pathsep.join(os.path.abspath(p or os.curdir) for p in sys.path)
     try:
         _process = subprocess.Popen(
-            [sys.executable, "-c", _SERVE, str(os.getpid())], stdin=subprocess.PIPE,
-            stdout=subprocess.PIPE, env={**os.environ, "PYTHONPATH": path},
-            start_new_session=True)
+            [sys.executable, "-c", _SERVE, str(os.getpid()), _HERE, os.path.join(_HERE, "output")],
+            stdin=subprocess.PIPE, stdout=subprocess.PIPE, start_new_session=True)
     except OSError:
         return
     try:    # room for a short run's charts while the process is still importing (Linux)
@@ -131,7 +141,6 @@ def serve(parent: int) -> None:
     os.dup2(2, 1)                       # print() and warnings go to the command's stderr
     import matplotlib.pyplot  # noqa: F401  (what every chart needs, loaded while waiting)
     import skfem_beam.output.charts  # noqa: F401
-    import skfem_beam.output.supports  # noqa: F401
     while True:
         try:
             chart, args, kwargs = pickle.load(sys.stdin.buffer)

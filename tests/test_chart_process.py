@@ -59,6 +59,15 @@ def test_a_command_draws_in_its_chart_process_the_pictures_drawn_in_it(tmp_path)
         assert a.shape == b.shape and np.abs(a - b).max() == 0.0, name
 
 
+def test_the_chart_process_loads_matplotlib_and_not_the_package(process):
+    """Its charts need numpy and matplotlib only: none of numba, scipy, scikit-fem, h5py
+    (~100 MB and 0.5 s of imports the package's __init__ would cost it)."""
+    process.draw(exec, "import sys\n"
+                 "loaded = {'numba', 'scipy', 'skfem', 'h5py', 'meshio'} & set(sys.modules)\n"
+                 "assert 'matplotlib.pyplot' in sys.modules and not loaded, loaded")
+    process.wait()
+
+
 def test_a_chart_error_is_raised_in_the_command_with_its_errno(tmp_path, process):
     t = np.linspace(0, 1, 11)
     process.draw(trajectory_chart, tmp_path / "no such folder" / "x.png", t, {"y": t})

@@ -9,7 +9,8 @@ import numpy as np
 from .. import cli
 from ..chart_process import draw
 from ..scheme.kernels import CONTACT_STEPS
-from ..output.charts import energy_chart, shape_chart, shapes, trajectory_chart
+from ..output.charts import (energy_chart, orbit_chart, shape_chart, shapes,
+                             trajectory_chart)
 from ..output.events import beam_impacts
 from ..output.fields import physical_at, physical_tip
 from ..output.probes import probe_columns, probe_units
@@ -210,7 +211,6 @@ def beam_charts(case, problem, rho_S, stops, extra, observed_x=None):
 def two_plane_charts(folder, data, run, case, problem, about, where, what, rho_S) -> None:
     """A two-plane run's charts: v and w at the observed point, the energy, the net
     contact force per plane, and an orbit per hole node (w against v, the wall drawn)."""
-    from ..output.supports import orbit_chart
     t = data["t"]
     draw(trajectory_chart, folder / "tip_displacement.png", t,
          {f"v({where}, t)": data["tip_displacement_v"],

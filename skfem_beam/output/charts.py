@@ -209,6 +209,18 @@ def shape_chart(path, shapes: Shapes, title=""):
         _frame(ax, "x (m)", "ũ (m)", title, fontsize=9)
 
 
+def orbit_chart(path, v, w, outline, title: str, centre=(0.0, 0.0)) -> None:
+    """w against v at a support's node, with its hole's wall (``outline``, (k, 2))."""
+    with figure(path, figsize=(5.5, 5.5)) as (fig, ax):
+        ax.plot(np.asarray(v) * 1e3, np.asarray(w) * 1e3, lw=0.6, color="C0", label="orbit")
+        if len(outline):
+            o = np.asarray(outline) * 1e3
+            ax.plot(o[:, 0], o[:, 1], color="k", lw=1.2, label="hole wall")
+        ax.plot([centre[0] * 1e3], [centre[1] * 1e3], "k+")
+        ax.set_aspect("equal", adjustable="datalim")
+        _frame(ax, "v (mm)", "w (mm)", title, fontsize=9)
+
+
 def penetration_chart(path, rows: list[dict], title=""):
     """Maximum penetration between nodes against J (log–log), one line per scene/element/side."""
     with figure(path, figsize=(7, 4.5)) as (fig, ax):

@@ -1,7 +1,7 @@
 """Two planes: what a pipe engineer reads per support (a hole or flat obstacles at a
 node): impacts, the time in contact, where on the hole the impacts land, and the work
-rates that wear it, in summary.json's ``impact_statistics.supports``; and the orbit
-chart, the node's w against v with the hole drawn.
+rates that wear it, in summary.json's ``impact_statistics.supports`` (the orbit chart,
+the node's w against v with the hole drawn, is ``charts.orbit_chart``).
 
 Work rates (W, when the beam's mass per length ρS is known; else per unit mass per
 length, m³/s³), over the run's time T:
@@ -34,7 +34,6 @@ import numpy as np
 
 from ..checks import check_positive
 from ..scheme.kernels import SECTORS
-from .charts import _frame, figure
 
 YEAR = 365.25 * 86400.0     # s
 
@@ -137,15 +136,3 @@ def work_rate_units(newtons: bool, wear: Wear | None = None) -> dict:
             "normal_velocity": "m/s, the node's velocity before the impact along the wall's "
                                "outward normal (> 0: towards the wall)",
             "tangential_velocity": "m/s, its component along the wall, counter-clockwise"}
-
-
-def orbit_chart(path, v, w, outline, title: str, centre=(0.0, 0.0)) -> None:
-    """w against v at a support's node, with its hole's wall (``outline``, (k, 2))."""
-    with figure(path, figsize=(5.5, 5.5)) as (fig, ax):
-        ax.plot(np.asarray(v) * 1e3, np.asarray(w) * 1e3, lw=0.6, color="C0", label="orbit")
-        if len(outline):
-            o = np.asarray(outline) * 1e3
-            ax.plot(o[:, 0], o[:, 1], color="k", lw=1.2, label="hole wall")
-        ax.plot([centre[0] * 1e3], [centre[1] * 1e3], "k+")
-        ax.set_aspect("equal", adjustable="datalim")
-        _frame(ax, "v (mm)", "w (mm)", title, fontsize=9)

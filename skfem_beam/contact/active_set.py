@@ -331,7 +331,12 @@ def exact_finish(D, yf, lo, hi, duals, state, mu, scale, engine, tol=REPAIR_TOL)
     constraints exactly.  Returns the number of such repairs (0 or 1); a residual
     above tol·scale (REPAIR_TOL unless the engine says) means the engine's answer was
     wrong: SolverError."""
-    res = finish_on_duals(D, yf, lo, hi, duals, state, mu)
+    return repair(finish_on_duals(D, yf, lo, hi, duals, state, mu), D, yf, lo, hi, state, mu,
+                  scale, engine, tol)
+
+
+def repair(res, D, yf, lo, hi, state, mu, scale, engine, tol=REPAIR_TOL) -> int:
+    """What `exact_finish` does with the KKT residual ``res`` of μ on an engine's set."""
     if res <= 0.0:
         return 0
     if res > tol * scale:

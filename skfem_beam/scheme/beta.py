@@ -10,6 +10,7 @@ import numpy as np
 import scipy.sparse
 from numba import typeof, types
 from numba.core import event
+from numba.core.dispatcher import LiftedCode
 
 from ..contact import ContactLaw, StepData, resolve
 from ..contact.base import NoContact, no_explicit
@@ -30,10 +31,14 @@ _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(4)
 class _CompileNotice(event.Listener):
     """One line on stderr, once per process, when numba starts compiling: the first run
     of a fresh install compiles the kernels (tens of seconds); later runs load them from
-    numba's cache and compile nothing, so they say nothing."""
+    numba's cache and compile nothing, so they say nothing.  The object-mode block through
+    which the loop calls a law solved in Python (kernels.run_steps_python) cannot be cached
+    and compiles in every run that reaches a contact (25 ms): it says nothing either."""
     said = False
 
     def on_start(self, ev):
+        if isinstance((ev.data or {}).get("dispatcher"), LiftedCode):
+            return
         if not _CompileNotice.said:
             _CompileNotice.said = True
             print("compiling numerical kernels (first run only) …", file=sys.stderr, flush=True)

@@ -86,7 +86,7 @@ class OSQPSolver:
             raise SolverError(f"OSQP returned status '{info.status}' after {info.iter} "
                               f"iterations")
         mu = np.empty(self.lo.size)
-        res = duals_and_finish(*self.ccsr, engine.solution.x, engine.solution.y, self.z,
+        res = duals_and_finish(self.ccsr, engine.solution.x, engine.solution.y, self.z,
                                self.lo, self.hi, self.s, self.duals, self.D, y_free,
                                self.state, mu)
         self.repairs += repair(res, self.D, y_free, self.lo, self.hi, self.state, mu,
@@ -111,10 +111,10 @@ def moved(lo, hi, lo_was, hi_was) -> bool:
 
 
 @njit(cache=True)
-def duals_and_finish(Cp, Ci, Cx, x, y, z, lo, hi, s, duals, D, yf, state, mu):
-    """z ← C x̂, OSQP's set by `guess_active`, μ exactly on it (`finish_on_duals`): its
-    KKT residual (`active_set.repair` says what follows)."""
-    csr_product(Cp, Ci, Cx, x, z)
+def duals_and_finish(ccsr, x, y, z, lo, hi, s, duals, D, yf, state, mu):
+    """z ← C x̂ (``ccsr``: C's CSR arrays), OSQP's set by `guess_active`, μ exactly on it
+    (`finish_on_duals`): its KKT residual (`active_set.repair` says what follows)."""
+    csr_product(ccsr[0], ccsr[1], ccsr[2], x, z)
     guess_active(z, y, lo, hi, s, duals)
     return finish_on_duals(D, yf, lo, hi, duals, state, mu)
 

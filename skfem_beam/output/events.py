@@ -166,10 +166,14 @@ def write_impacts(folder: Path, run, units: dict, scale: float = 1.0, sign: floa
                       "max_violation": "m", "open": "1 = not over at the last state",
                       "contact_fraction": "of the run's time"}
     if planes == 2:
+        from ..scheme.beta import disk_rows
         from .supports import support_statistics, work_rate_units
         stats["supports"] = support_statistics(table, run, scale, duration, last * run.dt,
                                                wear)
         stats["units"].update(work_rate_units(units["force"] == "N", wear))
+        if disk_rows(s).size:       # a round hole's event is its pair's (Run.impact_events)
+            stats["units"]["peak_force"] += "; a round hole's: the force's magnitude"
+            stats["units"]["impulse"] += "; a round hole's: Σ|force|Δt"
     if friction:
         stats["units"].update({"slip": "m, Σ|u_t|Δt over the contact",
                                "friction_impulse": i + ", Σ|p_t| over the contact"})
@@ -177,8 +181,6 @@ def write_impacts(folder: Path, run, units: dict, scale: float = 1.0, sign: floa
         return {"impact_statistics": stats, "friction": {
             "coefficients": sorted({float(m) for m in run.system.friction if m > 0}),
             "nsgs_tolerance": NSGS_TOL, "nsgs_max_residual": float(run.st.fres[1])}}
-        stats["units"]["peak_force"] += "; a round hole's: the force's magnitude"
-        stats["units"]["impulse"] += "; a round hole's: Σ|force|Δt"
     return {"impact_statistics": stats}
 
 

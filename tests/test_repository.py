@@ -38,3 +38,20 @@ def test_no_file_cites_a_document_outside_the_repository():
             cites.append(f"{path.relative_to(ROOT)}: {m.group()}")
     assert not cites, cites
     assert (ROOT / "docs" / "design.md").is_file()
+
+
+def test_every_cited_repository_path_exists():
+    # a docstring or a doc page that sends its reader to a test or a module names a file
+    # that is there (a docstring once named a test file that never existed; NAME.toml
+    # and other capitalised placeholders are not paths)
+    cited = re.compile(r"\b((?:tests|skfem_beam|docs|notebooks|meshes)/[\w/.-]+\.(?:py|md|toml"
+                       r"|ipynb|rst|txt|json))\b")
+    missing = []
+    for path in tracked("*.py", "*.md", "*.rst", "*.toml", ".ci/*"):
+        if path.name == "test_repository.py":
+            continue
+        for m in cited.finditer(path.read_text(errors="replace")):
+            placeholder = re.search(r"/[A-Z]+\.\w+$", m.group(1))
+            if not placeholder and not (ROOT / m.group(1)).exists():
+                missing.append(f"{path.relative_to(ROOT)}: {m.group(1)}")
+    assert not missing, missing

@@ -36,6 +36,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .round_hole import radial
+
 SEPARATE, STICK, SLIP_FORWARD, SLIP_BACKWARD = 0, 1, 2, 3
 MAX_SWEEPS = 10000
 DRIFT = 0.1
@@ -96,12 +98,10 @@ def nsgs(D, rows, step, out):
             hi_e[j] = 0.0 if yp[j] >= hi[j] else inf
         elif kind[j] > 0:
             b = kind[j]
-            ny, nz = yp[j] - 0.5 * (lo[j] + hi[j]), yp[b] - 0.5 * (lo[b] + hi[b])
-            rho = np.hypot(ny, nz)
+            ny, nz, rho, r = radial(yp[j], yp[b], lo[j], hi[j], lo[b], hi[b])
             fc[j, 4], fc[j, 5] = (ny / rho, nz / rho) if rho > 0.0 else (1.0, 0.0)
             fc[j, 0] = fc[j, 1] = 0.0
-            r = 0.5 * (hi[j] - lo[j])
-            now = np.hypot(ynow[j] - 0.5 * (lo[j] + hi[j]), ynow[b] - 0.5 * (lo[b] + hi[b]))
+            now = radial(ynow[j], ynow[b], lo[j], hi[j], lo[b], hi[b])[2]
             gap[j] = DRIFT * max(now - r, 0.0) / theta_dt
             on[j] = rho >= r or now >= r
     local = np.empty(4)

@@ -38,7 +38,7 @@ from ..checks import check_nonnegative, check_positive
 from ..errors import InputError
 from .active_set import data_scale
 from .base import ContactLaw, compiled_explicit, compiled_law
-from .round_hole import disk_params, kinds_of
+from .round_hole import disk_params, kinds_of, radial
 
 DISKS_AT = 5      # params[DISKS_AT:]: the disk pairs (round_hole.disk_params)
 
@@ -97,13 +97,6 @@ def compliance_solve(D, yf, lo, hi, c, state, mu, d, y_cur, y_prev):
         if d != 0.0 and damped(y_cur[j], lo[j], hi[j]):
             mu[j] -= d * (y[j] - y_prev[j])
     return it
-
-
-@njit(cache=True)
-def radial(ya, yb, lo_a, hi_a, lo_b, hi_b):
-    """(p_a, p_b, |p|, r): the pair's offset from its hole's centre and the radius."""
-    pa, pb = ya - 0.5 * (lo_a + hi_a), yb - 0.5 * (lo_b + hi_b)
-    return pa, pb, np.hypot(pa, pb), 0.5 * (hi_a - lo_a)
 
 
 @njit(cache=True)

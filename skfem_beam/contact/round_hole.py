@@ -23,7 +23,7 @@ Lemma 4.1), which converges for SPD D (a block coordinate descent of the strictl
 problem), until a sweep moves no value by more than round-off; then a Newton step on the
 active set's KKT equations removes what the linear rate left (`polish`).  Checked
 against Clarabel (an interior-point conic solver) on recorded step problems
-(tests/test_round_hole.py).
+(tests/test_two_planes.py).
 """
 from __future__ import annotations
 
@@ -39,6 +39,14 @@ internal = njit(cache=True)   # also called from Python: the start step runs the
 MAX_SWEEPS = 20000
 SWEEP_TOL = 1e-14        # a sweep moved no value y by more than this × the data's scale
 #                          (a few ulps: the values are recomputed with that round-off)
+
+
+@njit(cache=True)
+def radial(ya, yb, lo_a, hi_a, lo_b, hi_b):
+    """(p_a, p_b, |p|, r): the pair's offset from its hole's centre and the radius (the
+    centre is the middle of the pair's box [lo, hi], the radius its half-width)."""
+    pa, pb = ya - 0.5 * (lo_a + hi_a), yb - 0.5 * (lo_b + hi_b)
+    return pa, pb, np.hypot(pa, pb), 0.5 * (hi_a - lo_a)
 
 
 @njit(cache=True)
@@ -119,9 +127,7 @@ def _polish(D, yf, lo, hi, kind, mu, tol):
                 i += 1
             else:
                 a, b = j, kind[j]
-                ca, cb = 0.5 * (lo[a] + hi[a]), 0.5 * (lo[b] + hi[b])
-                r = 0.5 * (hi[a] - lo[a])
-                pa, pb = y[a] - ca, y[b] - cb
+                pa, pb, _, r = radial(y[a], y[b], lo[a], hi[a], lo[b], hi[b])
                 F[i] = 0.5 * (pa * pa + pb * pb - r * r) / r
                 F[i + 1] = mu_new[a] * pb - mu_new[b] * pa
                 for q in range(k):
@@ -146,13 +152,11 @@ def _polish(D, yf, lo, hi, kind, mu, tol):
                 return False
         elif kind[j] > 0:
             a, b = j, kind[j]
-            ca, cb = 0.5 * (lo[a] + hi[a]), 0.5 * (lo[b] + hi[b])
-            r = 0.5 * (hi[a] - lo[a])
-            pa, pb = y[a] - ca, y[b] - cb
+            pa, pb, rho, r = radial(y[a], y[b], lo[a], hi[a], lo[b], hi[b])
             if mu[a] != 0.0 or mu[b] != 0.0:
                 if mu_new[a] * pa + mu_new[b] * pb >= 0.0:    # must push inwards
                     return False
-            elif np.hypot(pa, pb) > r + tol:
+            elif rho > r + tol:
                 return False
     for j in range(m):
         mu[j] = mu_new[j]
@@ -192,9 +196,7 @@ def cone_solve(D, yf, lo, hi, kind, mu, active):
                 a, b = j, kind[j]
                 ya = y[a] - D[a, a] * mu[a] - D[a, b] * mu[b]
                 yb = y[b] - D[b, a] * mu[a] - D[b, b] * mu[b]
-                ca, cb = 0.5 * (lo[a] + hi[a]), 0.5 * (lo[b] + hi[b])
-                r = 0.5 * (hi[a] - lo[a])
-                za, zb = ya - ca, yb - cb
+                za, zb, _, r = radial(ya, yb, lo[a], hi[a], lo[b], hi[b])
                 if za * za + zb * zb <= r * r:
                     na, nb = 0.0, 0.0
                 else:

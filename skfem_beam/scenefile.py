@@ -901,6 +901,7 @@ def modes_main(argv) -> int:
     """``python -m skfem_beam modes``: natural frequencies of the scene's beam."""
     from .cli import Parser
     from .modes import modes
+    from .two_planes import plane_problems
     p = Parser(prog="python -m skfem_beam modes",
                description="Natural frequencies and mode shapes of a scene file's beam, with "
                            "its ends and supports (obstacles ignored).")
@@ -922,10 +923,7 @@ def modes_main(argv) -> int:
     problem = scene.problem
     # two planes: each plane's modes (its own EI), the lowest n of both, with their plane
     planes = [("", modes(problem, args.n))] if problem.planes == 1 else \
-        [(p, modes(replace(problem, planes=1, holes=(), load_w=Load(),
-                           support=Support(at=problem.support.at),
-                           beam=problem.beam if p == "v" else problem.beam.plane_w()), args.n))
-         for p in ("v", "w")]
+        [(p, modes(one, args.n)) for p, one in zip("vw", plane_problems(problem))]
     rows = sorted(((m.f[i], m.omega[i], p, m.shapes[:, i]) for p, m in planes
                    for i in range(m.f.size)), key=lambda r: r[0])[:args.n]
     two = problem.planes == 2

@@ -49,16 +49,25 @@ def _pad(rows, n: int, second: bool):
     return sp.hstack([zero, rows] if second else [rows, zero], format="csr")
 
 
+def plane_problems(problem):
+    """(pv, pw): the one-plane problems of a ``planes = 2`` BeamProblem's planes, each with
+    its own bending stiffness, loads and share of the support's motion (the flat
+    obstacles act in the first; the holes are the caller's)."""
+    dy, dz = problem.support.direction
+    one = dict(planes=1, holes=(), load_w=Load())
+    pv = replace(problem, **one, support=along(problem.support, dy))
+    pw = replace(problem, **one, load=problem.load_w, obstacles=Obstacles(),
+                 beam=problem.beam.plane_w(), support=along(problem.support, dz),
+                 initial=InitialState(fixed_frame=problem.initial.fixed_frame))
+    return pv, pw
+
+
 def two_plane_system(problem, samples_per_element: int = 20):
     """The semi-discrete system of a ``planes = 2`` BeamProblem (module docstring)."""
     from .semidiscrete import SemiDiscrete, _snap, beam_system
     sup = problem.support
     dy, dz = sup.direction
-    one = dict(planes=1, holes=(), load_w=Load())
-    pv = replace(problem, **one, support=along(sup, dy))
-    pw = replace(problem, **one, load=problem.load_w, obstacles=Obstacles(),
-                 beam=problem.beam.plane_w(), support=along(sup, dz),
-                 initial=InitialState(fixed_frame=problem.initial.fixed_frame))
+    pv, pw = plane_problems(problem)
     sv, sw = beam_system(pv, samples_per_element), beam_system(pw, samples_per_element)
     space, n = sv.space, sv.n
     lift = sv.view.lift or sw.view.lift

@@ -13,9 +13,9 @@ import pytest
 from skfem_beam import beam_system, scenes, solve
 from skfem_beam.bar import Bar, bar_system
 from skfem_beam.errors import InputError
-from skfem_beam.output.fields import FieldWriter, lifting_dd, sample_line, write_fields
+from skfem_beam.output.fields import FieldWriter, sample_line, write_fields
 from skfem_beam.meshes import PAPER_MESHES, load_mesh, write_mesh
-from skfem_beam.problem import Beam, BeamProblem, Load, Obstacles, lifting
+from skfem_beam.problem import Beam, BeamProblem, Load, Obstacles, lifting, lifting_dd
 
 ARRAYS = {"displacement", "displacement_vector", "velocity", "g1", "g2", "contact_force",
           "bending_moment"}

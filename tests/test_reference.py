@@ -1,6 +1,5 @@
 """Today's outputs stay today's outputs: every pinned run (tests/reference/) against the
 arrays stored before the redesign of issue 15, to 1e-12 of each array's largest value."""
-import json
 import sys
 from pathlib import Path
 

@@ -13,7 +13,6 @@ from skfem_beam.cases import flat_obstacles, impacting_bar, point_stops
 from skfem_beam.modes import modes
 from skfem_beam.problem import Beam, Material, Section
 from skfem_beam.scenefile import example, load, modes_main, run_main
-from skfem_beam.scheme import Run
 from skfem_beam.scheme.solve import drive
 from skfem_beam.timefunctions import Table
 

@@ -46,7 +46,6 @@ import scipy.sparse as sp
 from meshio._common import write_xml
 
 from ..errors import InputError
-from ..problem import lifting_dd  # noqa: F401  (h'' of the paper's lifting, kept importable here)
 from ..semidiscrete import SceneView
 
 FORMATS = ("xdmf", "vtu", "both", "none")
@@ -139,7 +138,6 @@ class LineSamples:
         if moment is not None:
             out["bending_moment"] = self.rho_S * self.k2 * moment
         return out
-
 
     def two_plane_fields(self, t: float, u, v, force) -> dict[str, np.ndarray]:
         """Two planes: each plane's ũ as a one-plane field (``displacement_v``, ``_w``,

@@ -129,7 +129,6 @@ class _Scene:
                          line_width=1, render=False)
 
     def frame_camera(self, plotter):
-        h = self.half_height
         plotter.enable_parallel_projection()
         plotter.view_xy()
         # frame the whole scene, whatever the beam does at this time

@@ -124,7 +124,9 @@ def work_rate_units(newtons: bool, wear: Wear | None = None) -> dict:
         "sectors: per 30° of the hole (rad from +v towards +w) the volume and depth "
         "volume/(R·(π/6)·b); K = coefficient m³/(N·m), R = radius, b = land (m), "
         "as given in [wear]")}
-    return {**out, "friction_work_rate": f"{unit}: −(1/T) × the support's friction work","impact_work_rate": f"{unit}: −(1/T)Σ ½λ·(y^(n+1) − y^(n−1)) over the support's "
+    return {**out,
+            "friction_work_rate": f"{unit}: −(1/T) × the support's friction work",
+            "impact_work_rate": f"{unit}: −(1/T)Σ ½λ·(y^(n+1) − y^(n−1)) over the support's "
                                 "rows, the energy its impacts take out of the beam per second",
             "normal_work_rate": f"{unit}: (1/T)∫|F_n||v_t| dt, the contact force times the "
                                 "node's velocity along the wall (the wear work rate)",

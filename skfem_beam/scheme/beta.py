@@ -19,8 +19,7 @@ from ..contact.round_hole import disk_kinds
 from ..errors import InputError, SolverError
 from ..linalg import band_solve, rows_matvec
 from .kernels import (EVENT_COLUMNS, IMPACT_FIELDS, SECTORS, Inputs, Ops, PythonLaw, Series,
-                      State,
-                      csr_product, energy_beta, move_bounds, record, run_steps,
+                      State, csr_product, energy_beta, move_bounds, record, run_steps,
                       run_steps_python)
 from .operators import csr_arrays, load_norms, step_operators
 from .stepping import Stepping

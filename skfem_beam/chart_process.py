@@ -4,7 +4,9 @@ Charts cost a short run most of its time: 0.3 s to import matplotlib and ~0.1 s 
 against a time loop of milliseconds.  A command therefore starts a chart process as it
 starts (:func:`start`, from ``skfem_beam._startup``): it imports matplotlib while the
 command imports its own modules and runs.  :func:`draw` sends it one chart (a module-level
-chart function and its arguments, plain arrays, pickled) and returns; :func:`wait` returns
+chart function and its arguments, plain arrays, pickled) and returns at once (a thread
+writes it into the pipe: a chart's data larger than the pipe waits there for the process
+to read it, not the command, which goes on writing its fields); :func:`wait` returns
 once every chart sent is drawn, raising the first chart's error as drawing it in the
 command would have.  Without a chart process (the Python API, notebooks, tests calling a
 command's ``main``), or should it fail to start or die, :func:`draw` draws here: the same
@@ -24,9 +26,11 @@ from __future__ import annotations
 import atexit
 import os
 import pickle
+import queue
 import signal
 import subprocess
 import sys
+import threading
 
 # The chart process loads the chart functions (output/charts.py: numpy and matplotlib) and
 # nothing else of the package: the packages' __init__ would import numba, scipy and
@@ -43,6 +47,7 @@ serve(int(sys.argv[1]))
 """
 _HERE = os.path.dirname(os.path.abspath(__file__))
 _process: subprocess.Popen | None = None
+_outbox: queue.SimpleQueue | None = None   # pickled jobs for the process's sender thread
 _pending: list = []        # the jobs sent and not yet reported drawn, in order
 PIPE_BYTES = 1 << 20       # Linux's default limit for an unprivileged process
 NICE = 10                  # the chart process's priority below its command's
@@ -50,7 +55,7 @@ NICE = 10                  # the chart process's priority below its command's
 
 def start() -> None:
     """Start the chart process (once; nothing when it cannot be started)."""
-    global _process
+    global _process, _outbox
     if _process is not None:
         return
     try:
@@ -64,7 +69,25 @@ def start() -> None:
         fcntl.fcntl(_process.stdin.fileno(), fcntl.F_SETPIPE_SZ, PIPE_BYTES)
     except (ImportError, AttributeError, OSError):
         pass
+    _outbox = queue.SimpleQueue()
+    threading.Thread(target=_send, args=(_process.stdin, _outbox), daemon=True,
+                     name="chart-sender").start()
     atexit.register(stop)
+
+
+def _send(pipe, outbox) -> None:
+    """The sender thread: write each job into the chart process's pipe, until
+    :func:`stop` sends None.  A failed write means the process died: :func:`wait` then
+    reads the end of its reports and draws what it did not."""
+    while True:
+        data = outbox.get()
+        if data is None:
+            return
+        try:
+            pipe.write(data)
+            pipe.flush()
+        except (OSError, ValueError):     # a broken pipe, or closed by stop()
+            return
 
 
 def running() -> bool:
@@ -80,13 +103,9 @@ def draw(chart, *args, **kwargs) -> None:
         except (pickle.PicklingError, TypeError, AttributeError):
             data = None                 # not a module-level function: drawn here
         if data is not None:
-            try:
-                _process.stdin.write(data)
-                _process.stdin.flush()
-                _pending.append(job)
-                return
-            except OSError:             # it died: this and the pending ones drawn here
-                _lost()
+            _pending.append(job)
+            _outbox.put(data)
+            return
     chart(*args, **kwargs)
 
 
@@ -125,6 +144,8 @@ def _lost(quiet: bool = False) -> None:
 def stop() -> None:
     """End the chart process (killed: it holds nothing to save, and the ~0.1 s of its
     interpreter's teardown would add to its command's)."""
+    if _outbox is not None:
+        _outbox.put(None)               # its sender thread ends
     if _process is not None and _process.poll() is None:
         _process.kill()
         _process.wait()

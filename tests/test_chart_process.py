@@ -5,6 +5,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -76,6 +77,24 @@ def test_a_chart_error_is_raised_in_the_command_with_its_errno(tmp_path, process
         process.wait()
     assert "in the chart process" in "".join(getattr(e.value, "__notes__", []))
     assert (tmp_path / "drawn.png").stat().st_size > 0     # the next chart is still drawn
+
+
+def test_a_chart_larger_than_the_pipe_does_not_hold_the_command(tmp_path, process):
+    """While the chart process is busy (stopped here), ``draw`` of a chart whose data
+    (4 MB) exceed the pipe (1 MiB) returns at once: a thread writes it, and the command
+    goes on writing its fields; the chart is drawn once the process reads it."""
+    t = np.linspace(0, 1, 125_001)
+    os.kill(process._process.pid, signal.SIGSTOP)
+    try:
+        sender = threading.Thread(target=process.draw, args=(
+            trajectory_chart, tmp_path / "big.png", t, {f"y{k}": t * k for k in range(3)}))
+        sender.start()
+        sender.join(timeout=30)
+        assert not sender.is_alive(), "draw() waited for the stopped chart process"
+    finally:
+        os.kill(process._process.pid, signal.SIGCONT)
+    process.wait()
+    assert (tmp_path / "big.png").stat().st_size > 0 and not process._pending
 
 
 def test_charts_of_a_process_that_died_are_drawn_here(tmp_path, process):

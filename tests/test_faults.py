@@ -15,6 +15,7 @@ import subprocess
 import sys
 import time
 
+import meshio
 import numpy as np
 import pytest
 
@@ -160,9 +161,12 @@ class GivesUp(ContactLaw):
 
 def test_failed_solver_keeps_the_impacts_so_far(tmp_path, monkeypatch, capsys):
     """A solver failing at its 430th call (a step in contact, 6 tenths into the run):
-    exit 3, status "failed", and impacts.csv holds the events up to the state before the
-    failed step, their rows those of the same run with the compiled projection."""
-    argv = ["--dt", "1e-4", "--T", "1", "--flush-every", "200", "--format", "none"]
+    exit 3, status "failed", impacts.csv holds the events up to the state before the
+    failed step, their rows those of the same run with the compiled projection, and the
+    field series the frames up to the last whole chunk (a run's first second keeps its
+    frames in memory: the failure writes them, series._Stream)."""
+    argv = ["--dt", "1e-4", "--T", "1", "--flush-every", "200", "--format", "xdmf",
+            "--frames", "10"]
     ref = tmp_path / "ref"
     assert exit_code(point_stops.main, argv + ["--out", str(ref)]) == 0
     monkeypatch.setattr(PositionLevel, "build", lambda self, system, stepping:
@@ -179,6 +183,13 @@ def test_failed_solver_keeps_the_impacts_so_far(tmp_path, monkeypatch, capsys):
     assert imp["t_start"].size > 10 and imp["t_end"].max() == pytest.approx(t_fail - 1e-4) \
         or imp["open"].sum() == 0
     assert impacts_so_far(out, ref, t_fail) >= imp["t_start"].size - 1
+    frames = []
+    with meshio.xdmf.TimeSeriesReader(str(out / "fields.xdmf")) as r:
+        r.read_points_cells()
+        for k in range(r.num_steps):
+            frames.append(r.read_data(k)[0])
+    assert frames == pytest.approx([0.1 * k for k in range(s["steps"] // 1000 + 1)])
+    assert len(frames) >= 5
 
 
 HOLD = ("import fcntl, os, sys, time; fd = os.open(sys.argv[1], os.O_RDWR | os.O_CREAT); "

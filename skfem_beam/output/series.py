@@ -631,8 +631,8 @@ class _Stream:
             self.on_chunk(run)              # state 1 (and, on resume, the frames so far)
             try:
                 drive(run, chunk=self.options.flush_every, on_chunk=self.on_chunk)
-            except SolverError:
-                self.write_frames()         # those of the whole chunks (class docstring)
+            except (SolverError, InputError):   # a failed step (not a write refused: no
+                self.write_frames()             # more writes) keeps the whole chunks' frames
                 raise
             data = self.rows.data()
             entries = outcome(run.result(), data)

@@ -388,7 +388,6 @@ class BetaScheme:
         finally:
             PythonLaw.solver = PythonLaw.state = None
 
-
     def restored(self) -> None:
         """After the checkpoint's fields were put back: C uⁿ⁻¹, C uⁿ from them."""
         ops, st = self.ops, self.st

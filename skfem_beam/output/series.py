@@ -628,7 +628,7 @@ class _Stream:
                                    list(series.columns(run, 0, 0)), keep=self.ck,
                                    limit=None if series.keep_all else KEEP_ROWS)
             self.fields = _Fields(self.folder.path, run, fmt, series) if fmt != "none" else None
-            self.on_chunk(run)              # state 1 (and, on resume, the frames so far)
+            self.on_chunk(run)              # state 1's row (on resume: the rows so far)
             try:
                 drive(run, chunk=self.options.flush_every, on_chunk=self.on_chunk)
             except (SolverError, InputError):   # a failed step (not a write refused: no

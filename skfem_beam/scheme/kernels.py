@@ -518,10 +518,10 @@ def _solve_in_python() -> int:
 @njit(cache=True)
 def python_law() -> int:
     """`_solve_in_python` from compiled code.  A function of its own: an object-mode block
-    inside `run_steps_python` made each of its steps with a call 11-14 µs slower (the
-    loop around it lost its compiled speed: OSQP on flat J = 40 took 25 µs a step, 5.1×
-    the active set; measured with a Python law returning μ = 0, 17.6 against 6.1 ms for
-    1,000 calls, 7.3 ms with the block here)."""
+    inside `run_steps_python` made each of its steps with a call 11-14 µs slower, though
+    the call alone costs 0.55 µs in a small loop (why, not found).  OSQP on flat J = 40
+    took 25 µs a step, 5.1× the active set; a Python law returning μ = 0 took 17.6 ms
+    for 1,000 calls against 6.1 ms without the block, 7.3 ms with the block here."""
     with objmode(its="int64"):
         its = _solve_in_python()
     return its

@@ -42,6 +42,10 @@ def command_starting() -> None:
     (`exit_on_signals`), and one that draws charts starts its chart process now, to load
     matplotlib beside the command's own imports."""
     exit_on_signals()
+    # LLVM at -O1 for what a first run compiles: the loop and the laws step as fast as at
+    # numba's default -O3 and compile in less time (docs/design.md, "The whole command");
+    # numba reads it at import, which comes after this; a NUMBA_OPT of the user's is kept
+    os.environ.setdefault("NUMBA_OPT", "1")
     argv = getattr(sys, "orig_argv", [])
     i = argv.index("-m") if "-m" in argv else -1
     command = " ".join(argv[i + 1:i + 3]) if i >= 0 else ""

@@ -127,36 +127,41 @@ def massless_work(Zr, ez, d, mu, Cp, Ci, Cx, beta, dt):
     return 0.5 * s
 
 
+# The helpers inlined into the loop read the tuples' fields they use before their first
+# loop or branch: a tuple used in one block only is an SSA value, one used across blocks
+# a stack copy of the whole struct in every helper (compile time, docs/design.md).
 @njit(cache=True, inline="always")
 def free_step(ops, st, Gn, H, row, massless):
     """st.x ← the step without contact, st.yf ← C x, st.Ku ← K uⁿ (reused by the energy);
     ``Gn``: the load coefficients Gⁿ of this step; st.r_e: the law's explicit force;
     ``H[row]``: the load at the quasi-static massless rows (see massless_force)."""
-    dt2 = ops.dt * ops.dt
-    x, u_cur, u_prev = st.x, st.u_cur, st.u_prev
-    rows_matvec(ops.Kb, u_cur, st.Ku, 1.0, np.bool_(False))
+    dt, Kb, Bb, loads, Achol, Cp, Ci, Cx = ops.dt, ops.Kb, ops.Bb, ops.loads, ops.Achol, \
+        ops.Cp, ops.Ci, ops.Cx
+    Zr, Zp, Zi, Zx, beta = ops.Zr, ops.Zp, ops.Zi, ops.Zx, ops.beta
+    x, u_cur, u_prev, Ku, r_e, d, yf = st.x, st.u_cur, st.u_prev, st.Ku, st.r_e, st.d, st.yf
+    dt2 = dt * dt
+    rows_matvec(Kb, u_cur, Ku, 1.0, np.bool_(False))
     for i in range(x.size):
-        s = -st.Ku[i]
+        s = -Ku[i]
         for k in range(Gn.size):
-            s += Gn[k] * ops.loads[i, k]
+            s += Gn[k] * loads[i, k]
         x[i] = dt2 * s
-    for r in range(st.r_e.size):
-        if st.r_e[r] != 0.0:
-            for p in range(ops.Cp[r], ops.Cp[r + 1]):
-                x[ops.Ci[p]] += dt2 * ops.Cx[p] * st.r_e[r]
-    if ops.Bb.shape[0]:
-        for i in range(st.d.size):
-            st.d[i] = u_cur[i] - u_prev[i]
-        rows_matvec(ops.Bb, st.d, x, -ops.dt, np.bool_(True))
+    for r in range(r_e.size):
+        if r_e[r] != 0.0:
+            for p in range(Cp[r], Cp[r + 1]):
+                x[Ci[p]] += dt2 * Cx[p] * r_e[r]
+    if Bb.shape[0]:
+        for i in range(d.size):
+            d[i] = u_cur[i] - u_prev[i]
+        rows_matvec(Bb, d, x, -dt, np.bool_(True))
     if massless is not None:
-        massless_force(ops.Zr, ops.Zp, ops.Zi, ops.Zx, ops.beta, st.Ku, st.u_prev, H, row,
-                       massless)
-        for q in range(ops.Zr.size):
-            x[ops.Zr[q]] += dt2 * massless[q]
-    band_solve(ops.Achol, x)
+        massless_force(Zr, Zp, Zi, Zx, beta, Ku, u_prev, H, row, massless)
+        for q in range(Zr.size):
+            x[Zr[q]] += dt2 * massless[q]
+    band_solve(Achol, x)
     for i in range(x.size):
         x[i] += 2.0 * u_cur[i] - u_prev[i]
-    csr_product(ops.Cp, ops.Ci, ops.Cx, x, st.yf)
+    csr_product(Cp, Ci, Cx, x, yf)
 
 
 @njit(cache=True, inline="always")
@@ -169,42 +174,44 @@ def finish_step(ops, st, Gn, massless):
         ½E_β^{n+1} − ½E_β^n + δᵀBδ/(4Δt) = ½ Gⁿ·Lᵀδ + ½ λᵀCδ,   δ = uⁿ⁺¹ − uⁿ⁻¹,
     (L the load vectors), so the saved energy, the damping work and the load and contact
     work add up to round-off at every step (``st.work``)."""
-    x, mu, d = st.x, st.mu, st.d
+    dt, W, Bb, loads, Cp, Ci, Cx = ops.dt, ops.W, ops.Bb, ops.loads, ops.Cp, ops.Ci, ops.Cx
+    Zr, beta = ops.Zr, ops.beta
+    x, mu, d, u_prev, u_cur, work = st.x, st.mu, st.d, st.u_prev, st.u_cur, st.work
+    dy, y_prev, y_cur, r_e, rowwork = st.dy, st.y_prev, st.y_cur, st.r_e, st.rowwork
     for j in range(mu.size):
         if mu[j] != 0.0:
             for i in range(x.size):
-                x[i] += ops.W[i, j] * mu[j]
+                x[i] += W[i, j] * mu[j]
     for i in range(x.size):
-        d[i] = x[i] - st.u_prev[i]
-    if ops.Bb.shape[0]:
-        st.work[0] += rows_dot(ops.Bb, d, d) / (4.0 * ops.dt)
+        d[i] = x[i] - u_prev[i]
+    if Bb.shape[0]:
+        work[0] += rows_dot(Bb, d, d) / (4.0 * dt)
     for k in range(Gn.size):
         s = 0.0
         for i in range(x.size):
-            s += ops.loads[i, k] * d[i]
-        st.work[1] += 0.5 * Gn[k] * s
+            s += loads[i, k] * d[i]
+        work[1] += 0.5 * Gn[k] * s
     if massless is not None:    # quasi-static massless rows
-        st.work[2] += massless_work(ops.Zr, massless, d, mu, ops.Cp, ops.Ci, ops.Cx, ops.beta,
-                                    ops.dt)
+        work[2] += massless_work(Zr, massless, d, mu, Cp, Ci, Cx, beta, dt)
     for i in range(x.size):
-        st.u_prev[i] = st.u_cur[i]
-        st.u_cur[i] = x[i]
+        u_prev[i] = u_cur[i]
+        u_cur[i] = x[i]
     for j in range(mu.size):
-        st.dy[j] = -st.y_prev[j]
-        st.y_prev[j] = st.y_cur[j]
-    csr_product(ops.Cp, ops.Ci, ops.Cx, st.u_cur, st.y_cur)
+        dy[j] = -y_prev[j]
+        y_prev[j] = y_cur[j]
+    csr_product(Cp, Ci, Cx, u_cur, y_cur)
     for j in range(mu.size):
-        st.dy[j] += st.y_cur[j]
-    dt2 = ops.dt * ops.dt
-    for j in range(st.r_e.size):   # the contact force: explicit and implicit parts
-        if st.r_e[j] != 0.0:
-            mu[j] += dt2 * st.r_e[j]
+        dy[j] += y_cur[j]
+    dt2 = dt * dt
+    for j in range(r_e.size):   # the contact force: explicit and implicit parts
+        if r_e[j] != 0.0:
+            mu[j] += dt2 * r_e[j]
     for j in range(mu.size):
         if mu[j] != 0.0:
-            st.work[2] += 0.5 * mu[j] / dt2 * st.dy[j]
-    if st.rowwork.shape[0]:          # two planes: each row's share
+            work[2] += 0.5 * mu[j] / dt2 * dy[j]
+    if rowwork.shape[0]:          # two planes: each row's share
         for j in range(mu.size):
-            st.rowwork[j, 0] += 0.5 * mu[j] / dt2 * st.dy[j]
+            rowwork[j, 0] += 0.5 * mu[j] / dt2 * dy[j]
 
 
 @njit(cache=True)
@@ -224,46 +231,53 @@ def energy_beta(Eb, u_prev, u_cur, Ku, d):
 @njit(cache=True, inline="always")
 def record(n, ops, st, out):
     """Diagnostics after state n: penetration (every step), saved series, frames."""
-    stats, u_cur, u_prev, dt = st.stats, st.u_cur, st.u_prev, ops.dt
-    for r in range(st.y_cur.size):
-        v = max(st.lo[r] - st.y_cur[r], st.y_cur[r] - st.hi[r])
+    dt, disks, pair, Sp, Si, Sx, Op, Oi, Ox, Eb = ops.dt, ops.disks, ops.pair, ops.Sp, \
+        ops.Si, ops.Sx, ops.Op, ops.Oi, ops.Ox, ops.Eb
+    save_every, frame_every = ops.save_every, ops.frame_every
+    stats, u_cur, u_prev, y_cur, lo, hi, slo, shi = st.stats, st.u_cur, st.u_prev, st.y_cur, \
+        st.lo, st.hi, st.slo, st.shi
+    counters, Ku, d, work, mu = st.counters, st.Ku, st.d, st.work, st.mu
+    obs, obsv, energy, out_work, lam, frames_u, frames_v, frames_f = out.obs, out.obsv, \
+        out.energy, out.work, out.lam, out.frames_u, out.frames_v, out.frames_f
+    for r in range(y_cur.size):
+        v = max(lo[r] - y_cur[r], y_cur[r] - hi[r])
         if v > stats[0]:
             stats[0] = v
-    for r in ops.disks:       # round holes: beyond the circle (a loop of its own: 1 µs a
-        v = violation(ops.pair, st.lo, st.hi, st.y_cur, r)   # step on 40 box rows)
+    for r in disks:           # round holes: beyond the circle (a loop of its own: 1 µs a
+        v = violation(pair, lo, hi, y_cur, r)   # step on 40 box rows)
         if v > stats[0]:
             stats[0] = v
-    for r in range(st.slo.size):
+    for r in range(slo.size):
         s = 0.0
-        for p in range(ops.Sp[r], ops.Sp[r + 1]):
-            s += ops.Sx[p] * u_cur[ops.Si[p]]
-        if st.slo[r] - s > stats[1]:
-            stats[1] = st.slo[r] - s
-        if s - st.shi[r] > stats[2]:
-            stats[2] = s - st.shi[r]
+        for p in range(Sp[r], Sp[r + 1]):
+            s += Sx[p] * u_cur[Si[p]]
+        if slo[r] - s > stats[1]:
+            stats[1] = slo[r] - s
+        if s - shi[r] > stats[2]:
+            stats[2] = s - shi[r]
     dt2 = dt * dt
-    if n % ops.save_every == 0:
-        k = n // ops.save_every - st.counters[5]   # the buffers hold rows from counters[5] on
-        for r in range(ops.Op.size - 1):
+    if n % save_every == 0:
+        k = n // save_every - counters[5]   # the buffers hold rows from counters[5] on
+        for r in range(Op.size - 1):
             s = 0.0
             sv = 0.0
-            for p in range(ops.Op[r], ops.Op[r + 1]):
-                s += ops.Ox[p] * u_cur[ops.Oi[p]]
-                sv += ops.Ox[p] * (u_cur[ops.Oi[p]] - u_prev[ops.Oi[p]])
-            out.obs[k, r] = s
-            out.obsv[k, r] = sv / dt
-        out.energy[k] = 0.5 * energy_beta(ops.Eb, u_prev, u_cur, st.Ku, st.d)
+            for p in range(Op[r], Op[r + 1]):
+                s += Ox[p] * u_cur[Oi[p]]
+                sv += Ox[p] * (u_cur[Oi[p]] - u_prev[Oi[p]])
+            obs[k, r] = s
+            obsv[k, r] = sv / dt
+        energy[k] = 0.5 * energy_beta(Eb, u_prev, u_cur, Ku, d)
         for c in range(4):
-            out.work[k, c] = st.work[c]
-        for j in range(st.mu.size):
-            out.lam[k, j] = st.mu[j] / dt2
-    if n % ops.frame_every == 0:
-        k = n // ops.frame_every
+            out_work[k, c] = work[c]
+        for j in range(mu.size):
+            lam[k, j] = mu[j] / dt2
+    if n % frame_every == 0:
+        k = n // frame_every
         for i in range(u_cur.size):
-            out.frames_u[k, i] = u_cur[i]
-            out.frames_v[k, i] = (u_cur[i] - u_prev[i]) / dt
-        for j in range(st.mu.size):
-            out.frames_f[k, j] = st.mu[j] / dt2
+            frames_u[k, i] = u_cur[i]
+            frames_v[k, i] = (u_cur[i] - u_prev[i]) / dt
+        for j in range(mu.size):
+            frames_f[k, j] = mu[j] / dt2
 
 
 @njit(cache=True, inline="always")
@@ -277,13 +291,15 @@ def call_law(law, ops, st):
 def move_bounds(ops, st, phi):
     """The bounds at t_{n+1}: at rest plus shift·φ(t_{n+1}) (obstacles that move with a
     support, seen in the lifted variable)."""
-    for j in range(ops.shift.size):
-        st.lo[j] = ops.lo[j] + ops.shift[j] * phi
-        st.hi[j] = ops.hi[j] + ops.shift[j] * phi
+    shift, lo, hi, sshift, slo, shi = ops.shift, ops.lo, ops.hi, ops.sshift, ops.slo, ops.shi
+    lo_t, hi_t, slo_t, shi_t = st.lo, st.hi, st.slo, st.shi
     st.stats[3] = phi
-    for r in range(ops.sshift.size):
-        st.slo[r] = ops.slo[r] + ops.sshift[r] * phi
-        st.shi[r] = ops.shi[r] + ops.sshift[r] * phi
+    for j in range(shift.size):
+        lo_t[j] = lo[j] + shift[j] * phi
+        hi_t[j] = hi[j] + shift[j] * phi
+    for r in range(sshift.size):
+        slo_t[r] = slo[r] + sshift[r] * phi
+        shi_t[r] = shi[r] + sshift[r] * phi
 
 
 @njit(cache=True, inline="always")
@@ -390,17 +406,21 @@ def track_impacts(ops, st, out, step):
     force trails the contact by up to two states; Σ impulse is then Σ λΔt of the run
     (exact laws: λ = 0 off contact, the same rows).  Returns EVENTS_FULL when the event
     buffer has no room left for another row."""
-    counters, ev, dt = st.counters, st.impact, ops.dt
+    dt, pair = ops.dt, ops.pair
+    counters, ev, active, active_prev, y_prev, y_cur, dy, mu, fc, lo, hi = st.counters, \
+        st.impact, st.active, st.active_prev, st.y_prev, st.y_cur, st.dy, st.mu, st.fc, \
+        st.lo, st.hi
+    events = out.events
     any_active = False
-    for j in range(st.active.size):
-        a = st.active[j]
-        if a and not st.active_prev[j]:
+    for j in range(active.size):
+        a = active[j]
+        if a and not active_prev[j]:
             counters[0] += 1
             if ev[j, 0] >= 0.0:          # the last contact's trailing force ends here
-                write_event(out.events, counters, j, ev[j])
+                write_event(events, counters, j, ev[j])
             ev[j, 0] = step + 1
             # approach velocity (yⁿ − yⁿ⁻¹)/Δt, with yⁿ⁻¹ = yⁿ⁺¹ − dy
-            ev[j, 1] = (st.y_prev[j] - st.y_cur[j] + st.dy[j]) / dt
+            ev[j, 1] = (y_prev[j] - y_cur[j] + dy[j]) / dt
             ev[j, 2] = 0.0
             ev[j, 3] = 0.0
             ev[j, 4] = 0.0
@@ -409,27 +429,26 @@ def track_impacts(ops, st, out, step):
                 ev[j, c] = np.nan
             ev[j, 9] = 0.0
             ev[j, 10] = 0.0
-        elif st.active_prev[j] and not a:
+        elif active_prev[j] and not a:
             ev[j, 5] = step + 1          # the first state off the obstacle
         if ev[j, 0] >= 0.0:
-            if st.mu[j] != 0.0 or ops.pair[j] > 0:
+            if mu[j] != 0.0 or pair[j] > 0:
                 # a round hole's force is its pair's, its impulse Σ|λ|Δt
-                lam = st.mu[j] / (dt * dt) if ops.pair[j] == 0 else \
-                    row_force(ops.pair, st.mu, j) / (dt * dt)
+                lam = mu[j] / (dt * dt) if pair[j] == 0 else row_force(pair, mu, j) / (dt * dt)
                 ev[j, 2] = max(ev[j, 2], abs(lam))
                 ev[j, 3] += lam * dt
-            if st.fc.shape[0] and ops.pair[j] > 0:     # friction: slip and its impulse
-                ev[j, 9] += abs(st.fc[j, 3]) * dt
-                ev[j, 10] += abs(st.fc[j, 1])
+            if fc.shape[0] and pair[j] > 0:     # friction: slip and its impulse
+                ev[j, 9] += abs(fc[j, 3]) * dt
+                ev[j, 10] += abs(fc[j, 1])
             if a:
-                ev[j, 4] = max(ev[j, 4], violation(ops.pair, st.lo, st.hi, st.y_cur, j))
+                ev[j, 4] = max(ev[j, 4], violation(pair, lo, hi, y_cur, j))
             elif step + 1 > ev[j, 5]:    # the second state off: no force can trail further
-                write_event(out.events, counters, j, ev[j])
-        st.active_prev[j] = a
+                write_event(events, counters, j, ev[j])
+        active_prev[j] = a
         any_active = any_active or a
     if any_active:
         counters[1] += 1
-    return EVENTS_FULL if counters[4] + st.active.size > out.events.shape[0] else 0
+    return EVENTS_FULL if counters[4] + active.size > events.shape[0] else 0
 
 
 @njit(cache=True, inline="always")
@@ -437,9 +456,9 @@ def stop_code(ops, st, out, step, Ebound, full):
     """After the diagnostics of state step+1: UNSTABLE when its saved energy is non-finite
     or above Ebound, else ``full`` (EVENTS_FULL when the event buffer must be emptied
     before the next step, else 0); counters[3] ← step+1 when the loop must stop."""
-    counters = st.counters
-    if (step + 1) % ops.save_every == 0 \
-            and not abs(out.energy[(step + 1) // ops.save_every - counters[5]]) <= Ebound:
+    counters, save_every, energy = st.counters, ops.save_every, out.energy
+    if (step + 1) % save_every == 0 \
+            and not abs(energy[(step + 1) // save_every - counters[5]]) <= Ebound:
         counters[3] = step + 1
         return UNSTABLE
     if full:

@@ -15,6 +15,7 @@ import threading
 
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
 COMMAND = False     # this process is a ``python -m skfem_beam...`` command
+NUMBA_OPT = "1"     # LLVM's optimisation level for a command's kernels (command_starting)
 
 
 def _leave(signum, frame):
@@ -45,7 +46,7 @@ def command_starting() -> None:
     # LLVM at -O1 for what a first run compiles: the loop and the laws step as fast as at
     # numba's default -O3 and compile in less time (docs/design.md, "The whole command");
     # numba reads it at import, which comes after this; a NUMBA_OPT of the user's is kept
-    os.environ.setdefault("NUMBA_OPT", "1")
+    os.environ.setdefault("NUMBA_OPT", NUMBA_OPT)
     argv = getattr(sys, "orig_argv", [])
     i = argv.index("-m") if "-m" in argv else -1
     command = " ".join(argv[i + 1:i + 3]) if i >= 0 else ""

@@ -90,7 +90,11 @@ def _run(folder: Path, job: str, listen: bool, one_core: bool) -> tuple[float, f
     before, t0 = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
     # one core: the run compiles its law itself (not aside), so every compile is listed
     pin = (lambda: os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})) if one_core else None
-    p = subprocess.run(argv, cwd=folder, env={**_env(), "PYTHONPATH": str(folder)},
+    env = {**_env(), "PYTHONPATH": str(folder)}
+    if listen:      # the listener calls main(): at the level a command compiles at
+        from skfem_beam._startup import NUMBA_OPT
+        env.setdefault("NUMBA_OPT", NUMBA_OPT)
+    p = subprocess.run(argv, cwd=folder, env=env,
                        capture_output=True, text=True, check=True, preexec_fn=pin)
     wall, after = time.perf_counter() - t0, resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime

@@ -33,3 +33,30 @@ def test_cold_then_warm_run_same_files_one_notice(tmp_path):
                 "kernels.massless_work"} & cached, cached
     for f in ("timeseries.csv", "impacts.csv"):
         assert (tmp_path / "cold" / f).read_bytes() == (tmp_path / "warm" / f).read_bytes(), f
+
+
+CALLEES_CHILD = """
+import sys
+from skfem_beam import aside, beam_system, scenes, solve
+from skfem_beam.scheme.kernels import CALLEES
+child = aside.start([(f.py_func.__module__, f.py_func.__name__, sig) for f, sig in CALLEES])
+assert child is not None and child.wait() == 0, "the child failed"
+solve(beam_system(scenes.flat_obstacles(J=8)), dt=1e-3, T=0.05, solver="active-set")
+for f, sig in CALLEES:   # loaded from the child's cache entry, compiled for no other types
+    print(f.py_func.__name__, sum(f.stats.cache_hits.values()),
+          sum(f.stats.cache_misses.values()), len(f.signatures))
+"""
+
+
+def test_the_callees_compiled_aside_are_the_loops(tmp_path):
+    """kernels.CALLEES, which a fresh install compiles in a child (skfem_beam.aside) while
+    run_steps compiles, carry the types run_steps calls them with: the loop's compile then
+    loads each from the child's cache entry instead of compiling it again."""
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+    p = subprocess.run([sys.executable, "-c", CALLEES_CHILD], env=env, capture_output=True,
+                       text=True)
+    assert p.returncode == 0, p.stderr
+    rows = [line.split() for line in p.stdout.splitlines()]
+    assert [r[0] for r in rows] == ["rows_matvec", "csr_product", "rows_dot", "write_event",
+                                    "energy_beta"], p.stdout
+    assert all(r[1:] == ["1", "0", "1"] for r in rows), p.stdout

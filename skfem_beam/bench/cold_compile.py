@@ -1,6 +1,7 @@
 """Cold start of the README's main job: the first run of a fresh install against a warm one.
 
     python -m skfem_beam.bench.cold_compile [--repeat 3] [--job skfem_beam.cases.flat_obstacles]
+                                            [--against OTHER_CHECKOUT/skfem_beam]
 
 Each repeat copies the package (sources only) to a fresh temporary folder, so that no
 ``__pycache__`` and no numba cache exist, and runs ``python -m JOB`` there twice in child
@@ -14,7 +15,9 @@ compiled aside in a child process (a fresh install on two cores or more, see
 contact.base.Compiled) is not listed: ``--one-core`` lists it.  That child calls the job's
 ``main`` (not ``python -m``), so it draws its charts itself: its times are not the
 command's.  The per-function times are CPU seconds, which a busy shared machine disturbs
-less than wall time.
+less than wall time.  ``--against`` another checkout's ``skfem_beam`` folder: each repeat
+runs both, in alternating order (this VM's speed drifts by ±30 % within minutes), and the
+medians of both are printed.
 """
 from __future__ import annotations
 
@@ -23,6 +26,7 @@ import json
 import os
 import resource
 import shutil
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -126,6 +130,22 @@ def _attribution(info: dict) -> None:
             print(f"  {name:40s} {s:7.2f} {t:11.2f} {k:8d}")
 
 
+def _cold_then_warm(package: str, job: str, one_core: bool) -> tuple[float, float, str]:
+    """A fresh copy of ``package`` runs the job cold, then warm: both wall times and a line."""
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = _fresh(tmp, package)
+        cold, cold_wall, info = _run(folder, job, False, one_core)
+        warm, warm_wall, again = _run(folder, job, False, one_core)
+    met = "yes" if cold_wall <= COLD_TARGET else "NO"
+    notice = "compiling numerical kernels"
+    return cold_wall, warm_wall, (
+        f"python -m {job}: wall cold {cold_wall:.2f} s (≤ {COLD_TARGET:g} s: {met}), warm "
+        f"{warm_wall:.2f} s, compile {cold_wall - warm_wall:.2f} s; CPU cold {cold:.2f} s, warm "
+        f"{warm:.2f} s; its loop {info['loop_s']:.4f} s (cold {cold_wall / info['loop_s']:.0f}×, "
+        f"warm {warm_wall / again['loop_s']:.0f}× the loop); notice: cold "
+        f"{info['stderr'].count(notice)}, warm {again['stderr'].count(notice)}")
+
+
 def _env() -> dict:
     return {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_CACHE_DIR")}
 
@@ -137,6 +157,9 @@ def main(argv=None) -> int:
     ap.add_argument("--job", default="skfem_beam.cases.flat_obstacles")
     ap.add_argument("--package", default=str(PACKAGE),
                     help="the skfem_beam folder to copy (another checkout, to compare)")
+    ap.add_argument("--against", metavar="FOLDER",
+                    help="another skfem_beam folder (an older checkout's): each repeat runs "
+                         "both, in alternating order, and the medians are printed")
     ap.add_argument("--one-core", action="store_true",
                     help="pin the runs to one core: the law compiles in the run itself, so the "
                          "table lists it (by default it compiles in a child process, unlisted)")
@@ -147,25 +170,23 @@ def main(argv=None) -> int:
     if args.child:
         _child(*args.child)
         return 0
-    notice = "compiling numerical kernels"
+    packages = [args.package] + ([args.against] if args.against else [])
+    walls = {p: [] for p in packages}
     for r in range(args.repeat):
-        with tempfile.TemporaryDirectory() as tmp:
-            folder = _fresh(tmp, args.package)
-            cold, cold_wall, info = _run(folder, args.job, False, args.one_core)
-            warm, warm_wall, again = _run(folder, args.job, False, args.one_core)
-        met = "yes" if cold_wall <= COLD_TARGET else "NO"
-        print(f"run {r + 1}: python -m {args.job}: wall cold {cold_wall:.2f} s (≤ {COLD_TARGET:g} s: "
-              f"{met}), warm {warm_wall:.2f} s, compile {cold_wall - warm_wall:.2f} s; CPU cold "
-              f"{cold:.2f} s, warm {warm:.2f} s; its loop {info['loop_s']:.4f} s (cold "
-              f"{cold_wall / info['loop_s']:.0f}×, warm {warm_wall / again['loop_s']:.0f}× the "
-              f"loop); notice: cold {info['stderr'].count(notice)}, warm "
-              f"{again['stderr'].count(notice)}", flush=True)
+        for package in packages if r % 2 == 0 else packages[::-1]:   # alternated: drift
+            walls[package].append(_cold_then_warm(package, args.job, args.one_core))
+            label = f" ({package})" if args.against else ""
+            print(f"run {r + 1}{label}: {walls[package][-1][2]}", flush=True)
         if not args.no_attribute:
             with tempfile.TemporaryDirectory() as tmp:
                 _, listened, info = _run(_fresh(tmp, args.package), args.job, True,
                                          args.one_core)
             print(f"  listener run (it draws its charts itself): wall {listened:.2f} s")
             _attribution(info)
+    if args.against:
+        for package, runs in walls.items():
+            print(f"{package}: median cold {statistics.median(r[0] for r in runs):.2f} s, warm "
+                  f"{statistics.median(r[1] for r in runs):.2f} s over {len(runs)} runs")
     return 0
 
 

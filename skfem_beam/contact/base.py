@@ -36,8 +36,6 @@ and cached once for all of them and calls the law through a pointer.
 """
 from __future__ import annotations
 
-import atexit
-import os
 import subprocess
 import sys
 from dataclasses import dataclass, field
@@ -46,29 +44,14 @@ import numpy as np
 import scipy.sparse as sp
 from numba import cfunc, types
 
+from .. import aside
+
 _vec = types.float64[::1]
 LAW_SIGNATURE = types.int64(types.float64[:, ::1], _vec, _vec, _vec, _vec, _vec, _vec,
                             types.int8[::1], _vec, types.boolean[::1])
 
 
 EXPLICIT_SIGNATURE = types.int64(_vec, _vec, _vec, _vec, _vec, _vec)
-
-
-# The child that compiles a kernel aside: argv is the kernel's module, its name and the
-# folders of the packages above the module, which are entered bare (their folder, not their
-# __init__), so that the child imports what the kernel's module needs (numpy, scipy.sparse,
-# numba), not the package's whole API (0.5 → 0.25 s, on a core the loop's compile shares).
-# It ends without the interpreter's teardown (0.3 s with numba), which the run waits for.
-_CHILD = """
-import importlib, os, sys, types
-module, name, folders = sys.argv[1], sys.argv[2], sys.argv[3:]
-parts = module.split(".")
-for i, folder in enumerate(folders, 1):
-    package = sys.modules[".".join(parts[:i])] = types.ModuleType(".".join(parts[:i]))
-    package.__path__ = [folder]
-getattr(importlib.import_module(module), name).cfunc
-os._exit(0)
-"""
 
 
 class Compiled:
@@ -99,37 +82,9 @@ class Compiled:
         child fail, `cfunc` compiles it here as before."""
         mod, name = self.func.__module__, self.func.__name__
         if self._cfunc is not None or self._child is not None or mod == "__main__" \
-                or getattr(sys.modules.get(mod), name, None) is not self or _cores() < 2:
+                or getattr(sys.modules.get(mod), name, None) is not self:
             return
-        # the child imports the same package: this process's sys.path, '' as the cwd
-        path = os.pathsep.join(os.path.abspath(p or os.curdir) for p in sys.path)
-        parts = mod.split(".")
-        folders = [list(sys.modules[".".join(parts[:i])].__path__)[0] for i in range(1, len(parts))]
-        try:
-            self._child = subprocess.Popen(
-                [sys.executable, "-c", _CHILD, mod, name, *folders],
-                env={**os.environ, "PYTHONPATH": path},
-                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        except OSError:
-            return
-        _CHILDREN.append(self._child)
-
-
-_CHILDREN = []
-
-
-def _cores() -> int:
-    affinity = getattr(os, "sched_getaffinity", None)
-    return len(affinity(0)) if affinity else (os.cpu_count() or 1)
-
-
-@atexit.register
-def _stop_children() -> None:
-    """A process that ends before it needed its law leaves no compiler running."""
-    for child in _CHILDREN:
-        if child.poll() is None:
-            child.kill()
-            child.wait()
+        self._child = aside.start([(mod, name, None)])
 
 
 def compiled_law(func) -> Compiled:

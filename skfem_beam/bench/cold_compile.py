@@ -4,15 +4,15 @@
                                             [--against OTHER_CHECKOUT/skfem_beam]
 
 Each repeat copies the package's sources to a fresh temporary folder and byte-compiles them,
-as ``pip install`` does, so that no numba cache exists, and runs ``python -m JOB`` there twice in child
-processes, exactly as a user types it (cold, then warm): their wall times against the
-target (cold ≤ 6 s), their difference (the compile a first run pays) and the time loop
-beside them.  Then, unless ``--no-attribute``, a second fresh copy runs the job cold once
-more in a child that registers a ``numba:compile`` listener and times the law's C callbacks
-(``CFunc.compile``), so the compile time is attributed per function: ``self`` excludes the
-functions compiled inside it (callees that are not inlined), ``total`` includes them; a law
-compiled aside in a child process (a fresh install on two cores or more, see
-contact.base.Compiled) is not listed: ``--one-core`` lists it.  That child calls the job's
+as ``pip install`` does, so that no numba cache exists, and runs ``python -m JOB`` there
+twice in child processes, exactly as a user types it (cold, then warm): their wall times
+against the target (cold ≤ 6 s), their difference (the compile a first run pays) and the
+time loop beside them.  Then, unless ``--no-attribute``, a second fresh copy runs the job
+cold once more in a child that registers a ``numba:compile`` listener and times the law's C
+callbacks (``CFunc.compile``), so the compile time is attributed per function: ``self``
+excludes the functions compiled inside it (callees that are not inlined), ``total``
+includes them; what is compiled aside in a child process (a fresh install on two cores or
+more, see skfem_beam.aside) is not listed: ``--one-core`` lists it.  That child calls the job's
 ``main`` (not ``python -m``), so it draws its charts itself: its times are not the
 command's.  The per-function times are CPU seconds, which a busy shared machine disturbs
 less than wall time.  ``--against`` another checkout's ``skfem_beam`` folder: each repeat

@@ -36,12 +36,16 @@ def cores() -> int:
     return len(affinity(0)) if affinity else (os.cpu_count() or 1)
 
 
-def start(jobs) -> subprocess.Popen | None:
-    """A child compiling ``jobs``, in order: (module, name, argument types) of a numba
-    dispatcher, or (module, name, None) of a ``contact.base.Compiled`` kernel.  None with
-    one core, or when it cannot start."""
+def start(kernels) -> subprocess.Popen | None:
+    """A child compiling ``kernels``, in order: (numba dispatcher, argument types), or
+    (``contact.base.Compiled`` kernel, None); each must be a module-level name of its
+    module.  None with one core, or when it cannot start."""
     if cores() < 2:
         return None
+    jobs = []
+    for kernel, sig in kernels:
+        func = kernel.py_func if sig is not None else kernel.func
+        jobs.append((func.__module__, func.__name__, sig))
     packages = {}
     for module, _, _ in jobs:
         parts = module.split(".")
@@ -58,7 +62,7 @@ def start(jobs) -> subprocess.Popen | None:
         return None
     _CHILDREN.append(child)
     try:
-        child.stdin.write(pickle.dumps((packages, list(jobs))))
+        child.stdin.write(pickle.dumps((packages, jobs)))
         child.stdin.close()
     except OSError:         # it died: what it was to compile is compiled here
         pass

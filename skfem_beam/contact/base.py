@@ -84,7 +84,7 @@ class Compiled:
         if self._cfunc is not None or self._child is not None or mod == "__main__" \
                 or getattr(sys.modules.get(mod), name, None) is not self:
             return
-        self._child = aside.start([(mod, name, None)])
+        self._child = aside.start([(self, None)])
 
 
 def compiled_law(func) -> Compiled:

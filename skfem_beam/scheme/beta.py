@@ -59,7 +59,7 @@ class _CalleesAside(event.Listener):
     def on_start(self, ev):
         if not self.started:
             self.started = True
-            aside.start([(f.py_func.__module__, f.py_func.__name__, sig) for f, sig in CALLEES])
+            aside.start(CALLEES)
 
     def on_end(self, ev):
         pass

@@ -8,6 +8,7 @@ the modules down (~0.2 s with numba and matplotlib loaded), so a SIGTERM then ki
 the finished command silently; a command process therefore runs its exit handlers
 itself and ends with ``os._exit`` (`end`)."""
 import atexit
+import gc
 import os
 import signal
 import sys
@@ -16,6 +17,10 @@ import threading
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
 COMMAND = False     # this process is a ``python -m skfem_beam...`` command
 NUMBA_OPT = "1"     # LLVM's optimisation level for a command's kernels (command_starting)
+# A command's garbage collector runs a young collection every GC_THRESHOLD[0] allocations,
+# not Python's 700: numba's compile of a first run makes millions of short-lived objects,
+# and at 700 the main job's ~730 collections took 0.7–0.8 CPU s (docs/design.md)
+GC_THRESHOLD = (50_000, 20, 100)
 
 
 def _leave(signum, frame):
@@ -40,9 +45,11 @@ CHARTING = ("skfem_beam.cases.", "skfem_beam run")
 
 def command_starting() -> None:
     """A ``python -m skfem_beam...`` command is starting: signals end it in one line
-    (`exit_on_signals`), and one that draws charts starts its chart process now, to load
-    matplotlib beside the command's own imports."""
+    (`exit_on_signals`), its garbage is collected less often (GC_THRESHOLD), and one that
+    draws charts starts its chart process now, to load matplotlib beside the command's own
+    imports."""
     exit_on_signals()
+    gc.set_threshold(*GC_THRESHOLD)
     # LLVM at -O1 for what a first run compiles: the loop and the laws step as fast as at
     # numba's default -O3 and compile in less time (docs/design.md, "The whole command");
     # numba reads it at import, which comes after this; a NUMBA_OPT of the user's is kept

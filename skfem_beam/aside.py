@@ -5,21 +5,25 @@ The child is a new interpreter.  The packages above the kernels' modules are ent
 its ``sys.modules`` bare (their folder, not their ``__init__``), so that it imports what
 those modules need (numpy, scipy.sparse, numba), not the package's whole API (0.5 → 0.25 s,
 on a core that this process's compile shares).  It ends without the interpreter's teardown
-(0.3 s with numba loaded), which a run waiting for it would wait for too.  A kernel it has
-compiled is loaded from the cache by this process when its own compile reaches it; one it
-has not compiled yet is compiled here, as without the child (the same code either way).
+(0.3 s with numba loaded), which a run waiting for it would wait for too, and it collects
+garbage as seldom as the process that started it (a command's ``_startup.GC_THRESHOLD``).
+A kernel it has compiled is loaded from the cache by this process when its own compile
+reaches it; one it has not compiled yet is compiled here, as without the child (the same
+code either way).
 """
 from __future__ import annotations
 
 import atexit
+import gc
 import os
 import pickle
 import subprocess
 import sys
 
 _CHILD = """
-import importlib, os, pickle, sys, types
-packages, jobs = pickle.load(sys.stdin.buffer)
+import gc, importlib, os, pickle, sys, types
+packages, jobs, threshold = pickle.load(sys.stdin.buffer)
+gc.set_threshold(*threshold)
 for package, folder in packages.items():
     sys.modules[package] = types.ModuleType(package)
     sys.modules[package].__path__ = [folder]
@@ -62,7 +66,7 @@ def start(kernels) -> subprocess.Popen | None:
         return None
     _CHILDREN.append(child)
     try:
-        child.stdin.write(pickle.dumps((packages, jobs)))
+        child.stdin.write(pickle.dumps((packages, jobs, gc.get_threshold())))
         child.stdin.close()
     except OSError:         # it died: what it was to compile is compiled here
         pass

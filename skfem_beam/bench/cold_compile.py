@@ -71,9 +71,12 @@ def _listen() -> list:
     return records
 
 
-def _child(job: str, out: str) -> None:
-    """Runs ``python -m job --out out`` in this process with the compile listener."""
+def _child(job: str, out: str, threshold: str) -> None:
+    """Runs ``python -m job --out out`` in this process with the compile listener, its
+    garbage collected at ``threshold`` (a command's: "n0,n1,n2")."""
+    import gc
     import importlib
+    gc.set_threshold(*map(int, threshold.split(",")))
     records = _listen()
     t0 = time.process_time()
     code = importlib.import_module(job).main(["--out", out, "--overwrite"])
@@ -89,15 +92,17 @@ def _child(job: str, out: str) -> None:
 
 def _run(folder: Path, job: str, listen: bool, one_core: bool) -> tuple[float, float, dict]:
     out = folder / "out"
-    # the listener runs from this file, so that an older checkout can be measured too
-    argv = ([sys.executable, str(Path(__file__).resolve()), "--child", job, str(out)]
+    from skfem_beam._startup import GC_THRESHOLD, NUMBA_OPT
+    # the listener runs from this file, so that an older checkout can be measured too; it
+    # calls main(), so it compiles at the level and collects garbage as a command does
+    argv = ([sys.executable, str(Path(__file__).resolve()), "--child", job, str(out),
+             ",".join(map(str, GC_THRESHOLD))]
             if listen else [sys.executable, "-m", job, "--out", str(out), "--overwrite"])
     before, t0 = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
     # one core: the run compiles its law itself (not aside), so every compile is listed
     pin = (lambda: os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})) if one_core else None
     env = {**_env(), "PYTHONPATH": str(folder)}
-    if listen:      # the listener calls main(): at the level a command compiles at
-        from skfem_beam._startup import NUMBA_OPT
+    if listen:
         env.setdefault("NUMBA_OPT", NUMBA_OPT)
     p = subprocess.run(argv, cwd=folder, env=env,
                        capture_output=True, text=True, check=True, preexec_fn=pin)
@@ -168,7 +173,7 @@ def main(argv=None) -> int:
                          "table lists it (by default it compiles in a child process, unlisted)")
     ap.add_argument("--no-attribute", action="store_true",
                     help="no listener run: only the command's cold and warm wall times")
-    ap.add_argument("--child", nargs=2, help=argparse.SUPPRESS)
+    ap.add_argument("--child", nargs=3, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.child:
         _child(*args.child)

@@ -69,6 +69,26 @@ def test_the_chart_process_loads_matplotlib_and_not_the_package(process):
     process.wait()
 
 
+def test_each_chart_is_drawn_in_a_child_of_the_single_threaded_chart_process(tmp_path, process):
+    """The chart process has one thread (BLAS's workers are off), so it forks one child per
+    chart; two charts are drawn by two children, neither of them the chart process."""
+    server = process._process.pid
+    for name in ("a", "b"):
+        process.draw(exec, f"import os; open({str(tmp_path / name)!r}, 'w').write(str(os.getpid()))")
+    process.wait()
+    drawers = {int((tmp_path / name).read_text()) for name in ("a", "b")}
+    assert len(os.listdir(f"/proc/{server}/task")) == 1
+    assert len(drawers) == 2 and server not in drawers
+
+
+def test_a_chart_whose_child_died_is_drawn_again_by_the_chart_process(tmp_path, process):
+    server = process._process.pid
+    process.draw(exec, f"import os\nif os.getpid() != {server}: os._exit(1)\n"
+                       f"open({str(tmp_path / 'drawn')!r}, 'w').write(str(os.getpid()))")
+    process.wait()
+    assert (tmp_path / "drawn").read_text() == str(server)
+
+
 def test_a_chart_error_is_raised_in_the_command_with_its_errno(tmp_path, process):
     t = np.linspace(0, 1, 11)
     process.draw(trajectory_chart, tmp_path / "no such folder" / "x.png", t, {"y": t})

@@ -60,7 +60,7 @@ _outbox: queue.SimpleQueue | None = None   # pickled jobs for the process's send
 _pending: list = []        # the jobs sent and not yet reported drawn, in order
 PIPE_BYTES = 1 << 20       # Linux's default limit for an unprivileged process
 NICE = 10                  # the chart process's priority below its command's
-FRAME = "<Q"               # each job on the pipe: its length, then the pickled job
+JOB_LENGTH = "<Q"          # each job on the pipe: its length in bytes, then the pickled job
 # BLAS without its worker threads in the chart process: it forks (serve), and a fork
 # copies only the thread that calls it
 ONE_THREAD = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
@@ -118,7 +118,7 @@ def draw(chart, *args, **kwargs) -> None:
             data = None                 # not a module-level function: drawn here
         if data is not None:
             _pending.append(job)
-            _outbox.put(struct.pack(FRAME, len(data)) + data)
+            _outbox.put(struct.pack(JOB_LENGTH, len(data)) + data)
             return
     chart(*args, **kwargs)
 
@@ -191,10 +191,10 @@ def serve(parent: int) -> None:
             pickle.dump(_result(*drawing.popleft()), report, protocol=pickle.HIGHEST_PROTOCOL)
             report.flush()
             continue
-        header = _read(0, struct.calcsize(FRAME))
+        header = _read(0, struct.calcsize(JOB_LENGTH))
         if header is None:
             os._exit(0)                 # nothing to tear down: the command has ended
-        job = pickle.loads(_read(0, struct.unpack(FRAME, header)[0]))
+        job = pickle.loads(_read(0, struct.unpack(JOB_LENGTH, header)[0]))
         drawing.append(_fork_draw(job) if forks else (_draw(job), None, None))
 
 

@@ -177,7 +177,8 @@ def serve(parent: int) -> None:
     os.dup2(2, 1)                       # print() and warnings go to the command's stderr
     import matplotlib.pyplot  # noqa: F401  (what every chart needs, loaded while waiting)
     import skfem_beam.output.charts  # noqa: F401
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else 1
+    from .aside import cores            # the standard library only, as here
+    most = cores()                      # charts drawn at once
     # a child per chart where forking is safe: Linux, and this process has one thread
     forks = sys.platform.startswith("linux") and len(os.listdir("/proc/self/task")) == 1
     drawing = collections.deque()       # (job, pid, read end) per chart, in the order sent
@@ -185,7 +186,7 @@ def serve(parent: int) -> None:
         # the first chart's report as soon as it is ready; a new chart while a core is free
         head_done = bool(drawing) and drawing[0][1] is None     # drawn here
         if not head_done:
-            wait_on = ([drawing[0][2]] if drawing else []) + ([0] if len(drawing) < cores else [])
+            wait_on = ([drawing[0][2]] if drawing else []) + ([0] if len(drawing) < most else [])
             head_done = bool(drawing) and drawing[0][2] in select.select(wait_on, [], [])[0]
         if head_done:
             pickle.dump(_result(*drawing.popleft()), report, protocol=pickle.HIGHEST_PROTOCOL)

@@ -30,6 +30,17 @@ def test_a_run_imports_no_extra(tmp_path):
     assert out == "extras: "          # neither Dask nor PyVista, VTK or imageio
 
 
+def test_a_scene_loads_no_writer_or_chart_library_before_its_loop():
+    """meshio and h5py come with the first frame, matplotlib with the first chart (in the
+    chart process): before its loop a command runs on one core (docs/design.md)."""
+    code = ("import sys, skfem_beam.scenefile, skfem_beam.cases.flat_obstacles, "
+            "skfem_beam.cases.point_stops, skfem_beam.cases.impacting_bar; "
+            "print(sorted({'meshio', 'h5py', 'matplotlib'} & set(sys.modules)))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout.split()
+    assert out == ["[]"]
+
+
 def test_a_missing_extra_is_named_in_one_line(monkeypatch):
     from skfem_beam.output import render
     from skfem_beam.sweep import dask_client

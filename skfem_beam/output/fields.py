@@ -39,11 +39,8 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
-import h5py
-import meshio
 import numpy as np
 import scipy.sparse as sp
-from meshio._common import write_xml
 
 from ..errors import InputError
 from ..semidiscrete import SceneView
@@ -283,70 +280,6 @@ def _obstacle_lines(system, view, x, L):
     return g1, g2, contact, carried, fixed
 
 
-class _XdmfSeries(meshio.xdmf.TimeSeriesWriter):
-    """meshio's XDMF time series writer with the traps of docs/design.md §6 worked around.
-
-    - meshio opens the ``.h5`` in the *working directory* (``filename.stem + ".h5"``);
-      here it is opened beside the ``.xdmf`` (the XML refers to it by base name, so the
-      reference stays relative to the ``.xdmf``, as XDMF readers resolve it).
-    - meshio writes line cells as ``TopologyType="Polyline"`` without
-      ``NodesPerElement``; ParaView 5.11's Xdmf3 reader aborts the process (SIGABRT,
-      measured) on that, so the attribute (2: straight segments) is added.
-    - meshio keeps the mesh in a separate ``<Grid Name="mesh">`` beside the temporal
-      collection; ParaView's Xdmf2 reader shows it as a second, stale block.  Here the
-      mesh lives in the first time step and the others include it from there (the
-      layout FEniCS writes), which both ParaView readers, VTK's and meshio's read.
-    Only the in-memory XML tree that meshio builds is edited; meshio writes the files.
-    """
-
-    _pointer = ('xpointer(//Grid[@Name="TimeSeries_meshio"]/Grid[1]'
-                '/*[self::Topology or self::Geometry])')
-
-    def __enter__(self):
-        self.h5_filename = str(self.filename.with_suffix(".h5"))
-        self.h5_file = h5py.File(self.h5_filename, "w")
-        return self
-
-    def write_points_cells(self, points, cells):
-        super().write_points_cells(points, cells)
-        self._mesh = self.domain.find(f"Grid[@Name='{self.mesh_name}']")
-        self.domain.remove(self._mesh)
-        for topo in self._mesh.iter("Topology"):
-            if topo.get("TopologyType") == "Polyline" and "NodesPerElement" not in topo.attrib:
-                topo.set("NodesPerElement", "2")
-
-    def numpy_to_xml_string(self, data):
-        """One HDF5 dataset, as meshio makes it (``dataN``, contiguous, the array's own
-        type), made through h5py's low-level calls: a frame has seven, and h5py's
-        ``create_dataset`` costs 2.4× as much per dataset (docs/design.md)."""
-        data = np.ascontiguousarray(data)
-        name = f"data{self.data_counter}"
-        self.data_counter += 1
-        space = h5py.h5s.create_simple(data.shape)
-        dataset = h5py.h5d.create(self.h5_file.id, name.encode(), h5py.h5t.py_create(data.dtype),
-                                  space)
-        dataset.write(h5py.h5s.ALL, h5py.h5s.ALL, data)
-        return f"{os.path.basename(self.h5_filename)}:/{name}"
-
-    def write_data(self, t, point_data=None, cell_data=None):
-        super().write_data(t, point_data, cell_data)
-        steps = list(self.collection)
-        grid = steps[-1]
-        grid.set("GridType", "Uniform")
-        include = grid[0]             # meshio's xi:include of the mesh grid
-        if len(steps) == 1:           # the first step holds the mesh itself
-            grid.remove(include)
-            for k, item in enumerate(self._mesh):
-                grid.insert(k, item)
-        else:
-            include.set("xpointer", self._pointer)
-
-    def flush(self):
-        """Make the files readable as they are now (meshio writes the XML only at exit)."""
-        write_xml(self.filename, self.xdmf_file)
-        self.h5_file.flush()
-
-
 def check_format(fmt: str, flag: str = "--format ") -> str:
     """``fmt`` if it is one of FORMATS; else one clear error line."""
     if fmt not in FORMATS:
@@ -410,7 +343,9 @@ class FieldWriter:
         self._xdmf = None
         self.closed = False
         if fmt in ("xdmf", "both"):
-            self._xdmf = _XdmfSeries(self.folder / f"{name}.xdmf").__enter__()
+            from .xdmf import XdmfSeries    # meshio and h5py: loaded with a run's first frame
+            self._room_for_hdf5()           # the mesh's datasets are written now
+            self._xdmf = XdmfSeries(self.folder / f"{name}.xdmf").__enter__()
             self._xdmf.write_points_cells(self.line.points, [("line", self.line.cells)])
         if fmt in ("vtu", "both"):
             (self.folder / f"{name}_vtu").mkdir(exist_ok=True)
@@ -445,6 +380,7 @@ class FieldWriter:
             self._xdmf.write_data(t, point_data=data)
         if self.fmt in ("vtu", "both"):
             rel = f"{self.name}_vtu/{self.name}_{len(self.times):06d}.vtu"
+            import meshio
             mesh = meshio.Mesh(self.line.points, [("line", self.line.cells)], point_data=data)
             # uncompressed: zlib's set-up per array was 60% of a frame's time (docs/design.md)
             meshio.write(self.folder / rel, mesh, file_format="vtu", compression=None)

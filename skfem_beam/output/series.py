@@ -272,15 +272,23 @@ class Series:
 
 
 class _Fields:
-    """The field frames of a run, written as they are computed."""
+    """The field frames of a run, written as they are computed.  Their files are made with
+    the first frames (:class:`_Stream`: after the loop, in a short run), so that their
+    writer's imports come then too (:mod:`.xdmf`)."""
 
     def __init__(self, folder: Path, run: Run, fmt: str, series: Series):
-        self.run, self.writer = run, FieldWriter(folder, run.system, fmt)
+        self.run, self.folder, self.fmt, self._writer = run, folder, fmt, None
         every = series.field_every or run.frame_every
         if every % run.frame_every:
             raise InputError(f"field frames every {every} steps are not kept by the run "
                              f"(it keeps every {run.frame_every}-th)")
         self.every, self.until, self.written = every, series.field_until, 0
+
+    @property
+    def writer(self) -> FieldWriter:
+        if self._writer is None:
+            self._writer = FieldWriter(self.folder, self.run.system, self.fmt)
+        return self._writer
 
     def update(self) -> None:
         run, stride = self.run, self.every // self.run.frame_every
@@ -292,7 +300,8 @@ class _Fields:
         self.writer.flush()
 
     def close(self) -> None:
-        self.writer.close()
+        if self._writer is not None:   # a run stopped before its first frame has no field
+            self._writer.close()       # files (none made on a disk that may be full)
 
 
 def _digest(arrays: dict) -> str:

@@ -401,6 +401,28 @@ def test_full_disk_keeps_whole_rows_and_resumes_once_there_is_room(small_disk, t
     assert summary(out)["status"] == "success"
 
 
+def test_a_run_stopped_before_its_first_frame_has_no_field_files_until_resumed(
+        small_disk, tmp_path, capsys):
+    """The field files are made with the first frames (after the loop, in a run this
+    short): a full disk before them leaves none, the folder reads back with no fields,
+    and its resume writes the frames a run never stopped writes."""
+    argv = ["--dt", "5e-5", "--T", "2", "--flush-every", "1000", "--format", "both"]
+    out = small_disk / "run"
+    assert exit_code(point_stops.main, argv + ["--checkpoint-every", "0",
+                                               "--out", str(out)]) == 3
+    assert "No space left on device" in capsys.readouterr().err
+    assert not list(out.glob("fields*")) and read_run(out).fields is None
+    ref = tmp_path / "ref"
+    assert exit_code(point_stops.main, argv + ["--out", str(ref)]) == 0
+    subprocess.run(["mount", "-o", "remount,size=64m", str(small_disk)], check=True)
+    assert exit_code(point_stops.main, ["--resume", str(out)]) == 0
+    for source in ("xdmf", "vtu"):
+        got, want = read_run(out, fields=source).fields, read_run(ref, fields=source).fields
+        assert got.t.size == want.t.size == 201 and np.array_equal(got.t, want.t)
+        for name, values in want.arrays.items():
+            assert np.array_equal(got[name], values, equal_nan=True), (source, name)
+
+
 def test_immutable_checkpoint_fails_in_one_line_and_resumes_once_writable(tmp_path, capsys):
     """A resume that cannot replace its checkpoint (``chattr +i checkpoint.npz``) exits 3
     with one line naming the cause, not "once there is room", and leaves the folder as it

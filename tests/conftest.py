@@ -1,8 +1,35 @@
+import sys
+from functools import cache
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from skfem_beam import scenes
 from skfem_beam.cli import main_guard
+
+sys.path.insert(0, str(Path(__file__).parent / "reference"))
+
+
+@cache
+def _machine_pins():
+    """(this machine's pins or None, the line that says which check the pins' tests run)."""
+    from pins import machine_pins
+    return machine_pins()
+
+
+def pytest_report_header(config):
+    return _machine_pins()[1]
+
+
+def pytest_terminal_summary(terminalreporter):
+    terminalreporter.write_line(_machine_pins()[1])
+
+
+@pytest.fixture(scope="session")
+def machine_pins():
+    """This machine's pins (tests/reference/pins/), or None: then only values are checked."""
+    return _machine_pins()[0]
 
 
 @pytest.fixture(scope="session")

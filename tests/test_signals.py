@@ -8,14 +8,21 @@ import subprocess
 import sys
 import time
 
-# ~2 s: the signals' random instants (≤ 1.6 s) all land before its end
-CASE = [sys.executable, "-m", "skfem_beam.cases.point_stops", "--T", "4", "--dt", "1e-5",
-        "--format", "none"]
+# `python -m skfem_beam.cases.point_stops` as Python runs it (runpy, argv[0] "-m" while
+# the package imports), once the interpreter has said it is up: the instants count from
+# there, not from a process start whose length depends on the machine and its load (a
+# signal inside Python's own start-up is Python's, not ours)
+MODULE = ("import runpy, sys; print('up', flush=True); sys.argv[0] = '-m'; "
+          "runpy._run_module_as_main('skfem_beam.cases.point_stops')")
+# 10 million steps (a minute or more on any machine): the signals' random instants
+# (≤ 1.6 s) land before its end however fast the machine is
+CASE = [sys.executable, "-c", MODULE, "--T", "100", "--dt", "1e-5", "--format", "none"]
 
 
 def signalled(out, sig, delay):
-    p = subprocess.Popen(CASE + ["--out", str(out)], stdout=subprocess.DEVNULL,
+    p = subprocess.Popen(CASE + ["--out", str(out)], stdout=subprocess.PIPE,
                          stderr=subprocess.PIPE, text=True)
+    assert p.stdout.readline() == "up\n"
     time.sleep(delay)
     assert p.poll() is None, f"the command ended before its signal at {delay:.3f} s"
     p.send_signal(sig)
@@ -26,20 +33,21 @@ def signalled(out, sig, delay):
 
 
 def test_sigterm_at_random_instants_of_start_up_ends_the_run(tmp_path):
-    """30 of 30: exit 143, one line, and the folder (if any) says "interrupted", or
-    "success" when the signal came after the last step."""
+    """30 of 30: exit 143, one line, and the folder (if any) says "interrupted"."""
     rng = random.Random(2026)
     for i in range(30):
         code, err, status = signalled(tmp_path / f"r{i}", signal.SIGTERM, rng.uniform(0, 1.6))
         assert code == 143 and len(err) == 1 and "SIGTERM" in err[0], (i, code, err)
-        assert status in (None, "interrupted", "success"), (i, status)
+        assert status in (None, "interrupted"), (i, status)
 
 
 def test_sigint_while_importing_is_one_line_and_130(tmp_path):
+    """While importing on any machine we know of; on a faster one the last instants may
+    fall in the run, which must then end the same way, its folder saying so."""
     for i, delay in enumerate((0.05, 0.15, 0.3)):
         code, err, status = signalled(tmp_path / f"i{i}", signal.SIGINT, delay)
         assert code == 130 and len(err) == 1 and "SIGINT" in err[0], (delay, code, err)
-        assert status is None
+        assert status in (None, "interrupted"), (delay, status)
 
 
 END = """

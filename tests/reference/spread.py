@@ -1,0 +1,123 @@
+"""Measure how far the reference runs move from one machine to another, and write each
+run's tolerances (tolerances.json; docs/tests.md says how they were measured).
+
+    python tests/reference/spread.py save DIR              # every reference run, here
+    python tests/reference/spread.py tolerances DIR [...]  # each DIR against the stored
+
+A second sample on the same machine: another x86-64 target for numba, OpenBLAS and numpy
+(and a cache of numba's own for it):
+
+    NUMBA_CPU_NAME=generic NUMBA_CACHE_DIR=/tmp/nb-generic OPENBLAS_CORETYPE=Sandybridge \\
+        NPY_DISABLE_CPU_FEATURES="X86_V3 X86_V4" python tests/reference/spread.py save DIR
+
+The stored arrays are what the tests compare with: reference.npz (the API's runs) and
+reference_cli.npz (the case commands'), recorded on another machine before issue 15, and
+values.npz (the pinned commands' columns: pins.py --values).
+"""
+from __future__ import annotations
+
+import json
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).parent
+sys.path.insert(0, str(HERE))
+from compare import TOLERANCES, second_impact, spread, tolerance  # noqa: E402
+
+FILES = {"api": "reference.npz", "cli": "reference_cli.npz", "commands": "values.npz"}
+
+
+def save(folder: Path) -> None:
+    from make_cli import COMMANDS, outputs
+    from pins import all_runs, values_of
+    from scenes import runs
+    from skfem_beam import scenes
+    folder.mkdir(parents=True, exist_ok=True)
+    data = {f"{name}/{k}": np.asarray(v) for name, make in runs(scenes).items()
+            for k, v in make().items()}
+    np.savez_compressed(folder / FILES["api"], **data)
+    with tempfile.TemporaryDirectory() as tmp:
+        data = {}
+        for name, args in COMMANDS.items():
+            data.update(outputs(name, args, tmp))
+        np.savez_compressed(folder / FILES["cli"], **data)
+    with tempfile.TemporaryDirectory() as tmp:      # its names are COMMANDS' too
+        np.savez_compressed(folder / FILES["commands"], **values_of(all_runs(Path(tmp))))
+
+
+def runs_of(path: Path) -> dict:
+    """run name -> {key: array}, from one of FILES."""
+    out = {}
+    with np.load(path) as data:
+        for k in data.files:
+            name, key = k.split("/", 1)
+            out.setdefault(name, {})[key] = data[k]
+    return out
+
+
+def time_and_second_impact(arrays: dict):
+    """A run's time column and the start of its second impact (from its impacts table,
+    or where its contact force switches on for the second time)."""
+    t = arrays["t"]
+    if "impacts_t_start" in arrays:
+        s = arrays["impacts_t_start"]
+        return t, float(s[1]) if len(s) > 1 else np.inf
+    return t, second_impact(t, arrays.get("contact_force", arrays.get("force")))
+
+
+ROUND_OFF = ("friction_residual",)   # a solver's residual is round-off itself: its bound
+#                                    is asserted where it is computed (tests/test_friction.py)
+
+
+def compared(arrays: dict) -> list:
+    """The keys of a run compared across machines: all but time, impact times and
+    round-off measures."""
+    return [k for k in arrays if k != "t" and not k.startswith("impacts_")
+            and k not in ROUND_OFF]
+
+
+def run_spread(got: dict, ref: dict) -> dict:
+    t, t2 = time_and_second_impact(ref)
+    worst = {"before": 0.0, "after": 0.0}
+    for key in compared(ref):
+        s = spread(got[key], ref[key], t, t2)
+        worst = {w: max(worst[w], s[w]) for w in worst}
+    return worst
+
+
+def measure(folders: list[Path]) -> dict:
+    """group/run -> the largest spread over the folders, against the stored arrays."""
+    measured = {}
+    for group, file in FILES.items():
+        ref = runs_of(HERE / file)
+        for folder in folders:
+            got = runs_of(folder / file)
+            for name in ref:
+                s, key = run_spread(got[name], ref[name]), f"{group}/{name}"
+                old = measured.get(key, {"before": 0.0, "after": 0.0})
+                measured[key] = {w: max(old[w], s[w]) for w in s}
+    return measured
+
+
+def write_tolerances(folders: list[Path]) -> None:
+    measured = measure(folders)
+    tol = {k: {w: tolerance(v, w) for w, v in m.items()} for k, m in measured.items()}
+    for k in sorted(measured):
+        m, t = measured[k], tol[k]
+        print(f"{k:40s} before {m['before']:.2e} -> {t['before']:.1e}   "
+              f"after {m['after']:.2e} -> {t['after']:.1e}")
+    TOLERANCES.write_text(json.dumps({"samples": [f.name for f in folders],
+                                      "measured": measured, "tolerance": tol},
+                                     indent=1, sort_keys=True) + "\n")
+
+
+if __name__ == "__main__":
+    if sys.argv[1:2] == ["save"]:
+        save(Path(sys.argv[2]))
+    elif sys.argv[1:2] == ["tolerances"]:
+        write_tolerances([Path(a) for a in sys.argv[2:]])
+    else:
+        sys.exit(__doc__)

@@ -193,15 +193,16 @@ def test_sub_points_follow_the_cubic(run):
     phi = pb.support.phi(t)
     dphi = pb.support.amplitude * pb.support.omega * np.cos(pb.support.omega * t)
     x = line.x[:-1]
-    np.testing.assert_allclose(x, smp.x, atol=1e-15)
+    A, w = pb.support.amplitude, pb.support.omega       # φ = 0.2 sin 10t: 0.2 m, 2 m/s
+    np.testing.assert_allclose(x, smp.x, atol=6e-16 * pb.beam.L)
     np.testing.assert_allclose(f["displacement"][:-1], smp.E0 @ u + lifting(x, pb.beam.L) * phi,
-                               rtol=1e-13, atol=1e-15)
+                               rtol=1e-13, atol=5e-15 * A)
     np.testing.assert_allclose(f["velocity"][:-1], smp.E0 @ v + lifting(x, pb.beam.L) * dphi,
-                               rtol=1e-8, atol=1e-12)
+                               rtol=1e-8, atol=5e-13 * A * w)
     inner = np.arange(x.size) % S != 0               # u'' jumps at nodes: compare inside
     want = pb.beam.rho_S * pb.beam.k2 * (smp.E2 @ u + lifting_dd(x, pb.beam.L) * phi)  # N·m
     np.testing.assert_allclose(f["bending_moment"][:-1][inner], want[inner], rtol=1e-10)
-    assert f["displacement"][0] == pytest.approx(phi, abs=1e-15)   # the clamp moves with φ
+    assert f["displacement"][0] == pytest.approx(phi, abs=5e-15 * A)   # the clamp moves with φ
     # a cubic, not its chord: mid-element values differ from the nodal average
     nodes = f["displacement"][::S]
     chord = 0.5 * (nodes[:-1] + nodes[1:])
@@ -226,7 +227,8 @@ def test_bspline_and_bar_spaces(tmp_path):
         t, pd, _ = rd.read_data(rd.num_steps - 1)
     assert set(pd) == ARRAYS
     smp = rb.system.space.sampler(np.arange(S) / S)
-    np.testing.assert_allclose(pd["displacement"][:-1], smp.E0 @ rb.frames_u[-1], atol=1e-15)
+    np.testing.assert_allclose(pd["displacement"][:-1], smp.E0 @ rb.frames_u[-1],
+                               atol=1e-13 * 0.01)                  # 1e-13 × the gap
     assert (pd["g1"] == -0.01).all() and (pd["g2"] == 0.01).all()
 
     rbar = solve(bar_system(Bar(N=10)), dt=0.01, T=0.2, beta=0.25, frames=4)
@@ -328,7 +330,8 @@ MESH_DIR = os.path.join(os.path.dirname(__file__), "..", "meshes")
 def test_shipped_meshes(name):
     L, J = PAPER_MESHES[name]
     x = load_mesh(os.path.join(MESH_DIR, f"{name}.msh"), L)
-    np.testing.assert_allclose(x, np.linspace(0, L, J + 1), rtol=0, atol=1e-15)
+    # written to full precision: equal (0 measured), 1e-16 L is 1e-15 m on the 10 m pipe
+    np.testing.assert_allclose(x, np.linspace(0, L, J + 1), rtol=0, atol=1e-16 * L)
     if L == 10.0:
         assert 5.0 in x
     pb = BeamProblem(Beam(L, 282.84), Obstacles.point_stops(L, -0.1, 0.1), nodes=x)
@@ -396,6 +399,7 @@ def test_field_forces_are_the_series_newtons(tmp_path):
     assert exit_code(run_main, [str(example("heat_exchanger_tube")), "--set", "time.T=0.1",
                                 "--format", "xdmf", "--frames", "100", "--out", str(out)]) == 0
     series = np.genfromtxt(out / "timeseries.csv", delimiter=",", names=True)
+    small = 6e-15 * np.abs(series["contact_force_N"]).max()   # N, for a force near 0
     hits = 0
     with meshio.xdmf.TimeSeriesReader(out / "fields.xdmf") as rd:
         rd.read_points_cells()
@@ -404,6 +408,6 @@ def test_field_forces_are_the_series_newtons(tmp_path):
             k = int(np.argmin(np.abs(series["t"] - t)))
             assert abs(series["t"][k] - t) < 1e-12
             assert pd["contact_force"].sum() == pytest.approx(series["contact_force_N"][k],
-                                                              rel=1e-12, abs=1e-12)
+                                                              rel=1e-12, abs=small)
             hits += series["contact_force_N"][k] != 0
     assert hits >= 2

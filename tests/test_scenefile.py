@@ -120,7 +120,7 @@ def test_motion_table_is_relative_to_the_scene_and_stored_for_resume(tmp_path):
                        "[output]\nformat = \"none\"\n")
     scene = load(scene_file)
     motion = scene.problem.support.motion
-    assert isinstance(motion, Table) and motion(0.15) == pytest.approx(0.2 * np.sin(1.5), abs=1e-9)
+    assert isinstance(motion, Table) and motion(0.15) == pytest.approx(0.2 * np.sin(1.5), rel=5e-9)
     assert set(scene.files) == {"phi.csv"}
     a, ref = tmp_path / "a", tmp_path / "ref"
     assert exit_code(run_main, [str(scene_file), "--out", str(ref), "--T", "0.02"]) == 0
@@ -390,7 +390,9 @@ def test_a_bar_section_is_its_area(tmp_path, capsys):
     f1 = np.genfromtxt(per / "timeseries.csv", delimiter=",", names=True)["contact_force"]
     f2 = np.genfromtxt(area / "timeseries.csv", delimiter=",", names=True)["contact_force"]
     assert np.nanmax(np.abs(f1)) > 0.5
-    np.testing.assert_allclose(f2, 2.0 * f1, rtol=1e-12, atol=1e-12)
+    # two runs' round-off: 2.6e-12 N measured at a 2.0 N force (peak 2.18 N); rtol alone
+    # would not hold it, so an atol of 1e-12 × the peak force
+    np.testing.assert_allclose(f2, 2.0 * f1, rtol=1e-12, atol=1e-12 * np.nanmax(np.abs(f2)))
     assert json.loads((area / "summary.json").read_text())["units"]["contact_force"] == "N"
     bad = tmp_path / "bad"
     bad.mkdir()

@@ -11,8 +11,9 @@ output options).  Every value is checked by the object it builds; this module ch
 the file's shape: an unknown section or key is refused in one line naming it and the
 allowed ones, and a value the schema marks as a number (N), or an array of numbers
 (ListOf), that is not one (``"0.5m"``) in one line naming its key path (with the index
-inside an array: ``output.probes[0]``).  Relative paths (tables) are relative to the scene file.  The keys are
-:data:`BEAM_KEYS` and :data:`BAR_KEYS` (docs/scene_files.md, generated from them).
+inside an array: ``output.probes[0]``).  Relative paths (tables) are relative to the
+scene file.  The keys are :data:`BEAM_KEYS` and :data:`BAR_KEYS` (docs/scene_files.md,
+generated from them).
 
 Choices a TOML file forces:
 

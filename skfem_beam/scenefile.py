@@ -911,7 +911,9 @@ def _scene_of(path, sets, resume) -> Scene:
 
 
 def _wear(scene: Scene):
-    """[wear] as output.supports.Wear (radius defaults to a tube's or rod's outer one)."""
+    """[wear] as output.supports.Wear (radius defaults to a tube's or rod's outer one).
+    Without land: volumes only (a depth spreads the volume over the land), so no radius
+    is needed either."""
     from .output.supports import Wear
     d = scene.data.get("wear")
     if d is None:
@@ -920,17 +922,19 @@ def _wear(scene: Scene):
     if not holes:
         raise InputError("[wear] needs holes (planes = 2 and [[obstacles]] hole = ...): wear "
                          "comes from the normal force times the sliding along a wall")
-    section = scene.data.get("section", {})
-    radius = d.get("radius")
-    if radius is None:
-        diameter = section.get("tube", {}).get("outer_diameter") or \
-            section.get("rod", {}).get("diameter")
-        if diameter is None:
-            raise InputError("[wear] radius (m, the tube's outer radius) is needed when "
-                             "[section] is not a tube or a rod")
-        radius = 0.5 * diameter
-    need = _need(d, ("coefficient", "service_years", "land"), "wear")
-    return Wear(need["coefficient"], need["service_years"], need["land"], radius)
+    radius = d.get("radius", _outer_radius(scene.data.get("section", {})))
+    if radius is None and "land" in d:
+        raise InputError("[wear] radius (m, the tube's outer radius) is needed for the depth "
+                         "(land) when [section] is not a tube or a rod")
+    need = _need(d, ("coefficient", "service_years"), "wear")
+    return Wear(need["coefficient"], need["service_years"], d.get("land"), radius)
+
+
+def _outer_radius(section: dict) -> float | None:
+    """A tube's or rod's outer radius (m) from [section], else None."""
+    diameter = section.get("tube", {}).get("outer_diameter") or \
+        section.get("rod", {}).get("diameter")
+    return None if diameter is None else 0.5 * diameter
 
 
 def _spec(scene: Scene, flags: dict, resume) -> RunSpec:

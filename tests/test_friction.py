@@ -151,6 +151,34 @@ def test_wear_is_archards_law_linear_in_the_coefficient(tmp_path):
                                                                          rel=1e-12)
 
 
+def test_wear_without_a_land_gives_the_volumes_and_no_depth(tmp_path):
+    """[wear] with no land: the same volumes and volume rates per support and per sector
+    as with one (they need only K and the service years), no depth, and the units say
+    that a depth needs the land."""
+    text = example("tube_round_holes_friction").read_text()
+    assert "land = 0.019" in text
+    scenes = {"land": text, "none": text.replace("land = 0.019", "")}
+    supports, units = {}, {}
+    for name, scene in scenes.items():
+        (tmp_path / f"{name}.toml").write_text(scene)
+        out = tmp_path / name
+        assert exit_code(run_main, [str(tmp_path / f"{name}.toml"), "--set", "time.T=0.2",
+                                    "--out", str(out), "--format", "none"]) == 0
+        stats = json.loads((out / "summary.json").read_text())["impact_statistics"]
+        supports[name], units[name] = stats["supports"], stats["units"]["wear"]
+    for with_land, without in zip(supports["land"], supports["none"]):
+        w, v = with_land["wear"], without["wear"]
+        assert with_land["normal_work_rate"] > 0 and "depth_uniform" in w
+        assert set(v) == {"volume_rate", "volume", "sectors"}
+        assert v["volume_rate"] == w["volume_rate"] and v["volume"] == w["volume"]
+        for a, b in zip(w["sectors"], v["sectors"]):
+            assert "depth" in a and "depth" not in b
+            assert b == {k: a[k] for k in ("from_rad", "to_rad", "volume_rate", "volume")}
+        assert sum(k["volume_rate"] for k in v["sectors"]) == pytest.approx(v["volume_rate"],
+                                                                             rel=1e-12)
+    assert "depth needs [wear] land" in units["none"] and "depth" in units["land"]
+
+
 # ---------------------------------------------------------------- Siconos
 def recorded(count=30):
     """Moreau–Jean step problems with both holes in contact: nsgs's inputs and result."""
@@ -282,8 +310,6 @@ def test_a_step_that_misses_the_tolerance_stops_the_run_with_one_line():
      "[contact]\nlaw = \"position\"\n", "velocity-level"),
     ("planes = 2\n[[obstacles]]\nx = 0.5\nhole = { sides = 3, radius = 4e-4 }\nfriction = 0.3\n",
      "frictionless"),
-    ("planes = 2\n[[obstacles]]\nx = 0.5\nhole = { radius = 4e-4 }\n[wear]\ncoefficient = 1e-14\n"
-     "service_years = 40\n", "land"),
 ])
 def test_friction_where_it_cannot_act_is_refused(tmp_path, capsys, extra, word):
     from conftest import assert_refused

@@ -23,7 +23,8 @@ the tube's surface in contact, the land's width b (axial) times the arc the cont
 covers: uniformly round the tube, d = V/(2πRb); per 30° sector k of the hole (the node's
 angle when the work is done, as Code_Aster's POST_USURE sums it per sector),
 d_k = V_k/(R·(π/6)·b).  The tube does not turn about its axis, so a sector of the hole
-wears the same sector of the tube.
+wears the same sector of the tube.  Without a land the volumes and volume rates alone
+(per support and per sector): they need only K and the service years.
 """
 from __future__ import annotations
 
@@ -33,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..checks import check_positive
+from ..errors import InputError
 from ..scheme.kernels import SECTORS
 
 YEAR = 365.25 * 86400.0     # s
@@ -42,30 +44,46 @@ YEAR = 365.25 * 86400.0     # s
 class Wear:
     """Archard's law at the supports: ``coefficient`` K (m³/(N·m)), ``service_years`` Y,
     ``land`` b (m, the support's axial contact width), ``radius`` R (m, the tube's outer
-    radius); the module docstring says what each number assumes."""
+    radius); the module docstring says what each number assumes.  The volumes need only
+    K and Y; the depths spread them over the land and the radius, so with ``land`` None
+    there are no depths (and the radius may be None)."""
     coefficient: float
     service_years: float
-    land: float
-    radius: float
+    land: float | None = None
+    radius: float | None = None
 
     def __post_init__(self):
+        if self.land is not None and self.radius is None:
+            raise InputError("[wear] land: a depth spreads the volume over the land and the "
+                             "tube's radius: give radius (m) too")
         for name in ("coefficient", "service_years", "land", "radius"):
+            if getattr(self, name) is None:
+                continue        # land, radius: only the depths need them
             object.__setattr__(self, name, check_positive(f"[wear] {name}",
                                                           getattr(self, name)))
 
     def of(self, normal_work_rate: float, sectors: np.ndarray, T: float) -> dict:
         """The support's wear from its normal work rate (W) and its normal work per
-        sector over the run's time T (J)."""
+        sector over the run's time T (J): volume rates and volumes, per support and per
+        sector, and the depths only with a land (a depth spreads a volume over it)."""
         life = self.service_years * YEAR
         rate = self.coefficient * normal_work_rate
         arc = 2 * math.pi / SECTORS
-        volumes = self.coefficient * np.asarray(sectors) / T * life
-        return {"volume_rate": rate, "volume": rate * life,
-                "depth_uniform": rate * life / (2 * math.pi * self.radius * self.land),
-                "sectors": [{"from_rad": -math.pi + k * arc, "to_rad": -math.pi + (k + 1) * arc,
-                             "volume": float(v), "depth": float(v / (self.radius * arc
-                                                                      * self.land))}
-                            for k, v in enumerate(volumes)]}
+        rates = self.coefficient * np.asarray(sectors) / T     # m³/s per sector
+        out = {"volume_rate": rate, "volume": rate * life}
+        if self.land is not None:
+            out["depth_uniform"] = rate * life / (2 * math.pi * self.radius * self.land)
+        out["sectors"] = [self._sector(k, arc, float(r), float(r * life))
+                          for k, r in enumerate(rates)]
+        return out
+
+    def _sector(self, k: int, arc: float, rate: float, volume: float) -> dict:
+        """Sector k (from +v towards +w): its volume rate, volume and, with a land, depth."""
+        out = {"from_rad": -math.pi + k * arc, "to_rad": -math.pi + (k + 1) * arc,
+               "volume_rate": rate, "volume": volume}
+        if self.land is not None:
+            out["depth"] = volume / (self.radius * arc * self.land)
+        return out
 
 
 ANGLE_BINS = SECTORS   # the impact-angle histogram: the wear's 30° sectors, −180° to 180°
@@ -116,14 +134,22 @@ def support_statistics(table: dict, run, scale: float, duration: float, T: float
     return out
 
 
+def _wear_units(wear: Wear) -> str:
+    """What the wear entry's numbers are; without a land it says why there is no depth."""
+    volumes = ("volume_rate m³/s = K × normal_work_rate, volume m³ after service_years, "
+               "sectors: per 30° of the hole (rad from +v towards +w) the volume_rate and "
+               "volume")
+    if wear.land is None:
+        return (f"{volumes}; K = coefficient m³/(N·m), as given in [wear]; no depth: a "
+                "depth needs [wear] land (the support's axial width b, m)")
+    return (f"{volumes}, and depth volume/(R·(π/6)·b); depth_uniform m = volume/(2πRb) "
+            "(worn evenly round the tube over the land b); K = coefficient m³/(N·m), "
+            "R = radius, b = land (m), as given in [wear]")
+
+
 def work_rate_units(newtons: bool, wear: Wear | None = None) -> dict:
     unit = "W" if newtons else "m³/s³ (W per kg/m)"
-    out = {} if wear is None else {"wear": (
-        "volume_rate m³/s = K × normal_work_rate, volume m³ after service_years, "
-        "depth_uniform m = volume/(2πRb) (worn evenly round the tube over the land b), "
-        "sectors: per 30° of the hole (rad from +v towards +w) the volume and depth "
-        "volume/(R·(π/6)·b); K = coefficient m³/(N·m), R = radius, b = land (m), "
-        "as given in [wear]")}
+    out = {} if wear is None else {"wear": _wear_units(wear)}
     return {**out,
             "friction_work_rate": f"{unit}: −(1/T) × the support's friction work",
             "impact_work_rate": f"{unit}: −(1/T)Σ ½λ·(y^(n+1) − y^(n−1)) over the support's "

@@ -114,7 +114,7 @@ def support_statistics(table: dict, run, scale: float, duration: float, T: float
     edges = np.linspace(-math.pi, math.pi, ANGLE_BINS + 1)
     out = []
     for x in np.unique(x_rows):
-        rows = np.flatnonzero(x_rows == x)
+        rows = support_rows(run, x)
         ev = np.flatnonzero(table["x"] == x)
         angles = np.asarray(table["angle"], dtype=float)[ev]
         counts, _ = np.histogram(angles[np.isfinite(angles)], edges)
@@ -124,14 +124,31 @@ def support_statistics(table: dict, run, scale: float, duration: float, T: float
             / duration if ev.size and duration > 0 else 0.0,
             "impact_angle_histogram": {"edges_rad": edges.tolist(), "counts": counts.tolist()},
             "impact_work_rate": -scale * float(work[rows, 0].sum()) / T,
-            "normal_work_rate": scale * float(work[rows, 1].sum()) / T}
+            "normal_work_rate": _normal_work_rate(run, rows, scale, T)}
         if run.st.fc.shape[0]:
             entry["friction_work_rate"] = -scale * float(work[rows, 2].sum()) / T
         if wear is not None:
-            entry["wear"] = wear.of(entry["normal_work_rate"],
-                                    scale * run.st.sectors[rows].sum(axis=0), T)
+            entry["wear"] = support_wear(run, x, scale, T, wear)
         out.append(entry)
     return out
+
+
+def support_rows(run, x: float) -> np.ndarray:
+    """The constrained rows of the support at x (a hole's two, or its faces)."""
+    return np.flatnonzero(np.asarray(run.system.x_contact, dtype=float) == x)
+
+
+def _normal_work_rate(run, rows, scale: float, T: float) -> float:
+    return scale * float(run.st.rowwork[rows, 1].sum()) / T
+
+
+def support_wear(run, x: float, scale: float, T: float, wear: Wear) -> dict:
+    """The wear entry of the support at x, as summary.json has it (the same code): the
+    wear chart draws it in the charts' phase, before summary.json is written."""
+    T = T if T > 0 else math.nan
+    rows = support_rows(run, x)
+    return wear.of(_normal_work_rate(run, rows, scale, T),
+                   scale * run.st.sectors[rows].sum(axis=0), T)
 
 
 def _wear_units(wear: Wear) -> str:

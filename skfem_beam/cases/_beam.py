@@ -14,8 +14,8 @@ from ..output.charts import (energy_chart, orbit_chart, shape_chart, shapes,
 from ..output.events import beam_impacts
 from ..output.fields import physical_at, physical_tip
 from ..output.probes import probe_columns, probe_units
-from ..output.series import Series, execute, prepare
-from ..output.supports import support_wear
+from ..output.series import Series, execute, prepare, read_summary
+from ..output.supports import support_table, support_wear
 from ..methods import Penalty
 from ..scheme.kernels import WORK_TERMS
 from ..spec import RunSpec
@@ -63,8 +63,20 @@ def run_beam_case(case: str, problem, spec: RunSpec, stops=(), extra=None) -> in
                    beam_charts(case, problem, rho_S, stops, extra, system.view.observed_x,
                                spec.wear))
     if code == 0:
+        print_supports(Path(spec.options.out), spec.wear)
         warn_no_contact(run, system)
     return code
+
+
+def print_supports(folder: Path, wear) -> None:
+    """Under the run's end line, the supports' table (output.supports.support_table) read
+    back from summary.json, so that the screen says what the file says; nothing when
+    the run has no supports (one plane, or no hole and no flat obstacle at a node)."""
+    stats = read_summary(folder).get("impact_statistics") or {}
+    newtons = stats.get("units", {}).get("impact_work_rate", "W").startswith("W")
+    text = support_table(stats.get("supports") or [], newtons, wear)
+    if text:
+        print(text)
 
 
 def warn_no_contact(run, system) -> None:

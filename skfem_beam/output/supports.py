@@ -181,3 +181,46 @@ def work_rate_units(newtons: bool, wear: Wear | None = None) -> dict:
             "normal_velocity": "m/s, the node's velocity before the impact along the wall's "
                                "outward normal (> 0: towards the wall)",
             "tangential_velocity": "m/s, its component along the wall, counter-clockwise"}
+
+
+DASH = "—"      # a number the run has not got: no friction, no [wear], no land
+
+
+def _cell(value: float | None) -> str:
+    return DASH if value is None else f"{value:.4g}"
+
+
+def _row(s: dict) -> list[str]:
+    """One support's cells: x, impacts, contact fraction, the three work rates, the worn
+    volume (mm³) and the deepest sector's depth (mm), as summary.json has them."""
+    wear = s.get("wear")
+    depths = [k["depth"] for k in wear["sectors"] if "depth" in k] if wear else []
+    return [f"{s['x']:g}", str(s["impacts"]), _cell(s["contact_fraction"]),
+            _cell(s["impact_work_rate"]), _cell(s["normal_work_rate"]),
+            _cell(s.get("friction_work_rate")),
+            _cell(wear["volume"] * 1e9 if wear else None),
+            _cell(max(depths) * 1e3 if depths else None)]
+
+
+def support_table(supports: list[dict], newtons: bool = True,
+                  wear: Wear | None = None) -> str:
+    """summary.json's ``impact_statistics.supports`` as a plain-text table for the
+    terminal, one row per support (about 80 columns): the answer a pipe engineer reads
+    first, without opening the file.  ``newtons``: the work rates are in W (ρS known);
+    ``wear``: the run's [wear], whose service years the heading names.  "" without
+    supports."""
+    if not supports:
+        return ""
+    unit = "W" if newtons else "W/(kg/m)"
+    head = ["x (m)", "impacts", "contact", f"impact {unit}", f"normal {unit}",
+            f"friction {unit}", "volume mm³", "depth mm"]
+    rows = [_row(s) for s in supports]
+    widths = [max(len(r[i]) for r in [head] + rows) for i in range(len(head))]
+    about = "contact: fraction of the time"
+    if wear is not None:
+        about += (f"; wear after {wear.service_years:g} years; "
+                  + ("depth: deepest 30° sector" if wear.land is not None
+                     else "no depth without [wear] land"))
+    lines = [f"supports ({about}):"]
+    lines += ["  ".join(c.rjust(w) for c, w in zip(r, widths)) for r in [head] + rows]
+    return "\n".join(lines)

@@ -109,9 +109,11 @@ SECTION_DOCS = {
     ),
     'wear': (
         "Archard's law at the holes (two planes): `coefficient` K (m³/(N·m)), "
-        "`service_years`, `land` (the support's axial width b, m), `radius` (the tube's outer"
-        " radius, m; default from a tube or rod `[section]`); summary.json's supports get the"
-        ' wear volume rate, volume, depth spread evenly and per 30° sector'
+        "`service_years`, `land` (the support's axial width b, m; optional: a depth needs it),"
+        " `radius` (the tube's outer radius, m; default from a tube or rod `[section]`; only"
+        " the depth needs it); summary.json's supports get the wear volume rate and volume,"
+        ' per support and per 30° sector, and with `land` the depth spread evenly and per'
+        ' sector'
     ),
 }
 

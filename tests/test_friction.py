@@ -151,6 +151,108 @@ def test_wear_is_archards_law_linear_in_the_coefficient(tmp_path):
                                                                          rel=1e-12)
 
 
+def test_wear_without_a_land_gives_the_volumes_and_no_depth(tmp_path):
+    """[wear] with no land: the same volumes and volume rates per support and per sector
+    as with one (they need only K and the service years), no depth, and the units say
+    that a depth needs the land."""
+    text = example("tube_round_holes_friction").read_text()
+    assert "land = 0.019" in text
+    scenes = {"land": text, "none": text.replace("land = 0.019", "")}
+    supports, units = {}, {}
+    for name, scene in scenes.items():
+        (tmp_path / f"{name}.toml").write_text(scene)
+        out = tmp_path / name
+        assert exit_code(run_main, [str(tmp_path / f"{name}.toml"), "--set", "time.T=0.2",
+                                    "--out", str(out), "--format", "none"]) == 0
+        stats = json.loads((out / "summary.json").read_text())["impact_statistics"]
+        supports[name], units[name] = stats["supports"], stats["units"]["wear"]
+    for with_land, without in zip(supports["land"], supports["none"]):
+        w, v = with_land["wear"], without["wear"]
+        assert with_land["normal_work_rate"] > 0 and "depth_uniform" in w
+        assert set(v) == {"volume_rate", "volume", "sectors"}
+        assert v["volume_rate"] == w["volume_rate"] and v["volume"] == w["volume"]
+        for a, b in zip(w["sectors"], v["sectors"]):
+            assert "depth" in a and "depth" not in b
+            assert b == {k: a[k] for k in ("from_rad", "to_rad", "volume_rate", "volume")}
+        assert sum(k["volume_rate"] for k in v["sectors"]) == pytest.approx(v["volume_rate"],
+                                                                             rel=1e-12)
+    assert "depth needs [wear] land" in units["none"] and "depth" in units["land"]
+
+
+def printed_supports(out: str) -> list[list[str]] | None:
+    """The rows (cells) of the supports' table a run printed on stdout, None if none."""
+    lines = out.splitlines()
+    start = next((i for i, line in enumerate(lines) if line.startswith("supports (")), None)
+    if start is None:
+        return None
+    assert lines[start + 1].split()[:3] == ["x", "(m)", "impacts"]
+    assert all(len(line) <= 100 for line in lines[start:])
+    return [line.split() for line in lines[start + 2:] if line.strip()]
+
+
+def is_png(path) -> bool:
+    return path.stat().st_size > 0 and path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_a_tube_run_prints_its_supports_and_draws_their_wear(tmp_path, capsys, monkeypatch):
+    """The friction scene prints one row per support whose numbers are summary.json's (to
+    the 4 digits printed), and draws wear_<x>.png per support from the same wear entry."""
+    from skfem_beam.cases import _beam
+    drawn = {}
+    real = _beam.draw
+
+    def draw(chart, path, *args, **kwargs):     # the wear entry each chart is drawn from
+        if chart.__name__ == "wear_chart":
+            drawn[path.name] = args[0]
+        real(chart, path, *args, **kwargs)
+    monkeypatch.setattr(_beam, "draw", draw)
+    out = tmp_path / "run"
+    assert exit_code(run_main, [str(example("tube_round_holes_friction")), "--set",
+                                "time.T=0.2", "--out", str(out), "--format", "none"]) == 0
+    rows = printed_supports(capsys.readouterr().out)
+    supports = json.loads((out / "summary.json").read_text())["impact_statistics"]["supports"]
+    assert rows is not None and len(rows) == len(supports) == 2
+    for row, s in zip(rows, supports):
+        depth = max(k["depth"] for k in s["wear"]["sectors"])
+        expect = [s["x"], s["contact_fraction"], s["impact_work_rate"], s["normal_work_rate"],
+                  s["friction_work_rate"], s["wear"]["volume"] * 1e9, depth * 1e3]
+        assert int(row[1]) == s["impacts"] > 0
+        cells = [float(c) for c in row[:1] + row[2:]]
+        assert cells == pytest.approx(expect, rel=5e-4)
+        assert is_png(out / f"wear_{s['x']:g}.png")
+        assert drawn[f"wear_{s['x']:g}.png"] == s["wear"]
+
+
+def test_without_land_or_wear_the_table_says_so_and_without_wear_no_wear_chart(
+        tmp_path, capsys):
+    """No land: the depth column is "—", the chart draws volumes; no [wear]: "—" for the
+    volume too and no wear chart (the orbits are drawn as before)."""
+    text = example("tube_round_holes_friction").read_text()
+    start = text.index("[wear]")
+    scenes = {"no_land": text.replace("land = 0.019", ""),
+              "no_wear": text[:start] + text[text.index("[mesh]"):]}
+    for name, scene in scenes.items():
+        (tmp_path / f"{name}.toml").write_text(scene)
+        out = tmp_path / name
+        assert exit_code(run_main, [str(tmp_path / f"{name}.toml"), "--set", "time.T=0.05",
+                                    "--out", str(out), "--format", "none"]) == 0
+        rows = printed_supports(capsys.readouterr().out)
+        assert [r[-1] for r in rows] == ["—", "—"]
+        assert (rows[0][-2] == "—") == (name == "no_wear")
+        assert is_png(out / "orbit_0.5.png")
+        assert (out / "wear_0.5.png").exists() == (name == "no_land")
+
+
+def test_a_run_without_supports_prints_no_table_and_draws_no_wear_chart(tmp_path, capsys):
+    from skfem_beam.cases import point_stops
+    out = tmp_path / "run"
+    assert exit_code(point_stops.main, ["--T", "0.05", "--out", str(out),
+                                        "--format", "none"]) == 0
+    printed = capsys.readouterr().out
+    assert "steps in" in printed and printed_supports(printed) is None
+    assert not list(out.glob("wear_*"))
+
+
 # ---------------------------------------------------------------- Siconos
 def recorded(count=30):
     """Moreau–Jean step problems with both holes in contact: nsgs's inputs and result."""
@@ -282,8 +384,6 @@ def test_a_step_that_misses_the_tolerance_stops_the_run_with_one_line():
      "[contact]\nlaw = \"position\"\n", "velocity-level"),
     ("planes = 2\n[[obstacles]]\nx = 0.5\nhole = { sides = 3, radius = 4e-4 }\nfriction = 0.3\n",
      "frictionless"),
-    ("planes = 2\n[[obstacles]]\nx = 0.5\nhole = { radius = 4e-4 }\n[wear]\ncoefficient = 1e-14\n"
-     "service_years = 40\n", "land"),
 ])
 def test_friction_where_it_cannot_act_is_refused(tmp_path, capsys, extra, word):
     from conftest import assert_refused

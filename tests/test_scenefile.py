@@ -472,6 +472,12 @@ def test_added_mass_gives_the_textbook_first_frequency(tmp_path):
                                  "SI units (m, s, kg, N, Pa; e.g. 0.25 mm is 0.00025)"),
     ((), ["obstacles.0.g1=-0.25mm"], "hx.toml: --set obstacles.0.g1=-0.25mm: must be a number"),
     ((), ["mass.added=0.3kg"], "hx.toml: --set mass.added=0.3kg: must be a number"),
+    (("frames = 200", 'frames = 200\nprobes = [0.5, "1m"]'), [],
+     "hx.toml: output.probes[1] = '1m': must be a number, in SI units"),
+    (("frames = 200", "frames = 200\nprobes = 0.5"), [],
+     "hx.toml: output.probes = 0.5: must be an array of numbers"),
+    ((), ['output.probes=[0.5, "1m"]'],
+     "hx.toml: --set output.probes=[0.5, \"1m\"]: output.probes[1] = '1m': must be a number"),
 ])
 def test_unit_mistakes_are_one_line_naming_the_file_and_key(tmp_path, capsys, change, sets,
                                                             line):
@@ -481,6 +487,126 @@ def test_unit_mistakes_are_one_line_naming_the_file_and_key(tmp_path, capsys, ch
     out.mkdir()
     argv = [str(src), *[a for x in sets for a in ("--set", x)], "--out", str(out / "run")]
     assert_refused(run_main, argv, line, capsys, out)
+
+
+def toml_text(data: dict) -> str:
+    """``data`` as TOML, each top-level key on one line (inline tables and arrays), so
+    that a test can write back a scene file with one value changed."""
+    return "".join(f"{key} = {toml_value(value)}\n" for key, value in data.items())
+
+
+def toml_value(value) -> str:
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{k} = {toml_value(v)}" for k, v in value.items()) + "}"
+    if isinstance(value, list):
+        return "[" + ", ".join(toml_value(v) for v in value) + "]"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    return json.dumps(value) if isinstance(value, str) else repr(value)
+
+
+def numbers_in(value, schema, name="", where=()):
+    """(key path as error lines write it, path into the data) of every number in
+    ``value``, list entries included, walking the key table ``schema`` beside it; a number
+    where the table checks no number fails: "0.5m" there would reach the objects."""
+    from skfem_beam.scenefile import N, ListOf, NumberOr, NumberOrWord
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        assert schema is N or isinstance(schema, (NumberOr, NumberOrWord)), \
+            f"{name} = {value!r}: the key table does not mark it as a number"
+        yield name, where
+    elif isinstance(value, list):
+        assert isinstance(schema, (ListOf, list)), f"{name}: the key table has no array"
+        for i, item in enumerate(value):
+            inner = f"{name}[{i}]" if isinstance(schema, ListOf) else f"{name}.{i}"
+            yield from numbers_in(item, schema.item if isinstance(schema, ListOf)
+                                  else schema[0], inner, where + (i,))
+    elif isinstance(value, dict):
+        for key, item in value.items():
+            yield from numbers_in(item, schema[key], f"{name}.{key}" if name else key,
+                                  where + (key,))
+
+
+SHIPPED = sorted(p.name for p in example("point_stops").parent.glob("*.toml"))
+# the arrays of numbers the shipped files do not use (they run as they are)
+ARRAYS = {"arrays.toml": """kind = "beam"
+planes = 2
+[mass_normalised]
+k2 = 282.84
+rho_S = 0.1194
+[geometry]
+L = 1.5
+[motion]
+end = "left"
+direction = [0.6, 0.8]
+sines = [[0.001, 10.0, 0.0], [0.002, 20.0]]
+[[obstacles]]
+x = 0.5
+hole = { radius = 0.001, centre = [0.0001, 0.0] }
+[[obstacles]]
+x = 0.75
+hole = { polygon = [[0.001, 0.0], [0.0, 0.001], [-0.001, 0.0], [0.0, -0.001]] }
+[[obstacles]]
+x = 1.0
+hole = { faces = [[1.0, 0.0, 0.001], [-1.0, 0.0, 0.001]], centre = [0.0, 0.0] }
+[[obstacles]]
+x_from = 1.25
+x_to = 1.5
+g1 = { x = [1.25, 1.5], g = [-0.01, -0.02] }
+g2 = { poly = [0.01, 0.001], about = 1.25 }
+[initial]
+u0 = { x = [0.0, 0.5, 1.0, 1.5], u = [0.0, 0.0001, 0.0002, 0.0003] }
+v0 = { x = [0.0, 0.75, 1.5], v = [0.0, 0.001, 0.002] }
+[mesh]
+nodes = [0.0, 0.25, 0.5, 0.75, 1.0, 1.25, 1.5]
+[time]
+dt = 1e-4
+T = 0.01
+[output]
+probes = [0.3, 0.6]
+""", "bar_tables.toml": """kind = "bar"
+[material]
+E = 1.0
+rho = 1.0
+[geometry]
+L = 1.0
+[[obstacles]]
+x = "left"
+[initial]
+u0 = { x = [0.0, 1.0], u = [0.0, 0.0] }
+v0 = { x = [0.0, 0.5, 1.0], v = [-1.0, -1.0, -1.0] }
+[time]
+dt = 1e-3
+T = 0.01
+"""}
+
+
+@pytest.mark.parametrize("name", SHIPPED + sorted(ARRAYS))
+def test_a_unit_string_for_any_number_of_a_scene_file_is_one_line(tmp_path, capsys, name):
+    """Every number of the shipped scene files (and of ARRAYS), in arrays too, written
+    "0.5m": exit code 2, one stderr line naming the file, the key path and the value,
+    nothing written."""
+    import copy
+    import tomllib
+    from skfem_beam.scenefile import KINDS
+    text = ARRAYS[name] if name in ARRAYS else example(name).read_text()
+    if name in ARRAYS:      # a valid scene: the refusals below are the changed value's
+        assert exit_code(run_main, [str(write(tmp_path, text, name)), "--format", "none",
+                                    "--out", str(tmp_path / "valid")]) == 0
+    data = tomllib.loads(text)
+    assert tomllib.loads(toml_text(data)) == data          # the writer loses nothing
+    found = list(numbers_in(data, KINDS[data.get("kind", "beam")]))
+    assert len(found) >= 10
+    out = tmp_path / "out"
+    out.mkdir()
+    for key, where in found:
+        changed = copy.deepcopy(data)
+        node = changed
+        for part in where[:-1]:
+            node = node[part]
+        node[where[-1]] = "0.5m"
+        src = write(tmp_path, toml_text(changed), name)
+        assert_refused(run_main, [str(src), "--out", str(out / "run")],
+                       f"error: {name}: {key} = '0.5m': must be ", capsys, out)
 
 
 @pytest.mark.parametrize("sets, warning", [

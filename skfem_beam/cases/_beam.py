@@ -10,11 +10,12 @@ from .. import cli
 from ..chart_process import draw
 from ..scheme.kernels import CONTACT_STEPS
 from ..output.charts import (energy_chart, orbit_chart, shape_chart, shapes,
-                             trajectory_chart)
+                             trajectory_chart, wear_chart)
 from ..output.events import beam_impacts
 from ..output.fields import physical_at, physical_tip
 from ..output.probes import probe_columns, probe_units
-from ..output.series import Series, execute, prepare
+from ..output.series import Series, execute, prepare, read_summary
+from ..output.supports import support_table, support_wear
 from ..methods import Penalty
 from ..scheme.kernels import WORK_TERMS
 from ..spec import RunSpec
@@ -59,10 +60,23 @@ def run_beam_case(case: str, problem, spec: RunSpec, stops=(), extra=None) -> in
     series = Series((two_plane_columns if two else beam_columns)(system.view, rho_S),
                     events=events)
     code = execute(run, spec.options, summary, series,
-                   beam_charts(case, problem, rho_S, stops, extra, system.view.observed_x))
+                   beam_charts(case, problem, rho_S, stops, extra, system.view.observed_x,
+                               spec.wear))
     if code == 0:
+        print_supports(Path(spec.options.out), spec.wear)
         warn_no_contact(run, system)
     return code
+
+
+def print_supports(folder: Path, wear) -> None:
+    """Under the run's end line, the supports' table (output.supports.support_table) read
+    back from summary.json, so that the screen says what the file says; nothing when
+    the run has no supports (one plane, or no hole and no flat obstacle at a node)."""
+    stats = read_summary(folder).get("impact_statistics") or {}
+    newtons = stats.get("units", {}).get("impact_work_rate", "W").startswith("W")
+    text = support_table(stats.get("supports") or [], newtons, wear)
+    if text:
+        print(text)
 
 
 def warn_no_contact(run, system) -> None:
@@ -170,9 +184,10 @@ def two_plane_units(rho_S) -> dict:
     return out
 
 
-def beam_charts(case, problem, rho_S, stops, extra, observed_x=None):
+def beam_charts(case, problem, rho_S, stops, extra, observed_x=None, wear=None):
     """The charts of a beam run (and the case's ``extra`` files), from the rows in memory;
-    ``observed_x``: where the default series observes a beam whose end at L is held."""
+    ``observed_x``: where the default series observes a beam whose end at L is held;
+    ``wear``: the [wear] of a two-plane run (output.supports.Wear), a wear chart per hole."""
     where = "L" if observed_x is None else f"{observed_x:g} m"
     what = "tip displacement" if observed_x is None else f"displacement at x = {where}"
 
@@ -181,6 +196,8 @@ def beam_charts(case, problem, rho_S, stops, extra, observed_x=None):
         about = f"{run.label}, Δt={run.dt:g} s, J={problem.J}, {problem.element}"
         if problem.planes == 2:
             two_plane_charts(folder, data, run, case, problem, about, where, what, rho_S)
+            if wear is not None:
+                wear_charts(folder, data, run, case, problem, about, rho_S, wear)
             if extra is not None:
                 extra(folder, data, run)
             return
@@ -229,13 +246,31 @@ def two_plane_charts(folder, data, run, case, problem, about, where, what, rho_S
              title=f"{case}: net contact force on the beam ({about})",
              ylabel="force (N)" if newtons else
              "force per mass (m²/s² = N per kg/m)")
-    for h in problem.holes:
-        for x in problem.nodes[h.acts_at(problem.nodes, problem.beam.L)]:
-            key = f"hole_{float(x):g}_displacement"
-            draw(orbit_chart, folder / f"orbit_{float(x):g}.png", data[f"{key}_v"],
-                 data[f"{key}_w"], h.hole.outline(),
-                 f"{case}: orbit at x = {float(x):g} m, {h.hole.shape} hole\n({about})",
-                 h.hole.centre)
+    for h, x in hole_nodes(problem):
+        key = f"hole_{x:g}_displacement"
+        draw(orbit_chart, folder / f"orbit_{x:g}.png", data[f"{key}_v"],
+             data[f"{key}_w"], h.hole.outline(),
+             f"{case}: orbit at x = {x:g} m, {h.hole.shape} hole\n({about})",
+             h.hole.centre)
+
+
+def hole_nodes(problem):
+    """(hole, x) of every node a hole acts at: where the orbits are observed."""
+    return [(h, float(x)) for h in problem.holes
+            for x in problem.nodes[h.acts_at(problem.nodes, problem.beam.L)]]
+
+
+def wear_charts(folder, data, run, case, problem, about, rho_S, wear) -> None:
+    """wear_<x>.png per hole: the wear per sector round the hole beside the orbit.  The
+    wear is computed as summary.json's (output.supports.support_wear, over the same
+    T = n·Δt and in the same units), since the charts are drawn before that file."""
+    for h, x in hole_nodes(problem):
+        key = f"hole_{x:g}_displacement"
+        entry = support_wear(run, x, rho_S or 1.0, run.n * run.dt, wear)
+        draw(wear_chart, folder / f"wear_{x:g}.png", entry, data[f"{key}_v"],
+             data[f"{key}_w"], h.hole.outline(),
+             f"{case}: wear at x = {x:g} m after {wear.service_years:g} years, "
+             f"{h.hole.shape} hole\n({about})", h.hole.centre)
 
 
 def units(rho_S, system) -> dict:

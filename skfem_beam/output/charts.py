@@ -209,16 +209,55 @@ def shape_chart(path, shapes: Shapes, title=""):
         _frame(ax, "x (m)", "ũ (m)", title, fontsize=9)
 
 
+def _orbit(ax, v, w, outline, title: str, centre=(0.0, 0.0)) -> None:
+    """w against v (mm) on ``ax``, with the hole's wall (``outline``, (k, 2), m): the
+    orbit chart's drawing, which the wear chart draws beside its sectors."""
+    ax.plot(np.asarray(v) * 1e3, np.asarray(w) * 1e3, lw=0.6, color="C0", label="orbit")
+    if len(outline):
+        o = np.asarray(outline) * 1e3
+        ax.plot(o[:, 0], o[:, 1], color="k", lw=1.2, label="hole wall")
+    ax.plot([centre[0] * 1e3], [centre[1] * 1e3], "k+")
+    ax.set_aspect("equal", adjustable="datalim")
+    _frame(ax, "v (mm)", "w (mm)", title, fontsize=9)
+
+
 def orbit_chart(path, v, w, outline, title: str, centre=(0.0, 0.0)) -> None:
     """w against v at a support's node, with its hole's wall (``outline``, (k, 2))."""
     with figure(path, figsize=(5.5, 5.5)) as (fig, ax):
-        ax.plot(np.asarray(v) * 1e3, np.asarray(w) * 1e3, lw=0.6, color="C0", label="orbit")
-        if len(outline):
-            o = np.asarray(outline) * 1e3
-            ax.plot(o[:, 0], o[:, 1], color="k", lw=1.2, label="hole wall")
-        ax.plot([centre[0] * 1e3], [centre[1] * 1e3], "k+")
-        ax.set_aspect("equal", adjustable="datalim")
-        _frame(ax, "v (mm)", "w (mm)", title, fontsize=9)
+        _orbit(ax, v, w, outline, title, centre)
+
+
+def _sectors(ax, wear: dict) -> None:
+    """The worn depth (mm) per sector as bars round a polar ``ax``, or the volume (mm³)
+    when there is no depth (no [wear] land); the angle from +v towards +w, as the orbit
+    is drawn, so a bar points at the wall the orbit hits."""
+    sectors = wear["sectors"]
+    depth = all("depth" in k for k in sectors)
+    start = np.array([k["from_rad"] for k in sectors])
+    width = np.array([k["to_rad"] for k in sectors]) - start
+    value = np.array([k["depth"] * 1e3 if depth else k["volume"] * 1e9 for k in sectors])
+    ax.bar(start, value, width=width, align="edge", color="C3", alpha=0.7,
+           edgecolor="k", lw=0.5, label="per 30° sector")
+    if depth:       # the same volume worn evenly round the tube, for scale
+        ax.plot(np.linspace(-np.pi, np.pi, 121), np.full(121, wear["depth_uniform"] * 1e3),
+                "k--", lw=0.8, label="if worn evenly")
+        ax.legend(loc="lower left", bbox_to_anchor=(-0.1, -0.12), fontsize=7)
+    angles = np.arange(0, 360, 30)
+    ax.set_thetagrids(angles, ["+v" if a == 0 else "+w" if a == 90 else f"{a}°"
+                               for a in angles], fontsize=7)
+    ax.tick_params(axis="y", labelsize=7)
+    ax.set_title("worn depth (mm)" if depth else
+                 "worn volume (mm³): no [wear] land, so no depth", fontsize=9)
+
+
+def wear_chart(path, wear: dict, v, w, outline, title: str, centre=(0.0, 0.0)) -> None:
+    """A support's wear round its hole (``wear``: its entry of summary.json's supports)
+    beside the orbit of the tube's centre in the hole (as :func:`orbit_chart`)."""
+    with figure(path, figsize=(10, 5), ncols=2) as (fig, (left, right)):
+        left.remove()       # subplots makes its axes alike: the left one becomes polar
+        _sectors(fig.add_subplot(1, 2, 1, projection="polar"), wear)
+        _orbit(right, v, w, outline, "orbit of the tube's centre", centre)
+        fig.suptitle(title, fontsize=9)
 
 
 def penetration_chart(path, rows: list[dict], title=""):

@@ -23,7 +23,8 @@ the tube's surface in contact, the land's width b (axial) times the arc the cont
 covers: uniformly round the tube, d = V/(2πRb); per 30° sector k of the hole (the node's
 angle when the work is done, as Code_Aster's POST_USURE sums it per sector),
 d_k = V_k/(R·(π/6)·b).  The tube does not turn about its axis, so a sector of the hole
-wears the same sector of the tube.
+wears the same sector of the tube.  Without a land the volumes and volume rates alone
+(per support and per sector): they need only K and the service years.
 """
 from __future__ import annotations
 
@@ -33,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..checks import check_positive
+from ..errors import InputError
 from ..scheme.kernels import SECTORS
 
 YEAR = 365.25 * 86400.0     # s
@@ -42,30 +44,46 @@ YEAR = 365.25 * 86400.0     # s
 class Wear:
     """Archard's law at the supports: ``coefficient`` K (m³/(N·m)), ``service_years`` Y,
     ``land`` b (m, the support's axial contact width), ``radius`` R (m, the tube's outer
-    radius); the module docstring says what each number assumes."""
+    radius); the module docstring says what each number assumes.  The volumes need only
+    K and Y; the depths spread them over the land and the radius, so with ``land`` None
+    there are no depths (and the radius may be None)."""
     coefficient: float
     service_years: float
-    land: float
-    radius: float
+    land: float | None = None
+    radius: float | None = None
 
     def __post_init__(self):
+        if self.land is not None and self.radius is None:
+            raise InputError("[wear] land: a depth spreads the volume over the land and the "
+                             "tube's radius: give radius (m) too")
         for name in ("coefficient", "service_years", "land", "radius"):
+            if getattr(self, name) is None:
+                continue        # land, radius: only the depths need them
             object.__setattr__(self, name, check_positive(f"[wear] {name}",
                                                           getattr(self, name)))
 
     def of(self, normal_work_rate: float, sectors: np.ndarray, T: float) -> dict:
         """The support's wear from its normal work rate (W) and its normal work per
-        sector over the run's time T (J)."""
+        sector over the run's time T (J): volume rates and volumes, per support and per
+        sector, and the depths only with a land (a depth spreads a volume over it)."""
         life = self.service_years * YEAR
         rate = self.coefficient * normal_work_rate
         arc = 2 * math.pi / SECTORS
-        volumes = self.coefficient * np.asarray(sectors) / T * life
-        return {"volume_rate": rate, "volume": rate * life,
-                "depth_uniform": rate * life / (2 * math.pi * self.radius * self.land),
-                "sectors": [{"from_rad": -math.pi + k * arc, "to_rad": -math.pi + (k + 1) * arc,
-                             "volume": float(v), "depth": float(v / (self.radius * arc
-                                                                      * self.land))}
-                            for k, v in enumerate(volumes)]}
+        rates = self.coefficient * np.asarray(sectors) / T     # m³/s per sector
+        out = {"volume_rate": rate, "volume": rate * life}
+        if self.land is not None:
+            out["depth_uniform"] = rate * life / (2 * math.pi * self.radius * self.land)
+        out["sectors"] = [self._sector(k, arc, float(r), float(r * life))
+                          for k, r in enumerate(rates)]
+        return out
+
+    def _sector(self, k: int, arc: float, rate: float, volume: float) -> dict:
+        """Sector k (from +v towards +w): its volume rate, volume and, with a land, depth."""
+        out = {"from_rad": -math.pi + k * arc, "to_rad": -math.pi + (k + 1) * arc,
+               "volume_rate": rate, "volume": volume}
+        if self.land is not None:
+            out["depth"] = volume / (self.radius * arc * self.land)
+        return out
 
 
 ANGLE_BINS = SECTORS   # the impact-angle histogram: the wear's 30° sectors, −180° to 180°
@@ -96,7 +114,7 @@ def support_statistics(table: dict, run, scale: float, duration: float, T: float
     edges = np.linspace(-math.pi, math.pi, ANGLE_BINS + 1)
     out = []
     for x in np.unique(x_rows):
-        rows = np.flatnonzero(x_rows == x)
+        rows = support_rows(run, x)
         ev = np.flatnonzero(table["x"] == x)
         angles = np.asarray(table["angle"], dtype=float)[ev]
         counts, _ = np.histogram(angles[np.isfinite(angles)], edges)
@@ -106,24 +124,49 @@ def support_statistics(table: dict, run, scale: float, duration: float, T: float
             / duration if ev.size and duration > 0 else 0.0,
             "impact_angle_histogram": {"edges_rad": edges.tolist(), "counts": counts.tolist()},
             "impact_work_rate": -scale * float(work[rows, 0].sum()) / T,
-            "normal_work_rate": scale * float(work[rows, 1].sum()) / T}
+            "normal_work_rate": _normal_work_rate(run, rows, scale, T)}
         if run.st.fc.shape[0]:
             entry["friction_work_rate"] = -scale * float(work[rows, 2].sum()) / T
         if wear is not None:
-            entry["wear"] = wear.of(entry["normal_work_rate"],
-                                    scale * run.st.sectors[rows].sum(axis=0), T)
+            entry["wear"] = support_wear(run, x, scale, T, wear)
         out.append(entry)
     return out
 
 
+def support_rows(run, x: float) -> np.ndarray:
+    """The constrained rows of the support at x (a hole's two, or its faces)."""
+    return np.flatnonzero(np.asarray(run.system.x_contact, dtype=float) == x)
+
+
+def _normal_work_rate(run, rows, scale: float, T: float) -> float:
+    return scale * float(run.st.rowwork[rows, 1].sum()) / T
+
+
+def support_wear(run, x: float, scale: float, T: float, wear: Wear) -> dict:
+    """The wear entry of the support at x, as summary.json has it (the same code): the
+    wear chart draws it in the charts' phase, before summary.json is written."""
+    T = T if T > 0 else math.nan
+    rows = support_rows(run, x)
+    return wear.of(_normal_work_rate(run, rows, scale, T),
+                   scale * run.st.sectors[rows].sum(axis=0), T)
+
+
+def _wear_units(wear: Wear) -> str:
+    """What the wear entry's numbers are; without a land it says why there is no depth."""
+    volumes = ("volume_rate m³/s = K × normal_work_rate, volume m³ after service_years, "
+               "sectors: per 30° of the hole (rad from +v towards +w) the volume_rate and "
+               "volume")
+    if wear.land is None:
+        return (f"{volumes}; K = coefficient m³/(N·m), as given in [wear]; no depth: a "
+                "depth needs [wear] land (the support's axial width b, m)")
+    return (f"{volumes}, and depth volume/(R·(π/6)·b); depth_uniform m = volume/(2πRb) "
+            "(worn evenly round the tube over the land b); K = coefficient m³/(N·m), "
+            "R = radius, b = land (m), as given in [wear]")
+
+
 def work_rate_units(newtons: bool, wear: Wear | None = None) -> dict:
     unit = "W" if newtons else "m³/s³ (W per kg/m)"
-    out = {} if wear is None else {"wear": (
-        "volume_rate m³/s = K × normal_work_rate, volume m³ after service_years, "
-        "depth_uniform m = volume/(2πRb) (worn evenly round the tube over the land b), "
-        "sectors: per 30° of the hole (rad from +v towards +w) the volume and depth "
-        "volume/(R·(π/6)·b); K = coefficient m³/(N·m), R = radius, b = land (m), "
-        "as given in [wear]")}
+    out = {} if wear is None else {"wear": _wear_units(wear)}
     return {**out,
             "friction_work_rate": f"{unit}: −(1/T) × the support's friction work",
             "impact_work_rate": f"{unit}: −(1/T)Σ ½λ·(y^(n+1) − y^(n−1)) over the support's "
@@ -138,3 +181,46 @@ def work_rate_units(newtons: bool, wear: Wear | None = None) -> dict:
             "normal_velocity": "m/s, the node's velocity before the impact along the wall's "
                                "outward normal (> 0: towards the wall)",
             "tangential_velocity": "m/s, its component along the wall, counter-clockwise"}
+
+
+DASH = "—"      # a number the run has not got: no friction, no [wear], no land
+
+
+def _cell(value: float | None) -> str:
+    return DASH if value is None else f"{value:.4g}"
+
+
+def _row(s: dict) -> list[str]:
+    """One support's cells: x, impacts, contact fraction, the three work rates, the worn
+    volume (mm³) and the deepest sector's depth (mm), as summary.json has them."""
+    wear = s.get("wear")
+    depths = [k["depth"] for k in wear["sectors"] if "depth" in k] if wear else []
+    return [f"{s['x']:g}", str(s["impacts"]), _cell(s["contact_fraction"]),
+            _cell(s["impact_work_rate"]), _cell(s["normal_work_rate"]),
+            _cell(s.get("friction_work_rate")),
+            _cell(wear["volume"] * 1e9 if wear else None),
+            _cell(max(depths) * 1e3 if depths else None)]
+
+
+def support_table(supports: list[dict], newtons: bool = True,
+                  wear: Wear | None = None) -> str:
+    """summary.json's ``impact_statistics.supports`` as a plain-text table for the
+    terminal, one row per support (about 80 columns): the answer a pipe engineer reads
+    first, without opening the file.  ``newtons``: the work rates are in W (ρS known);
+    ``wear``: the run's [wear], whose service years the heading names.  "" without
+    supports."""
+    if not supports:
+        return ""
+    unit = "W" if newtons else "W/(kg/m)"
+    head = ["x (m)", "impacts", "contact", f"impact {unit}", f"normal {unit}",
+            f"friction {unit}", "volume mm³", "depth mm"]
+    rows = [_row(s) for s in supports]
+    widths = [max(len(r[i]) for r in [head] + rows) for i in range(len(head))]
+    about = "contact: fraction of the time"
+    if wear is not None:
+        about += (f"; wear after {wear.service_years:g} years; "
+                  + ("depth: deepest 30° sector" if wear.land is not None
+                     else "no depth without [wear] land"))
+    lines = [f"supports ({about}):"]
+    lines += ["  ".join(c.rjust(w) for c, w in zip(r, widths)) for r in [head] + rows]
+    return "\n".join(lines)

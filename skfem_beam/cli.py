@@ -20,8 +20,8 @@ from .output.folder import (EXIT_INPUT, EXIT_SOLVER, EXIT_UNSTABLE, OPENED,  # n
                             Interrupted, release, report, stamp)
 from .output.options import OutputOptions
 from .output.folder import lock_folder
-from .output.series import (_resume_folder, check_resumable, read_checkpoint,
-                            read_summary)
+from .output.series import (_resume_folder, check_resumable, has_checkpoint,
+                            read_checkpoint, read_summary)
 from .scheme.stepping import MASSLESS, Stepping
 from .spec import RunSpec
 
@@ -86,7 +86,8 @@ def parser(prog: str, description: str, *, J=None, dt=None, T=None, beta=None,
     p.add_argument("--checkpoint-every", type=float, default=None, metavar="SECONDS",
                    help="write the full integrator state this often (atomically)")
     p.add_argument("--resume", metavar="DIR", default=None,
-                   help="continue the killed run in DIR from its last checkpoint")
+                   help="continue the killed run in DIR from its last checkpoint (with none: "
+                        "run it again from step 0)")
     p.add_argument("--version", action="version", version=f"skfem_beam {__version__}")
     return p
 
@@ -216,12 +217,15 @@ def _given(parser, argv) -> dict:
 def stored_args(args, parser, argv=None):
     """For ``--resume DIR``: the flags of the run stored in DIR/summary.json, once DIR is
     locked and its summary, checkpoint and rows agree.  ``--T`` may grow (extending the
-    run); any other flag that differs from the stored one is refused by name."""
+    run); any other flag that differs from the stored one is refused by name.  A run
+    stopped before its first checkpoint has only its summary to agree with: it is run
+    again from step 0 with these flags (output.series.execute)."""
     if not getattr(args, "resume", None):
         return args
     out = _resume_folder(args.resume)
     lock_folder(out)
-    summary, ck = read_summary(out), read_checkpoint(out)
+    summary = read_summary(out)
+    ck = read_checkpoint(out) if has_checkpoint(out) else None
     config = summary["config"]
     given = _given(parser, argv)
     T = config.get("T")

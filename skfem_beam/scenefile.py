@@ -877,7 +877,8 @@ def _run_parser() -> argparse.ArgumentParser:
                    help="also record u, velocity, moment and shear at x = X (m), with "
                         "[output] probes (repeatable)")
     p.add_argument("--resume", metavar="DIR", default=None,
-                   help="continue the stopped run in DIR from its last checkpoint")
+                   help="continue the stopped run in DIR from its last checkpoint (with "
+                        "none: run it again from step 0)")
     return p
 
 

@@ -7,13 +7,16 @@ import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
 
+import skfem_beam
 from conftest import exit_code
 from skfem_beam.output import series as runner
 from skfem_beam.cases import point_stops
+from skfem_beam.scenefile import run_main
 
 ARGS = ["--dt", "1e-5", "--T", "1.0", "--flush-every", "2000", "--frames", "10"]
 CASE = [sys.executable, "-m", "skfem_beam.cases.point_stops"]
@@ -92,9 +95,12 @@ def test_disk_full_mid_run_stops_clearly_and_checkpoint_resumes(tmp_path, monkey
     assert rows(out) == rows(ref)
 
 
-def test_resume_needs_a_checkpoint(tmp_path, capsys):
+def test_resume_needs_a_run_folder(tmp_path, capsys):
+    """A folder no run made (no summary.json) is refused in one line, changing nothing."""
     assert exit_code(point_stops.main, ["--resume", str(tmp_path)]) == 2
-    assert "checkpoint.npz" in capsys.readouterr().err
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and "summary.json" in err[0] and "checkpoint.npz" in err[0], err
+    assert not list(tmp_path.iterdir())
 
 
 def test_summary_records_configuration_and_version(tmp_path):
@@ -206,3 +212,133 @@ def h5_datasets(path):
         f.visititems(lambda name, obj: found.update({name: obj[()].tobytes()})
                      if isinstance(obj, h5py.Dataset) else None)
     return found
+
+
+# ------------------------------------------------ a run stopped before its first checkpoint
+
+SHORT = ["--T", "0.1", "--flush-every", "300", "--frames", "5", "--format", "xdmf"]
+SCENE = [str(Path(skfem_beam.__file__).parent / "scene_files" / "point_stops.toml"),
+         "--set", "time.T=0.1", "--flush-every", "300", "--frames", "5", "--format", "xdmf"]
+# what differs between two runs of one command: the clock, the memory, the folder's name
+VOLATILE = {"wall_time_s", "us_per_step", "peak_rss_MB", "written"}
+
+
+def kill_before_the_first_checkpoint(command, out):
+    """``command`` (writing folder ``out``) SIGKILLed in its loop's first chunk
+    (SKFEM_BEAM_KILL_AT), with no --checkpoint-every: a folder "running" with a few rows
+    and no checkpoint.  Returns the lines of its timeseries.csv."""
+    p = subprocess.run(command, capture_output=True,
+                       env={**os.environ, "SKFEM_BEAM_KILL_AT": runner.FIRST_CHUNK})
+    assert p.returncode == -signal.SIGKILL, p.stderr
+    assert json.loads((out / "summary.json").read_text())["status"] == "running"
+    assert not (out / "checkpoint.npz").exists()
+    return len(rows(out))
+
+
+def run_again_from_step_0(main, out, capsys):
+    """``--resume out`` in process (from another folder: nothing but the folder is used):
+    exit 0 and one line saying the run started again."""
+    capsys.readouterr()
+    assert exit_code(main, ["--resume", str(out)]) == 0
+    err = [e for e in capsys.readouterr().err.splitlines() if not e.startswith("compiling")]
+    assert err == [f"{out} had no checkpoint: running it again from step 0"], err
+
+
+def assert_same_run(out, ref):
+    """The files of a run never stopped: the tables byte for byte, the summary's numbers,
+    the field frames value for value (an HDF5 file's bytes hold times of writing)."""
+    for name in ("timeseries.csv", "impacts.csv"):
+        assert (out / name).read_bytes() == (ref / name).read_bytes(), name
+    a, b = (json.loads((d / "summary.json").read_text()) for d in (out, ref))
+    assert a["status"] == "success" and a["checkpoint_step"] == b["steps"]
+    a["config"].pop("out"), b["config"].pop("out")
+    assert {k: v for k, v in a.items() if k not in VOLATILE} == \
+        {k: v for k, v in b.items() if k not in VOLATILE}
+    assert h5_datasets(out / "fields.h5") == h5_datasets(ref / "fields.h5")
+
+
+@pytest.mark.parametrize("flags", [[], ["--law", "moreau-jean"], ["--solver", "osqp"]],
+                         ids=["beta", "moreau-jean", "osqp"])
+def test_a_case_stopped_before_its_first_checkpoint_runs_again_on_resume(
+        tmp_path, monkeypatch, capsys, flags):
+    """Killed before any checkpoint, --resume runs the stored configuration again from step
+    0, to the files of a run never stopped: the β-scheme, Moreau–Jean, OSQP."""
+    ref, out = tmp_path / "ref", tmp_path / "out"
+    assert exit_code(point_stops.main, flags + SHORT + ["--out", str(ref)]) == 0
+    command = CASE + flags + SHORT + ["--out", str(out)]
+    assert 1 < kill_before_the_first_checkpoint(command, out) < len(rows(ref))
+    monkeypatch.chdir(tmp_path)
+    run_again_from_step_0(point_stops.main, out, capsys)
+    assert_same_run(out, ref)
+
+
+def test_a_scene_file_run_stopped_before_its_first_checkpoint_runs_again_on_resume(
+        tmp_path, monkeypatch, capsys):
+    """The same for python -m skfem_beam run FILE.toml --set ...: its resume rebuilds the
+    scene from the text and the --set stored in summary.json."""
+    ref, out = tmp_path / "ref", tmp_path / "out"
+    assert exit_code(run_main, SCENE + ["--out", str(ref)]) == 0
+    command = [sys.executable, "-m", "skfem_beam", "run"] + SCENE + ["--out", str(out)]
+    assert 1 < kill_before_the_first_checkpoint(command, out) < len(rows(ref))
+    monkeypatch.chdir(tmp_path)
+    run_again_from_step_0(run_main, out, capsys)
+    assert_same_run(out, ref)
+
+
+def test_a_folder_without_checkpoint_is_still_refused_when_unreadable_or_locked(
+        tmp_path, capsys):
+    """No checkpoint, and a summary.json that cannot be read, or a folder another process
+    holds: refused in one line, changing nothing."""
+    out = tmp_path / "run"
+    assert exit_code(point_stops.main, ["--T", "0.01", "--format", "none", "--out",
+                                        str(out)]) == 0
+    (out / "checkpoint.npz").unlink()       # as a run killed before its first checkpoint
+    summary = out / "summary.json"
+    summary.write_text(json.dumps({**json.loads(summary.read_text()), "status": "running"}))
+    good = summary.read_bytes()
+    summary.write_bytes(b"{\"status\": \"running\"")
+    before = snapshot(out)
+    assert exit_code(point_stops.main, ["--resume", str(out)]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and "summary.json is not a readable summary" in err[0], err
+    assert snapshot(out) == before
+    summary.write_bytes(good)
+    before = snapshot(out)
+    holder = subprocess.Popen([sys.executable, "-c", HOLD, str(out / ".lock")],
+                              stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "locked"
+        assert exit_code(point_stops.main, ["--resume", str(out)]) == 2
+        err = capsys.readouterr().err.splitlines()
+        assert len(err) == 1 and "is being written by another run" in err[0], err
+        assert snapshot(out) == before
+    finally:
+        holder.kill()
+        holder.wait()
+
+
+HOLD = ("import fcntl, os, sys, time; fd = os.open(sys.argv[1], os.O_RDWR | os.O_CREAT); "
+        "fcntl.flock(fd, fcntl.LOCK_EX); print('locked', flush=True); time.sleep(60)")
+
+
+def snapshot(folder):
+    return {p.name: p.read_bytes() for p in sorted(folder.iterdir()) if p.is_file()}
+
+
+def test_a_run_again_from_step_0_keeps_nothing_of_the_stopped_run(tmp_path, capsys):
+    """Killed after its last chunk (every row, its field files and charts, no checkpoint
+    yet), then its resume killed in its first chunk: the folder holds only what that new
+    start wrote (rows, no field file, no chart), never frames of the first attempt beyond
+    its rows; resumed again, the files of a run never stopped."""
+    ref, out = tmp_path / "ref", tmp_path / "out"
+    assert exit_code(point_stops.main, SHORT + ["--out", str(ref)]) == 0
+    p = subprocess.run(CASE + SHORT + ["--out", str(out)], capture_output=True,
+                       env={**os.environ, "SKFEM_BEAM_KILL_AT": "last-chunk"})
+    assert p.returncode == -signal.SIGKILL
+    assert (out / "fields.h5").exists() and not (out / "checkpoint.npz").exists()
+    assert len(rows(out)) == len(rows(ref))
+    assert kill_before_the_first_checkpoint(CASE + ["--resume", str(out)], out) < len(rows(ref))
+    assert sorted(p.name for p in out.iterdir()) == [".lock", ".reserve", "summary.json",
+                                                      "timeseries.csv"]
+    run_again_from_step_0(point_stops.main, out, capsys)
+    assert_same_run(out, ref)

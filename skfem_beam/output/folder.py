@@ -121,6 +121,13 @@ def _holds_files(out: Path) -> bool:
     return any(p.name not in OURS for p in out.iterdir())
 
 
+def _empty(out: Path, keep: tuple[str, ...]) -> None:
+    """Remove everything in folder ``out`` but the names in ``keep``."""
+    for p in out.iterdir():
+        if p.name not in keep:
+            shutil.rmtree(p) if p.is_dir() and not p.is_symlink() else p.unlink()
+
+
 def stamp() -> dict:
     """The package version and the time of writing, for every summary."""
     return {"package_version": __version__, "written": time.strftime("%Y-%m-%dT%H:%M:%S%z")}
@@ -216,9 +223,7 @@ class Folder:
                 if not overwrite:
                     raise InputError(f"--out {out} already holds files; pass --overwrite "
                                      "to replace them")
-                for p in out.iterdir():     # keep the lock file: it is what others lock
-                    if p.name != LOCK:
-                        shutil.rmtree(p) if p.is_dir() and not p.is_symlink() else p.unlink()
+                _empty(out, keep=(LOCK,))   # the lock file: it is what others lock
             folder = cls(out, summary)
             OPENED.append(out)
             folder.reserve()
@@ -227,6 +232,13 @@ class Folder:
             release(out)
             raise
         return folder
+
+    def clear(self) -> None:
+        """Remove what a stopped run left (rows, frames, charts, tables, temporary files),
+        so that a run started again from step 0 here writes what it would into an empty
+        folder.  The summary stays: it holds the run's configuration, and a run killed
+        in the middle of this must still find it."""
+        _empty(self.path, keep=(*OURS, SUMMARY))
 
     def reserve(self, size: int = 1 << 16) -> None:
         """Keep ``size`` bytes of disk, so that the final summary fits when the disk fills."""

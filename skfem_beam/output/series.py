@@ -9,7 +9,8 @@ S`` the run's full state is written atomically (write, then rename) to
 ``checkpoint.npz``.  ``--resume DIR`` rebuilds the same run from ``summary.json``,
 restores the checkpoint, cuts the series back to it and continues: the result is
 identical, bit for bit, to an uninterrupted run (values are written with the exact shortest
-digits).
+digits).  A folder with no checkpoint (the run stopped before its first) is emptied but
+for its summary and run again from step 0: nothing computed was kept, the configuration was.
 
 What a command streams is a :class:`Series`: its columns, computed from the run's saved
 buffers, and which field frames to write.
@@ -372,8 +373,20 @@ def read_summary(folder: Path) -> dict:
 NOT_IDENTITY = {"out", "overwrite"}   # a folder moved, copied or spelled another way resumes
 
 
-def check_resumable(folder: Path, summary: dict, ck: dict, extend: bool) -> None:
-    """Refuse a resume whose summary, checkpoint and rows on disk do not agree."""
+def check_resumable(folder: Path, summary: dict, ck: dict | None, extend: bool) -> None:
+    """Refuse a resume whose summary, checkpoint and rows on disk do not agree.  ``ck``
+    None (no checkpoint: the run starts again from step 0): its status alone is checked,
+    the rows on disk are not used."""
+    if ck is not None:
+        _check_config(folder, summary, ck)
+    _check_status(folder, summary, extend)
+    if ck is not None:
+        _check_rows(folder, ck)
+
+
+def _check_config(folder: Path, summary: dict, ck: dict) -> None:
+    """The summary's configuration is the checkpoint's (but for the folder, and a T grown
+    by an extension stopped before its first checkpoint)."""
     name = f"{Path(folder) / SUMMARY}"
     mine, theirs = _plain(summary["config"]), ck["config"]
     diff = sorted(k for k in (set(mine) | set(theirs)) - NOT_IDENTITY
@@ -384,6 +397,11 @@ def check_resumable(folder: Path, summary: dict, ck: dict, extend: bool) -> None
         k = diff[0]
         raise InputError(f"{name}: {k}={mine.get(k)!r} differs from the checkpoint's "
                          f"{k}={theirs.get(k)!r}; cannot resume, nothing was changed")
+
+
+def _check_status(folder: Path, summary: dict, extend: bool) -> None:
+    """A run that went unstable, or finished (unless extended), has nothing to resume."""
+    name = f"{Path(folder) / SUMMARY}"
     status = summary.get("status")
     if status == "unstable":
         raise InputError(f"{name}: the run went unstable; there is nothing to resume")
@@ -392,6 +410,10 @@ def check_resumable(folder: Path, summary: dict, ck: dict, extend: bool) -> None
     if status == "success" and not extend:
         raise InputError(f"{folder} holds a finished run (status success): nothing to "
                          f"resume; give a longer --T to extend it")
+
+
+def _check_rows(folder: Path, ck: dict) -> None:
+    """timeseries.csv holds the rows the checkpoint was written with (size and CRC)."""
     csv = Path(folder) / "timeseries.csv"
     size = csv.stat().st_size if csv.is_file() else -1
     nbytes = int(ck["nbytes"])
@@ -439,10 +461,19 @@ def prepare(options: OutputOptions) -> Path:
 
 
 def _resume_folder(out) -> Path:
+    """The folder of ``--resume``; refused when it is not a run's (no summary.json: a
+    checkpoint alone cannot say how to rebuild the run)."""
     out = Path(out)
-    if not (out / CHECKPOINT).is_file() or not (out / SUMMARY).is_file():
-        raise InputError(f"--resume {out}: no {CHECKPOINT} and {SUMMARY} there to resume from")
+    if not (out / SUMMARY).is_file():
+        raise InputError(f"--resume {out}: no {SUMMARY} (nor {CHECKPOINT}) there: not the "
+                         "folder of a run, nothing to resume from")
     return out
+
+
+def has_checkpoint(folder) -> bool:
+    """False for a run stopped before its first checkpoint: its resume runs it again from
+    step 0 with the configuration its summary.json stores."""
+    return (Path(folder) / CHECKPOINT).is_file()
 
 
 def outcome(result, data: dict) -> dict:
@@ -522,7 +553,8 @@ def execute(run: Run, options: OutputOptions, summary: dict, series, finish) -> 
             raise
         can_checkpoint = False
     used, ck = 0, None
-    if resume:
+    restart = resume and not has_checkpoint(out)
+    if resume and not restart:
         ck = read_checkpoint(out)       # checked again: the lock is held since the parse
         used = _restore(run, ck)
         # the checkpoint is the one truth: a resume that stops before its first new
@@ -531,6 +563,12 @@ def execute(run: Run, options: OutputOptions, summary: dict, series, finish) -> 
     with _Signals() as stop:
         folder = Folder.open(out, summary, overwrite=options.overwrite, resume=resume)
         try:
+            if restart:
+                # nothing computed is kept without a checkpoint, and the configuration
+                # is in hand (rebuilt from summary.json): the run starts again from step 0
+                folder.clear()
+                print(f"{out} had no checkpoint: running it again from step 0",
+                      file=sys.stderr)
             return _stream(run, folder, options, series, finish, stop, used, ck,
                            can_checkpoint)
         finally:
@@ -538,13 +576,18 @@ def execute(run: Run, options: OutputOptions, summary: dict, series, finish) -> 
 
 
 PHASES = ("last-chunk", "final-checkpoint", "charts", "impacts", "summary")
+FIRST_CHUNK = "first-chunk"     # not one of PHASES (the end's, which the soak draws from)
 
 
-def phase(name: str) -> None:
+def phase(name: str, before: Callable | None = None) -> None:
     """A test hook: the environment variable SKFEM_BEAM_KILL_AT=<name> (one of PHASES, the
-    boundaries of a run's end) makes the process SIGKILL itself there, as a scheduler or a
-    power cut would (tests/test_resume.py resumes each to the uninterrupted files)."""
+    boundaries of a run's end, or FIRST_CHUNK: the loop's first chunk, before any
+    checkpoint of a run without --checkpoint-every) makes the process SIGKILL itself
+    there, as a scheduler or a power cut would (tests/test_resume.py resumes each to the
+    uninterrupted files).  ``before``: called first, when the process is killed there."""
     if os.environ.get("SKFEM_BEAM_KILL_AT") == name:
+        if before is not None:
+            before()
         os.kill(os.getpid(), signal.SIGKILL)
 
 
@@ -622,6 +665,8 @@ class _Stream:
             self.write_frames(quiet=False)
         if stopping:
             raise Interrupted(self.stop.signum)
+        if run.n and not run.done:      # in the loop, with more to compute: killed with
+            phase(FIRST_CHUNK, before=self.rows.sync)   # its rows on disk (known state)
         every = self.options.checkpoint_every
         if every is not None and time.monotonic() - self.last_ck >= every and not run.done:
             self.save_checkpoint()
@@ -715,7 +760,8 @@ class _Stream:
                         "message": f"interrupted by {name} at step {run.n} "
                                    f"(t={run.n * run.dt:.6g} s)"})
         resume = (f"continue with: {_command(folder.summary)} --resume {folder.path}"
-                  if self.kept is not None else "no checkpoint: it cannot be resumed")
+                  if self.kept is not None else "no checkpoint: run it again from step 0 "
+                  f"with: {_command(folder.summary)} --resume {folder.path}")
         print(f"interrupted by {name}: {self.what_is_kept()}{why}; {resume}", file=sys.stderr)
         return e.code
 
@@ -725,7 +771,8 @@ class _Stream:
         folder.fail(e, steps=run.n, kept=self.what_is_kept(), **self.write_events(run.n))
         resume = (f"{_once_fixed(e)}, continue with: {_command(folder.summary)} --resume "
                   f"{folder.path}" if self.kept is not None else
-                  "without a checkpoint (--checkpoint-every) it cannot be resumed")
+                  f"{_once_fixed(e)}, with no checkpoint (--checkpoint-every) run it again "
+                  f"from step 0 with: {_command(folder.summary)} --resume {folder.path}")
         print(f"error: could not write the results: {e}; {self.what_is_kept()}; {resume}",
               file=sys.stderr)
         return EXIT_SOLVER

@@ -64,6 +64,8 @@ def parser(prog: str, description: str, *, J=None, dt=None, T=None, beta=None,
                    "θ = 1/2), or one-sided springs (default: from --method)")
     p.add_argument("--method", default="contact",
                    help="contact (= --law position) | penalty (= --law penalty)")
+    p.add_argument("--theta", type=float, default=None,
+                   help=f"θ in [1/2, 1] of --law {methods.MoreauJean.name} (default 1/2)")
     p.add_argument("--restitution", type=float, default=0.0, metavar="E",
                    help="Newton coefficient of restitution e in [0, 1] (position, "
                         f"{methods.MoreauJean.name})")
@@ -123,7 +125,7 @@ def method(args) -> methods.Method:
     --massless)."""
     return methods.make(args.law, getattr(args, "solver", "auto"), args.restitution,
                         args.stiffness if args.law == "penalty" else None,
-                        getattr(args, "massless", None))
+                        getattr(args, "massless", None), theta=getattr(args, "theta", None))
 
 
 def spec(args, config: dict | None = None) -> RunSpec:

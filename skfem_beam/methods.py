@@ -131,10 +131,11 @@ class Words:
     massless: str = "--massless "
     law: str = "--law "
     restitution: str = "--restitution "
+    theta: str = "--theta "
 
 
 FLAGS = Words()
-KEYS = Words("solver=", "massless=", "law=", "restitution=")    # the Python API's words
+KEYS = Words("solver=", "massless=", "law=", "restitution=", "theta=")   # the Python API's
 
 
 def _name(word: str) -> str:
@@ -143,13 +144,16 @@ def _name(word: str) -> str:
 
 def make(law: str = "position", solver: str = "auto", restitution: float = 0.0,
          stiffness: float | None = None, massless: str | None = None,
-         words: Words = FLAGS, damping: float = 0.0) -> Method:
+         words: Words = FLAGS, damping: float = 0.0, theta: float | None = None) -> Method:
     """The method the words name: ``law`` one of LAWS, ``solver`` the position-level
     QP solver, ``stiffness`` and ``damping`` the penalty springs and their dashpots (N/m,
-    N·s/m, see :class:`Penalty`), ``massless`` the massless rows' stepping (None: the
-    default)."""
+    N·s/m, see :class:`Penalty`), ``massless`` the massless rows' stepping, ``theta``
+    Moreau–Jean's θ (None: the defaults)."""
     check_choice(_name(words.law), law, LAWS)
     e = check_restitution(restitution, words.restitution)
+    if theta is not None and law != MOREAU_JEAN:
+        raise InputError(f"{words.theta}{theta} is Moreau–Jean's θ ({words.law}{MOREAU_JEAN}); "
+                         f"{words.law}{law} is a β-scheme: set its β instead")
     if law == MOREAU_JEAN:
         if solver != "auto":
             raise InputError(f"{words.law}{law} solves its own impulse problem: "
@@ -157,7 +161,8 @@ def make(law: str = "position", solver: str = "auto", restitution: float = 0.0,
         if massless is not None:
             raise InputError(f"{words.massless}{massless} applies to the β-scheme "
                              f"({words.law}position); {words.law}{law} does not take it")
-        return MoreauJean(0.5, e)
+        from .scheme.moreau_jean import check_theta
+        return MoreauJean(0.5 if theta is None else check_theta(theta, words.theta), e)
     if law == "penalty":     # the registry's checks: no solver, no restitution with springs
         resolve("penalty" if solver == "auto" else solver, stiffness, e)
         return Penalty(stiffness, massless=massless or "beta", damping=damping)

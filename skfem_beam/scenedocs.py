@@ -96,8 +96,9 @@ SECTION_DOCS = {
         '`projection`, `active-set`, `osqp`, `daqp`, `round-hole`), `moreau-jean`, `penalty` '
         '(as `--law`); round holes take `auto` (the exact round-hole law) or `penalty` '
         '(radial springs); `stiffness` (N/m, the penalty spring), `restitution` (e in [0, 1],'
-        " position and moreau-jean) `friction` (Coulomb's μ at the holes' walls, two planes: "
-        'runs Moreau–Jean)'
+        ' position and moreau-jean), `theta` (θ in [1/2, 1] of moreau-jean, default 1/2; '
+        "as `--theta`), `friction` (Coulomb's μ at the holes' walls, two planes: runs "
+        'Moreau–Jean)'
     ),
     'output': (
         '`format`, `save_every`, `frames`, `flush_every`, `checkpoint_every`, `probes` (x in '

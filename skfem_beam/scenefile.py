@@ -53,7 +53,8 @@ from .timefunctions import Constant, Sine, SumOfSines, Table, band_limited, psd_
 
 BEAM_MASSES = ("consistent", "redistributed")        # [mesh] mass of a beam
 SCENE_WORDS = methods.Words(solver="[contact] law = ", massless="[mesh] massless = ",
-                            law="[contact] law = ", restitution="[contact] restitution = ")
+                            law="[contact] law = ", restitution="[contact] restitution = ",
+                            theta="[contact] theta = ")
 
 V = None          # a value (checked by the object it builds)
 
@@ -112,7 +113,7 @@ U0, V0 = {"x": NUMBERS, "u": NUMBERS}, {"x": NUMBERS, "v": NUMBERS}
 TIME_KEYS = {"dt": N, "T": N, "beta": N, "load_window": V}
 OUTPUT = {"format": V, "save_every": N, "frames": N, "flush_every": N, "checkpoint_every": N,
           "probes": NUMBERS}
-CONTACT = {"law": V, "stiffness": N, "restitution": N, "friction": N}
+CONTACT = {"law": V, "stiffness": N, "restitution": N, "friction": N, "theta": N}
 G = NumberOr({"poly": NUMBERS, "about": N, "x": NUMBERS, "g": NUMBERS},   # the rest: _g
              "{ poly = [...] } or { x = [...], g = [...] }")
 HOLE = {"radius": N, "sides": N, "angle": N, "centre": NUMBERS,     # the rest: holes.py
@@ -187,8 +188,9 @@ class Scene:
         if law == "penalty" and self.stiffness is None:
             raise InputError("[contact] law='penalty' needs stiffness (N/m)")
         massless = self.data.get("mesh", {}).get("massless")    # as written: None if not
+        theta = self.data.get("contact", {}).get("theta")
         return methods.make(law, solver, self.restitution or 0.0, self.stiffness, massless,
-                            words=SCENE_WORDS, damping=self.damping)
+                            words=SCENE_WORDS, damping=self.damping, theta=theta)
 
 
 # ---------------------------------------------------------------- the file's shape
@@ -384,14 +386,14 @@ def _scene(kind, problem, data, text, files) -> Scene:
     contact = data.get("contact", {})
     law, k, c = contact.get("law", "auto"), contact.get("stiffness"), 0.0
     if any(h.friction > 0 for h in getattr(problem, "holes", ())) and "law" not in contact:
-        law = "moreau-jean"        # Coulomb friction is a velocity-level law
+        law = methods.MoreauJean.name    # Coulomb friction is a velocity-level law
     supports = _supports(data)
     if supports is not None:
         law, (k, c) = "penalty", supports
     if k is not None and law == "auto":
         law = "penalty"
     check_choice("[contact] law", law, (*methods.LAWS, *SOLVERS))
-    if k is not None and law in methods.LAWS[:2]:
+    if k is not None and law in methods.LAWS and law != methods.Penalty.name:
         raise InputError(f"[contact] stiffness is the penalty spring: law = {law!r} does not "
                          "take it")
     t, mesh = data.get("time", {}), data.get("mesh", {})

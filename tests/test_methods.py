@@ -4,6 +4,7 @@ reaching every class, and every method's run checkpointing and resuming bit for 
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,6 +13,7 @@ from skfem_beam import methods, scenes
 from skfem_beam.errors import InputError
 from skfem_beam.methods import MoreauJean, Penalty, PositionLevel
 from skfem_beam.scheme import Stepping, drive, solve
+from skfem_beam.scenefile import load
 from skfem_beam.scheme.moreau_jean import moreau_jean
 from skfem_beam.semidiscrete import beam_system
 
@@ -134,3 +136,27 @@ def test_python_laws_killed_after_a_checkpoint_resume_byte_for_byte(tmp_path, so
     subprocess.run(PS + ["--resume", str(out)], check=True, capture_output=True, timeout=120)
     for name in ("timeseries.csv", "impacts.csv"):
         assert (out / name).read_bytes() == (ref / name).read_bytes(), name
+
+
+def test_theta_reaches_moreau_jean_from_the_command_line_and_a_scene_file(tmp_path):
+    """--theta and [contact] theta set Moreau–Jean's θ (summary "theta"); θ = 1 (implicit
+    Euler) dissipates what θ = 1/2 keeps, so it ends with less energy; a θ given to a
+    β-scheme or outside [1/2, 1] is one line, exit 2, nothing written."""
+    energy = {}
+    for theta in ("0.5", "1.0"):
+        out = tmp_path / f"mj{theta}"
+        subprocess.run(PS + ["--T", "0.1", "--law", "moreau-jean", "--theta", theta,
+                             "--out", str(out)], check=True, capture_output=True)
+        summary = json.loads((out / "summary.json").read_text())
+        assert summary["theta"] == float(theta) and summary["beta"] is None
+        energy[theta] = summary["energy_final"]
+    assert energy["1.0"] < 0.99 * energy["0.5"], energy
+    scene = Path(methods.__file__).parent / "scene_files" / "point_stops.toml"
+    assert load(scene, ['contact.law="moreau-jean"', "contact.theta=1.0"]).method \
+        == MoreauJean(1.0)
+    for argv, word in ((["--theta", "0.7"], "--theta 0.7 is Moreau–Jean's θ"),
+                       (["--law", "moreau-jean", "--theta", "0.2"], "must lie in [1/2, 1]")):
+        p = subprocess.run(PS + ["--T", "0.01", "--out", str(tmp_path / "bad")] + argv,
+                           capture_output=True, text=True)
+        assert p.returncode == 2 and p.stderr.count("\n") == 1 and word in p.stderr, p.stderr
+        assert not (tmp_path / "bad").exists()

@@ -133,6 +133,8 @@ class ContactLaw:
     free_inside = True   # μ = 0 whenever y_free lies within [lo, hi] (a Python law's
     #                      solver is then not called: every position-level law)
     round_holes = False  # takes StepData.disks (round holes); the others refuse them
+    springs = False      # the obstacles are springs: a penetration is a support's
+    #                      deflection (physics), not a numerical error
 
     def setup(self, step: StepData, first: bool = False) -> np.ndarray:
         return np.zeros(0)

@@ -221,6 +221,7 @@ class Penalty(ContactLaw):
     kernel = penalty_kernel
     explicit = penalty_explicit
     round_holes = True
+    springs = True
 
     def __init__(self, stiffness: float, damping: float = 0.0, implicit: bool = False):
         self.stiffness = check_positive("stiffness", stiffness)

@@ -489,8 +489,7 @@ def outcome(result, data: dict) -> dict:
         else None,
         # springs (the penalty law): their compression is the supports' deflection, the
         # physics of an elastic support, not a numerical error
-        "max_support_deflection": result.max_penetration if result.solver == "penalty"
-        else None,
+        "max_support_deflection": result.max_penetration if result.springs else None,
         "impacts": result.impacts, "contact_fraction": result.contact_fraction,
         "qp_iterations": result.qp_iterations, "status": result.status,
         "message": result.message,

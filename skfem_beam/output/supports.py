@@ -187,7 +187,7 @@ DASH = "—"      # a number the run has not got: no friction, no [wear], no lan
 
 
 def _cell(value: float | None) -> str:
-    return DASH if value is None else f"{value:.4g}"
+    return DASH if value is None else f"{value + 0.0:.4g}"    # + 0.0: no "-0" on screen
 
 
 def _row(s: dict) -> list[str]:

@@ -184,7 +184,7 @@ class BetaScheme:
             raise InputError(f"the {law.name} law takes flat faces only; round holes need "
                              "the exact round-hole law (solver auto or round-hole) or the "
                              "penalty law")
-        self.solver = law.name
+        self.solver, self.springs = law.name, law.springs
         params = law.setup(self.step)       # (it may choose the law's kernel)
         self.pysolver = law.solver(self.step) if law.kernel is None else None
         if op.Z.size and (law.kernel is None or law.explicit is not None):

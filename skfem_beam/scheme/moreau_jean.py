@@ -249,12 +249,13 @@ def mj_steps(ops, st, out, n0, n1, inputs, Ebound):
 NSGS_TOL = 1e-12     # friction's Gauss–Seidel: a sweep's largest change, relative
 
 
-def check_theta(theta) -> float:
-    """θ ∈ [1/2, 1], where the θ-scheme is unconditionally stable."""
-    theta = check_finite("theta", theta)
+def check_theta(theta, name: str = "theta=") -> float:
+    """θ ∈ [1/2, 1], where the θ-scheme is unconditionally stable; ``name``: the key or
+    flag as the user wrote it ("theta=", "--theta ", "[contact] theta = ")."""
+    theta = check_finite(name.rstrip("= "), theta)
     if 0.5 <= theta <= 1.0:
         return theta
-    raise InputError(f"theta={theta:g} must lie in [1/2, 1] (the θ-scheme is "
+    raise InputError(f"{name}{theta:g} must lie in [1/2, 1] (the θ-scheme is "
                      f"unconditionally stable there)")
 
 
@@ -281,7 +282,7 @@ class MoreauJeanScheme:
                              "on the wall at the step's end there (e = 0)")
         s, th = stepping, self.theta
         self.system, self.stepping, self.law = system, s, MoreauJeanLaw()
-        self.solver = self.law.name
+        self.solver, self.springs = self.law.name, self.law.springs
         self.dt, self.beta, self.n_steps = s.dt, None, s.steps
         self.save_every, self.frame_every, self.shift = s.save_every, s.frame_every, 0.0
         # Â = M + Δt²θ²K + ΔtθB is step_operators' A with β = θ² and B scaled by 2θ

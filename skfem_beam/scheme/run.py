@@ -95,6 +95,7 @@ class Run:
     op = property(lambda self: self.scheme.op)
     law = property(lambda self: self.scheme.law)
     solver = property(lambda self: self.scheme.solver)
+    springs = property(lambda self: self.scheme.springs)
     pysolver = property(lambda self: self.scheme.pysolver)
     loads = property(lambda self: self.scheme.loads)
     load_norm = property(lambda self: self.scheme.load_norm)
@@ -333,4 +334,5 @@ class Run:
             impacts=int(c[0]), contact_fraction=float(c[1]) / max(1, self.n - 1),
             qp_iterations=int(c[2]),
             work={k: out.work[:keep, i] for i, k in enumerate(self.work_terms)},
-            impact_events=self.impact_events(), system=self.system)
+            impact_events=self.impact_events(), system=self.system,
+            springs=self.springs)

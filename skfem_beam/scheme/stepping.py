@@ -109,6 +109,7 @@ class Result:
     work: dict = field(repr=False)
     impact_events: dict = field(repr=False)
     system: object = field(repr=False)
+    springs: bool = False    # the law's obstacles are springs (contact.base.ContactLaw)
 
     @property
     def success(self) -> bool:

@@ -9,7 +9,14 @@ A hole is a convex set around the beam's rest position (0, 0):
   (ny, nz, gap) saying n·((v, w) − centre) ≤ gap with n = (ny, nz) normalised;
 - ``Hole.regular(sides, radius, angle, centre)``: a regular polygon, ``radius`` to its
   faces (the inscribed circle), the first face's normal at ``angle`` (rad);
-- ``Hole.polygon(vertices)``: any convex polygon, vertices counter-clockwise.
+- ``Hole.polygon(vertices)``: any convex polygon, vertices counter-clockwise;
+- ``Hole.broached(lands, land_width, radius, angle, centre)``: a broached hole, ``lands``
+  arcs of the drilled circle (``land_width`` rad each, centred at angle + 2πk/lands) with
+  lobes cut between them.  To first order in clearance/radius the tube centre's set is
+  K = {p : p·e(φ) ≤ radius for every φ on a land}: arcs of the circle over the lands and,
+  in each lobe, the two tangent lines at the lands' ends meeting in a corner (convex;
+  full lands: the disk, lands of no width: the regular polygon).  Solved exactly by
+  contact.round_hole, as a disk pair whose block knows its lands.
 
 Faces are linear constraints: :meth:`Hole.rows` gives them as rows lo ≤ n·(v, w) ≤ hi,
 two antiparallel faces merged into one row with both bounds (a square hole is then the
@@ -40,6 +47,9 @@ class Hole:
     radius: float | None = None
     faces_: tuple[tuple[float, float, float], ...] = ()
     shape: str = "round"
+    lands: int = 0            # broached: the lands (0: a round or flat-faced hole)
+    land_width: float = 0.0   # broached: each land's angular width (rad)
+    angle: float = 0.0        # broached: the first land's centre (rad)
 
     @classmethod
     def round(cls, radius: float, centre=(0.0, 0.0)) -> "Hole":
@@ -95,9 +105,40 @@ class Hole:
         return cls.faces(np.column_stack([n, np.einsum("ij,ij->i", n, p)]), (0.0, 0.0),
                          "polygon")
 
+    @classmethod
+    def broached(cls, lands: int, land_width: float, radius: float, angle: float = 0.0,
+                 centre=(0.0, 0.0)) -> "Hole":
+        """``lands`` arcs of ``land_width`` rad on the circle of ``radius`` about ``centre``,
+        the first centred at ``angle`` rad; open lobes between them (module docstring)."""
+        lands = check_count("lands", lands, 2)
+        width = check_finite("land_width", land_width)
+        if not 0.0 < width <= 2 * math.pi / lands * (1 + 1e-12):
+            raise InputError(f"land_width={math.degrees(width):g}° must be in (0, "
+                             f"{360 / lands:g}]° (360/lands: the lands may not overlap)")
+        width = min(width, 2 * math.pi / lands)
+        hole = cls(_pair("centre", centre), check_positive("radius", radius), (),
+                   f"{lands}-land", lands, width, check_finite("angle", angle))
+        hole._check_rest()
+        return hole
+
     @property
     def is_round(self) -> bool:
+        """A drilled round hole (a broached hole has its radius too, and lands)."""
+        return self.radius is not None and self.lands == 0
+
+    @property
+    def is_broached(self) -> bool:
+        return self.lands > 0
+
+    @property
+    def is_disk_pair(self) -> bool:
+        """Solved as a pair of rows (v, w) with the box [c − r, c + r]: round or broached."""
         return self.radius is not None
+
+    def land_row(self) -> tuple[float, float, float]:
+        """(lands, half width, first land's angle), the contact law's constants of the
+        hole's block ((0, 0, 0): a round hole)."""
+        return (float(self.lands), 0.5 * self.land_width, self.angle)
 
     def _check_rest(self) -> None:
         """The beam's rest position (0, 0) must lie strictly inside."""
@@ -111,6 +152,8 @@ class Hole:
         d = np.asarray(p, dtype=float) - np.asarray(self.centre)
         if self.is_round:
             return float(self.radius - np.hypot(d[0], d[1]))
+        if self.is_broached:
+            return -float(land_excess(d[0], d[1], self.radius, *self.land_row()))
         f = np.asarray(self.faces_)
         return float(np.min(f[:, 2] - f[:, :2] @ d))
 
@@ -139,6 +182,8 @@ class Hole:
         if self.is_round:
             a = np.linspace(0.0, 2 * math.pi, points)
             return c + self.radius * np.column_stack([np.cos(a), np.sin(a)])
+        if self.is_broached:
+            return c + self._broached_outline(points)
         f = np.asarray(self.faces_)
         ang = np.arctan2(f[:, 1], f[:, 0])
         f = f[np.argsort(ang)]
@@ -152,23 +197,61 @@ class Hole:
         return np.array(verts + verts[:1]) if verts else np.zeros((0, 2))
 
 
+    def _broached_outline(self, points: int) -> np.ndarray:
+        """∂K about the centre, closed: per land an arc (its share of ``points``), then
+        the lobe's corner (the two edge lines are straight: their ends suffice)."""
+        n, h, a0 = self.lands, 0.5 * self.land_width, self.angle
+        delta = math.pi / n - h              # half the lobe's angle
+        per = max(2, points // n)
+        out = []
+        for k in range(n):
+            mid = a0 + 2 * math.pi * k / n
+            a = np.linspace(mid - h, mid + h, per)
+            out.append(self.radius * np.column_stack([np.cos(a), np.sin(a)]))
+            if delta > 0.0:
+                m = mid + math.pi / n
+                out.append(self.radius / math.cos(delta) * np.array([[math.cos(m),
+                                                                       math.sin(m)]]))
+        out = np.concatenate(out)
+        return np.vstack([out, out[:1]])
+
+
+def land_excess(pa: float, pb: float, r: float, lands: float, half: float,
+                angle: float) -> float:
+    """max over the lands' φ of p·e(φ) − r: how far p = (pa, pb) lies beyond a broached
+    hole's set K (≤ 0: inside; on a land's direction it is |p| − r).  The same arithmetic
+    as contact.lands.land_excess (plain Python here, for the checks and charts)."""
+    rho = math.hypot(pa, pb)
+    step = 2 * math.pi / lands
+    off = math.atan2(pb, pa) - angle
+    off -= step * math.floor(off / step + 0.5)     # from the nearest land's centre
+    return rho * math.cos(max(abs(off) - half, 0.0)) - r
+
+
 def _is_table(value) -> bool:
     return isinstance(value, (list, tuple, np.ndarray)) and not isinstance(value, (str, bytes))
 
 
 def hole_from_table(d: dict, where: str) -> Hole:
     """A hole from a scene file's ``hole = { ... }``: ``radius`` alone (round; with
-    ``sides`` a regular polygon, ``angle`` its first face's normal), ``polygon``, or
-    ``faces``; ``centre`` optional."""
+    ``sides`` a regular polygon, ``angle`` its first face's normal in rad; with ``lands`` a
+    broached hole, ``land_width`` and ``angle`` in degrees), ``polygon``, or ``faces``;
+    ``centre`` optional."""
     if not isinstance(d, dict):
         raise InputError(f"{where} must be a table: {{ radius = r }}, {{ sides = n, radius = r }}, "
+                         "{ lands = n, land_width = deg, radius = r }, "
                          "{ polygon = [[y, z], ...] } or { faces = [[ny, nz, gap], ...] }")
-    allowed = {"radius", "sides", "angle", "centre", "polygon", "faces"}
+    allowed = {"radius", "sides", "angle", "centre", "polygon", "faces", "lands", "land_width"}
     unknown = set(d) - allowed
     if unknown:
         raise InputError(f"unknown key {where}.{sorted(unknown)[0]}; a hole allows: "
                          f"{', '.join(sorted(allowed))}")
     centre = d.get("centre", (0.0, 0.0))
+    if ("lands" in d or "land_width" in d) and not {"polygon", "faces", "sides"} & set(d):
+        return _broached_from_table(d, where, centre)
+    if {"lands", "land_width"} & set(d):
+        raise InputError(f"{where} lands and land_width make a broached hole: not with "
+                         "sides, polygon or faces")
     if "polygon" in d:
         if set(d) - {"polygon"}:
             raise InputError(f"{where} polygon stands alone (its vertices are absolute)")
@@ -182,10 +265,27 @@ def hole_from_table(d: dict, where: str) -> Hole:
             raise InputError(f"{where} sides = n needs radius (to the faces, m)")
         return Hole.regular(d["sides"], d["radius"], d.get("angle", 0.0), centre)
     if "radius" not in d:
-        raise InputError(f"{where} needs radius, sides with radius, polygon or faces")
+        raise InputError(f"{where} needs radius, sides with radius, lands with radius, "
+                         "polygon or faces")
     if "angle" in d:
-        raise InputError(f"{where} angle applies to a regular polygon (sides)")
+        raise InputError(f"{where} angle applies to a regular polygon (sides) or lands")
     return Hole.round(d["radius"], centre)
+
+
+def _broached_from_table(d: dict, where: str, centre) -> Hole:
+    """``{ lands = n, land_width = deg, radius = r, angle = deg }`` (degrees: a drawing's)."""
+    for key in ("lands", "land_width", "radius"):
+        if key not in d:
+            raise InputError(f"{where} a broached hole needs lands, land_width (degrees) "
+                             f"and radius (m): {key} is missing")
+    try:
+        return Hole.broached(d["lands"], math.radians(check_finite("land_width",
+                                                                    d["land_width"])),
+                             d["radius"], math.radians(check_finite("angle",
+                                                                    d.get("angle", 0.0))),
+                             centre)
+    except InputError as e:
+        raise InputError(f"{where}: {e}") from None
 
 
 @dataclass(frozen=True)

@@ -53,7 +53,10 @@ SECTION_DOCS = {
         "obstacle: elastic supports, the penalty law's springs with Kelvin–Voigt dashpots. "
         'Two planes: g1, g2 bound v; `hole = {...}` at `x` or over `x_from`, `x_to` bounds '
         '(v, w): `{ radius = r }` (drilled, `centre = [cy, cz]` optional), `{ sides = n, '
-        'radius = r, angle = a }` (a regular polygon, r to its faces: a trefoil is 3), `{ '
+        'radius = r, angle = a }` (a regular polygon, r to its faces, a in rad), `{ lands = '
+        'n, land_width = deg, radius = r, angle = deg }` (broached: n lands, arcs of the '
+        'circle of radius r each land_width degrees wide, centred at angle + 360k/n degrees, '
+        'open lobes between them: a trefoil is 3, a quatrefoil 4), `{ '
         'polygon = [[y, z], ...] }` (convex, counter-clockwise), `{ faces = [[ny, nz, gap], '
         '...] }` (flat bars: n·(v, w) ≤ gap). Bar: one, `x = 0` or `L`, `stiffness` for an '
         'elastic obstacle `friction` (μ at this hole, overriding `[contact] friction`).'

@@ -117,7 +117,7 @@ CONTACT = {"law": V, "stiffness": N, "restitution": N, "friction": N, "theta": N
 G = NumberOr({"poly": NUMBERS, "about": N, "x": NUMBERS, "g": NUMBERS},   # the rest: _g
              "{ poly = [...] } or { x = [...], g = [...] }")
 HOLE = {"radius": N, "sides": N, "angle": N, "centre": NUMBERS,     # the rest: holes.py
-        "polygon": ListOf(NUMBERS), "faces": ListOf(NUMBERS)}
+        "polygon": ListOf(NUMBERS), "faces": ListOf(NUMBERS), "lands": N, "land_width": N}
 
 BEAM_KEYS = {
     "kind": V, "planes": N, "material": MATERIAL, "section": SECTION,

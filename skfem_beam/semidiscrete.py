@@ -102,6 +102,8 @@ class SemiDiscrete:
     # its hole at rest and how it moves per unit φ (None: one plane)
     planes: int = 1
     disks: np.ndarray | None = None
+    lands: np.ndarray | None = None          # per disk (lands, half width, angle): a
+    #                                          broached hole's; (0, 0, 0) round (None: all)
     friction: np.ndarray | None = None       # Coulomb's μ per row (a round hole's first)
     row_nodes: sp.csr_matrix | None = None
     row_centres: np.ndarray | None = None

@@ -10,7 +10,8 @@ and a banded solve keeps the one-plane band (twice the unknowns, the same bandwi
 The constraints couple the planes only at the nodes: a row is lo ≤ n·(v, w)(x_i) ≤ hi
 (the first plane's flat obstacles: n = (1, 0); a hole's faces, antiparallel ones in one
 row: holes.Hole.rows), and a round hole adds the pair of rows v(x_i), w(x_i) whose box
-[c − r, c + r] carries the disk (``disks``; contact.round_hole).  Obstacles that move with
+[c − r, c + r] carries the disk (``disks``; contact.round_hole); a broached hole is such
+a pair too, with its lands (``lands``; contact.lands).  Obstacles that move with
 the support move along d: a row's bound moves by (carried − h(x_i))·(n·d)·φ(t).
 """
 from __future__ import annotations
@@ -21,6 +22,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .errors import InputError
+from .holes import land_excess
 from .problem import InitialState, Load, Obstacles, Support
 from .timefunctions import Scaled
 
@@ -90,7 +92,7 @@ def two_plane_system(problem, samples_per_element: int = 20):
                                np.array([[shift_at(x, c) * dy, shift_at(x, c) * dz]
                                          for x, c in zip(sv.x_contact, carried_v)])
                                .reshape(-1, 2)])]
-    disks, mu, m = [], [], sv.C.shape[0]
+    disks, mu, lands, m = [], [], [], sv.C.shape[0]
     free = set(space.value_nodes.tolist())
     for k, h in enumerate(problem.holes):
         at = np.flatnonzero(h.acts_at(nodes, problem.beam.L))
@@ -104,15 +106,17 @@ def two_plane_system(problem, samples_per_element: int = 20):
             ev = space.nodal[i]
             s = shift_at(x, h.carried)
             c = np.array([[h.hole.centre[0], h.hole.centre[1], s * dy, s * dz]])
-            if h.hole.is_round:
+            if h.hole.is_disk_pair:
                 if any(d[2] == i for d in disks):
-                    raise InputError(f"two round holes at x={x:g}: give the smaller one")
+                    raise InputError(f"two round or broached holes at x={x:g}: give the "
+                                     "smaller one")
                 r, (cy, cz) = h.hole.radius, h.hole.centre
                 rows += [_pad(ev, n, False), _pad(ev, n, True)]
                 lo.append(np.array([cy - r, cz - r]))
                 hi.append(np.array([cy + r, cz + r]))
                 shift.append(np.array([s * dy, s * dz]))
                 disks.append((m, m + 1, i))
+                lands.append(h.hole.land_row() if h.hole.is_broached else (0.0, 0.0, 0.0))
                 mu.append(h.friction)
                 m += 2
                 xs.append(np.array([x, x]))
@@ -131,7 +135,7 @@ def two_plane_system(problem, samples_per_element: int = 20):
     shift, centre = np.concatenate(shift), np.concatenate(centre).reshape(-1, 4)
     motion = phi if lift is not None and np.any(shift != 0) else None
     u0, v0 = np.concatenate([sv.u0, sw.u0]), np.concatenate([sv.v0, sw.v0])
-    _check_start(C @ u0, lo, hi, disks, x_c, motion, shift)
+    _check_start(C @ u0, lo, hi, disks, x_c, motion, shift, lands)
 
     # penetration samples: the first plane's flat obstacles (a hole acts at its nodes)
     sample_E = _pad(sv.sample_E, n, False)
@@ -167,6 +171,8 @@ def two_plane_system(problem, samples_per_element: int = 20):
         view=view, bound_motion=motion, bound_shift=shift if motion is not None else None,
         sample_shift=s_shift if motion is not None else None,
         planes=2, disks=np.array([d[:2] for d in disks], dtype=np.int64).reshape(-1, 2),
+        lands=np.array(lands, dtype=float).reshape(-1, 3)
+        if any(row[0] > 0 for row in lands) else None,
         friction=_friction(m, disks, mu),
         row_nodes=node_rows, row_centres=centre)
 
@@ -181,18 +187,21 @@ def _friction(m: int, disks, mu) -> np.ndarray | None:
     return out
 
 
-def _check_start(y0, lo, hi, disks, x_c, motion, shift) -> None:
+def _check_start(y0, lo, hi, disks, x_c, motion, shift, lands) -> None:
     """u0 must lie in every hole (and between the flat obstacles) at t = 0."""
     if motion is not None:
         p0 = float(motion(0.0))
         lo, hi = lo + shift * p0, hi + shift * p0
     tol = 1e-12 * max(1.0, np.abs(y0).max(initial=0.0))
     in_disk = np.zeros(y0.size, bool)
-    for a, b, _ in disks:
+    for (a, b, _), land in zip(disks, lands):
         in_disk[[a, b]] = True
         c = 0.5 * (lo[[a, b]] + hi[[a, b]])
-        if np.hypot(*(y0[[a, b]] - c)) > 0.5 * (hi[a] - lo[a]) + tol:
-            raise InputError(f"u0 leaves the round hole at x={x_c[a]:g}")
+        r, p = 0.5 * (hi[a] - lo[a]), y0[[a, b]] - c
+        out = land_excess(p[0], p[1], r, *land) if land[0] > 0 else np.hypot(*p) - r
+        if out > tol:
+            raise InputError(f"u0 leaves the {'broached' if land[0] > 0 else 'round'} "
+                             f"hole at x={x_c[a]:g}")
     bad = ~in_disk & ((y0 < lo - tol) | (y0 > hi + tol))
     if bad.any():
         i = int(np.argmax(bad))

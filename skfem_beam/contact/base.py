@@ -115,6 +115,9 @@ class StepData:
     disks: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
     #                     (q, 2) row pairs (v, w) of round holes: |y_p − c| ≤ r with c, r
     #                     those of the pair's box [lo, hi] (contact.round_hole)
+    lands: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    #                     (q, 3) per disk: (lands, half width, angle) of a broached hole
+    #                     (contact.lands), (0, 0, 0) a round one; (0, 3): all round
 
     @property
     def decoupled(self) -> bool:

@@ -33,6 +33,8 @@ from numba import njit
 from ..errors import InputError
 from .active_set import data_scale
 from .base import ContactLaw, compiled_law
+from .lands import (PIECE_CORNER, PIECE_LINE, corner_candidate, land_excess, line_candidate,
+                    lobe_geometry, piece_holds, piece_of)
 
 internal = njit(cache=True)   # also called from Python: the start step runs the law uncompiled
 
@@ -94,21 +96,114 @@ def disk_root(a, b, d, z0, z1, r, out):
     return its
 
 
-@internal
-def _polish(D, yf, lo, hi, kind, mu, tol):
-    """Newton on the active set's KKT equations (boxes on their bound, disks on their
-    circle with μ_p ∥ −(y_p − c)), from the Gauss–Seidel μ; returns False (μ unchanged)
-    when the system is singular or the result leaves the active set's signs."""
-    m = yf.size
-    act = np.zeros(m, np.int64)
+@njit(cache=True)
+def land_project(a, b, d, za, zb, r, lands, half, angle, root, out):
+    """A broached block (contact.lands): out[0:2] ← μ of z's projection onto K in the
+    metric D⁻¹ (D = [[a, b], [b, d]]); returns its piece (0: z in K, μ = 0).  K is convex,
+    so the projection is the cheapest feasible point among the pieces' own projections:
+    the disk's (the circle lies in K, so it is always feasible; it is K's projection
+    when it falls on a land), each lobe line's when it falls on its segment, and the
+    corners (each in K).  Cost: (p − z)ᵀD⁻¹(p − z) = μᵀDμ."""
+    if land_excess(za, zb, r, lands, half, angle) <= 0.0:
+        out[0], out[1] = 0.0, 0.0
+        return 0
+    disk_root(a, b, d, za, zb, r, root)      # z ∉ K ⊇ disk: |z| > r
+    t = root[2]
+    out[0], out[1] = -t * root[0], -t * root[1]
+    best = -t * ((root[0] - za) * root[0] + (root[1] - zb) * root[1])
+    code = 1
+    cand = np.empty(2)
+    for k in range(int(lands)):
+        if lobe_geometry(k, lands, half, angle)[2] <= 0.0:
+            break                             # full lands: no lobes, K is the disk
+        for which in range(3):
+            kind, x, y, t_lo, t_hi = piece_of(2 + 3 * k + which, r, lands, half, angle)
+            if kind == PIECE_LINE:
+                cost = line_candidate(a, b, d, za, zb, r, x, y, t_lo, t_hi, cand)
+            else:
+                cost = corner_candidate(a, b, d, za, zb, x, y, cand)
+            if cost < best:
+                best, code = cost, 2 + 3 * k + which
+                out[0], out[1] = cand[0], cand[1]
+    return code
+
+
+@njit(cache=True)
+def _piece_rows(D, act, k, i, a, b, pa, pb, r, mua, mub, code, lands, F, J):
+    """Rows i, i+1 of the polish for a broached block on a line (e·p = r and μ ∥ e) or a
+    corner (p = q): both linear in μ.  Returns False for an arc (the disk's rows)."""
+    kind, x, y, _, _ = piece_of(code, r, lands[0], lands[1], lands[2])
+    if kind == PIECE_LINE:
+        F[i] = x * pa + y * pb - r
+        F[i + 1] = mua * y - mub * x
+        for q in range(k):
+            J[i, q] = x * D[a, act[q]] + y * D[b, act[q]]
+            J[i + 1, q] = 0.0
+        J[i + 1, i] += y
+        J[i + 1, i + 1] -= x
+        return True
+    if kind == PIECE_CORNER:
+        F[i] = pa - x
+        F[i + 1] = pb - y
+        for q in range(k):
+            J[i, q] = D[a, act[q]]
+            J[i + 1, q] = D[b, act[q]]
+        return True
+    return False
+
+
+@njit(cache=True)
+def _active_rows(kind, piece, mu, act):
+    """The polish's unknowns: box rows and round blocks with μ ≠ 0 on their first row (as
+    before broached holes), broached blocks on a piece (either row may carry μ)."""
     k = 0
-    for j in range(m):
-        if mu[j] != 0.0 and kind[j] >= 0:   # box rows and disk first rows
+    for j in range(kind.size):
+        if kind[j] >= 0 and (mu[j] != 0.0 or (kind[j] > 0 and piece[j] > 0)):
             act[k] = j
             k += 1
             if kind[j] > 0:
                 act[k] = kind[j]            # its second row
                 k += 1
+    return k
+
+
+@njit(cache=True)
+def _still_holds(D, yf, lo, hi, kind, lands, piece, mu, mu_new, tol):
+    """Whether μ_new keeps the active set's signs and the inactive constraints."""
+    y = yf + D @ mu_new
+    for j in range(yf.size):
+        if kind[j] == 0:
+            if (mu[j] > 0.0 and mu_new[j] <= 0.0) or (mu[j] < 0.0 and mu_new[j] >= 0.0):
+                return False
+            if mu[j] == 0.0 and (y[j] < lo[j] - tol or y[j] > hi[j] + tol):
+                return False
+        elif kind[j] > 0:
+            a, b = j, kind[j]
+            pa, pb, rho, r = radial(y[a], y[b], lo[a], hi[a], lo[b], hi[b])
+            if lands[j, 0] > 0.0:
+                if piece[j] > 0:
+                    if not piece_holds(piece[j], pa, pb, mu_new[a], mu_new[b], r,
+                                       lands[j, 0], lands[j, 1], lands[j, 2], tol):
+                        return False
+                elif land_excess(pa, pb, r, lands[j, 0], lands[j, 1], lands[j, 2]) > tol:
+                    return False
+            elif mu[a] != 0.0 or mu[b] != 0.0:
+                if mu_new[a] * pa + mu_new[b] * pb >= 0.0:    # must push inwards
+                    return False
+            elif rho > r + tol:
+                return False
+    return True
+
+
+@internal
+def _polish(D, yf, lo, hi, kind, lands, piece, mu, tol):
+    """Newton on the active set's KKT equations (boxes on their bound, disks on their
+    circle with μ_p ∥ −(y_p − c), broached blocks on their piece: _piece_rows), from the
+    Gauss–Seidel μ; returns False (μ unchanged) when the system is singular or the
+    result leaves the active set's signs."""
+    m = yf.size
+    act = np.zeros(m, np.int64)
+    k = _active_rows(kind, piece, mu, act)
     if k == 0:
         return True
     mu_new = mu.copy()
@@ -128,6 +223,10 @@ def _polish(D, yf, lo, hi, kind, mu, tol):
             else:
                 a, b = j, kind[j]
                 pa, pb, _, r = radial(y[a], y[b], lo[a], hi[a], lo[b], hi[b])
+                if piece[a] > 0 and _piece_rows(D, act, k, i, a, b, pa, pb, r, mu_new[a],
+                                                mu_new[b], piece[a], lands[a], F, J):
+                    i += 2
+                    continue
                 F[i] = 0.5 * (pa * pa + pb * pb - r * r) / r
                 F[i + 1] = mu_new[a] * pb - mu_new[b] * pa
                 for q in range(k):
@@ -143,36 +242,49 @@ def _polish(D, yf, lo, hi, kind, mu, tol):
         for q in range(k):
             mu_new[act[q]] -= delta[q]
     # keep it only if the signs and the inactive constraints still hold
-    y = yf + D @ mu_new
-    for j in range(m):
-        if kind[j] == 0:
-            if (mu[j] > 0.0 and mu_new[j] <= 0.0) or (mu[j] < 0.0 and mu_new[j] >= 0.0):
-                return False
-            if mu[j] == 0.0 and (y[j] < lo[j] - tol or y[j] > hi[j] + tol):
-                return False
-        elif kind[j] > 0:
-            a, b = j, kind[j]
-            pa, pb, rho, r = radial(y[a], y[b], lo[a], hi[a], lo[b], hi[b])
-            if mu[a] != 0.0 or mu[b] != 0.0:
-                if mu_new[a] * pa + mu_new[b] * pb >= 0.0:    # must push inwards
-                    return False
-            elif rho > r + tol:
-                return False
+    if not _still_holds(D, yf, lo, hi, kind, lands, piece, mu, mu_new, tol):
+        return False
     for j in range(m):
         mu[j] = mu_new[j]
     return True
 
 
 @internal
+def _block(D, y, lo, hi, kind, lands, piece, mu, a, root, out):
+    """The disk block a's new μ in out[0:2] (module docstring; a broached block:
+    land_project, its piece kept in piece[a] for the polish)."""
+    b = kind[a]
+    ya = y[a] - D[a, a] * mu[a] - D[a, b] * mu[b]
+    yb = y[b] - D[b, a] * mu[a] - D[b, b] * mu[b]
+    za, zb, _, r = radial(ya, yb, lo[a], hi[a], lo[b], hi[b])
+    if lands[a, 0] > 0.0:
+        piece[a] = land_project(D[a, a], D[a, b], D[b, b], za, zb, r, lands[a, 0],
+                                lands[a, 1], lands[a, 2], root, out)
+    elif za * za + zb * zb <= r * r:
+        out[0], out[1] = 0.0, 0.0
+    else:
+        disk_root(D[a, a], D[a, b], D[b, b], za, zb, r, root)
+        out[0], out[1] = -root[2] * root[0], -root[2] * root[1]
+
+
+@internal
 def cone_solve(D, yf, lo, hi, kind, mu, active):
-    """The step's μ for boxes and disks (module docstring).  ``kind[j]``: 0 a box row,
-    b > 0 the first row of a disk whose second row is b, −1 a disk's second row.
-    Returns the sweeps (< 0: no convergence)."""
+    """The step's μ for boxes and round disks: land_cone_solve without broached holes."""
+    return land_cone_solve(D, yf, lo, hi, kind, np.zeros((yf.size, 3)), mu, active)
+
+
+@internal
+def land_cone_solve(D, yf, lo, hi, kind, lands, mu, active):
+    """The step's μ for boxes, disks and broached holes (module docstring).  ``kind[j]``:
+    0 a box row, b > 0 the first row of a disk whose second row is b, −1 a disk's second
+    row; ``lands[j]`` of a disk's first row: (lands, half width, angle) of a broached hole
+    (lands 0: round).  Returns the sweeps (< 0: no convergence)."""
     m = yf.size
     y = yf.copy()
     for j in range(m):
         mu[j] = 0.0
-    root = np.empty(3)
+    root, new = np.empty(3), np.empty(2)
+    piece = np.zeros(m, np.int64)
     scale = data_scale(yf, lo, hi)
     tol = 1e-13 * scale
     blocks = 0
@@ -185,28 +297,21 @@ def cone_solve(D, yf, lo, hi, kind, mu, active):
             if kind[j] == 0:
                 yt = y[j] - D[j, j] * mu[j]
                 target = min(max(yt, lo[j]), hi[j])
-                new = (target - yt) / D[j, j]
-                dj = new - mu[j]
+                new_j = (target - yt) / D[j, j]
+                dj = new_j - mu[j]
                 if dj != 0.0:
                     for i in range(m):
                         y[i] += D[i, j] * dj
-                    mu[j] = new
+                    mu[j] = new_j
                 change = max(change, abs(D[j, j] * dj))
             elif kind[j] > 0:
                 a, b = j, kind[j]
-                ya = y[a] - D[a, a] * mu[a] - D[a, b] * mu[b]
-                yb = y[b] - D[b, a] * mu[a] - D[b, b] * mu[b]
-                za, zb, _, r = radial(ya, yb, lo[a], hi[a], lo[b], hi[b])
-                if za * za + zb * zb <= r * r:
-                    na, nb = 0.0, 0.0
-                else:
-                    disk_root(D[a, a], D[a, b], D[b, b], za, zb, r, root)
-                    na, nb = -root[2] * root[0], -root[2] * root[1]
-                da, db = na - mu[a], nb - mu[b]
+                _block(D, y, lo, hi, kind, lands, piece, mu, a, root, new)
+                da, db = new[0] - mu[a], new[1] - mu[b]
                 if da != 0.0 or db != 0.0:
                     for i in range(m):
                         y[i] += D[i, a] * da + D[i, b] * db
-                    mu[a], mu[b] = na, nb
+                    mu[a], mu[b] = new[0], new[1]
                 change = max(change, abs(D[a, a] * da + D[a, b] * db),
                              abs(D[b, a] * da + D[b, b] * db))
         if blocks == 1 or change <= SWEEP_TOL * scale:
@@ -214,7 +319,7 @@ def cone_solve(D, yf, lo, hi, kind, mu, active):
     else:
         return -1
     if blocks > 1:
-        _polish(D, yf, lo, hi, kind, mu, tol)
+        _polish(D, yf, lo, hi, kind, lands, piece, mu, tol)
     for j in range(m):
         if kind[j] > 0:
             active[j] = mu[j] != 0.0 or mu[kind[j]] != 0.0
@@ -245,15 +350,37 @@ def kinds_of(params, m):
     return kind
 
 
+@internal
+def lands_of(params, m):
+    """land_cone_solve's ``lands`` from the law's params: after the disk pairs, 3 numbers
+    per disk (lands, half width, angle; land_params), none: every disk round."""
+    lands = np.zeros((m, 3))
+    q = int(params[0])
+    at = 1 + 2 * q
+    if params.size > at:
+        for p in range(q):
+            a = int(params[1 + 2 * p])
+            for c in range(3):
+                lands[a, c] = params[at + 3 * p + c]
+    return lands
+
+
 @compiled_law
 def round_hole_kernel(D, yf, y_cur, y_prev, lo, hi, params, state, mu, active):
-    return cone_solve(D, yf, lo, hi, kinds_of(params, yf.size), mu, active)
+    m = yf.size
+    return land_cone_solve(D, yf, lo, hi, kinds_of(params, m), lands_of(params, m), mu,
+                           active)
 
 
 def disk_params(disks) -> np.ndarray:
     """[q, a0, b0, a1, b1, ...]: the disk pairs as a law's float constants."""
     d = np.asarray(disks, dtype=float).reshape(-1, 2)
     return np.concatenate([[float(d.shape[0])], d.ravel()])
+
+
+def land_params(lands) -> np.ndarray:
+    """The disks' (lands, half width, angle), (q, 3), flattened: after disk_params."""
+    return np.asarray(lands, dtype=float).reshape(-1, 3).ravel()
 
 
 class RoundHole(ContactLaw):
@@ -268,4 +395,6 @@ class RoundHole(ContactLaw):
                                              - (step.hi - step.lo)[step.disks[:, 1]])
                                       > 1e-12 * (step.hi - step.lo)[step.disks[:, 0]]):
             raise InputError("a round hole's two rows must have the same radius")
+        if step.lands.size and np.any(step.lands[:, 0] > 0):
+            return np.concatenate([disk_params(step.disks), land_params(step.lands)])
         return disk_params(step.disks)

@@ -20,9 +20,9 @@ from ..contact.registry import Auto
 from ..contact.round_hole import disk_kinds
 from ..errors import InputError, SolverError
 from ..linalg import band_solve, rows_matvec
-from .kernels import (CALLEES, EVENT_COLUMNS, IMPACT_FIELDS, SECTORS, Inputs, Ops, PythonLaw,
-                      Series, State, csr_product, energy_beta, move_bounds, record, run_steps,
-                      run_steps_python)
+from .kernels import (CALLEES, EVENT_COLUMNS, IMPACT_FIELDS, NC_COLUMNS, SECTORS, Inputs, Ops,
+                      PythonLaw, Series, State, csr_product, energy_beta, move_bounds, record,
+                      run_steps, run_steps_python)
 from .operators import csr_arrays, load_norms, step_operators
 from .stepping import Stepping
 
@@ -105,26 +105,44 @@ def disk_rows(system) -> np.ndarray:
         np.ascontiguousarray(disks, dtype=np.int64).reshape(-1, 2)
 
 
+def land_rows(system) -> np.ndarray:
+    """The (q, 3) lands of the system's disks (contact.lands; all round: (0, 3))."""
+    lands = getattr(system, "lands", None)
+    return np.zeros((0, 3)) if lands is None else \
+        np.ascontiguousarray(lands, dtype=float).reshape(-1, 3)
+
+
+def refuse_lands(system, law: str) -> None:
+    """One line when ``law`` meets a broached hole (the round-hole law's alone)."""
+    if np.any(land_rows(system)[:, 0] > 0):
+        raise InputError(f"broached holes (lands) need the exact round-hole law (solver "
+                         f"auto or round-hole), not {law}")
+
+
 def hole_arrays(system):
     """Ops' (pair, disks, Np, Ni, Nx, Nc) of ``system`` (kernels.Ops): the round holes'
     row pairs and first rows and, in two planes, each row's node and hole (one plane:
-    empty)."""
+    empty; Nc's columns 6:9: a disk's first row's lands, kernels.violation)."""
     m = system.C.shape[0]
     disks = disk_rows(system)
     pair = disk_kinds(m, disks)
     first = np.ascontiguousarray(disks[:, 0])
     if getattr(system, "row_nodes", None) is None or not m:
         return (pair, first, np.zeros(1, np.int64), np.zeros(0, np.int64), np.zeros(0),
-                np.zeros((0, 6)))
-    Nc = np.zeros((m, 6))
+                np.zeros((0, NC_COLUMNS)))
+    Nc = np.zeros((m, NC_COLUMNS))
     Nc[:, :4] = system.row_centres
+    lands = land_rows(system)
+    if lands.shape[0]:               # both rows of a pair: record skips its box
+        Nc[first, 6:9] = lands
+        Nc[pair[first], 6:9] = lands
     C = system.C.tocsr()
     for j in range(m):
         if pair[j] == 0:        # a face: its normal is its row on the node's (v, w)
             nv, nw = (system.row_nodes[2 * j + c].multiply(C[j]).sum() /
                       system.row_nodes[2 * j + c].multiply(system.row_nodes[2 * j + c]).sum()
                       for c in range(2))
-            Nc[j, 4:] = nv, nw
+            Nc[j, 4:6] = nv, nw
     return (pair, first, *csr_arrays(system.row_nodes), np.ascontiguousarray(Nc))
 
 
@@ -175,11 +193,13 @@ class BetaScheme:
             self.op = op = step_operators(system, s.dt, s.beta, s.massless)
         self.step = StepData(op.A, op.C, op.D, np.ascontiguousarray(system.lo, dtype=float),
                              np.ascontiguousarray(system.hi, dtype=float), s.dt, s.beta,
-                             disk_rows(system))
+                             disk_rows(system), land_rows(system))
         self.law = law = self._law(law, m)
         if friction(system):
             raise InputError("Coulomb friction is a velocity-level law: run it with law = "
                              "moreau-jean (the β-scheme's contact is frictionless)")
+        if law.name != "round-hole":
+            refuse_lands(system, f"the {law.name} law")
         if self.step.disks.size and not law.round_holes:
             raise InputError(f"the {law.name} law takes flat faces only; round holes need "
                              "the exact round-hole law (solver auto or round-hole) or the "

@@ -24,6 +24,7 @@ from collections import namedtuple
 import numpy as np
 from numba import njit, objmode, types
 
+from ..contact.lands import land_excess, land_normal
 from ..linalg import band_solve, csr_product, rows_dot, rows_matvec
 
 Ops = namedtuple("Ops", [
@@ -41,9 +42,12 @@ Ops = namedtuple("Ops", [
     #                                   row's index, its second row −1, other rows 0
     "disks",                          # the round holes' first rows
     "Np", "Ni", "Nx", "Nc",           # two planes: each row's node (v, w) as CSR rows 2j,
-    #                                   2j+1, and [cy, cz, sy, sz, ny, nz]: its hole's centre
-    #                                   at rest, the centre's motion per unit φ, the row's
-    #                                   normal ((0, 0): radial, a round hole); none: 1 plane
+    #                                   2j+1, and [cy, cz, sy, sz, ny, nz, n, h, a]: its hole's
+    #                                   centre at rest, the centre's motion per unit φ, the
+    #                                   row's normal ((0, 0): radial, a round hole), a
+    #                                   broached hole's lands, half width, first land's angle
+    #                                   (both rows of its pair; n = 0: not broached, see
+    #                                   contact.lands); none: 1 plane
 ])
 State = namedtuple("State", [
     "u_prev", "u_cur",                # uⁿ⁻¹, uⁿ
@@ -77,6 +81,7 @@ Series = namedtuple("Series", ["obs", "obsv", "energy", "work", "lam", "frames_u
 Inputs = namedtuple("Inputs", ["G", "phi", "H"], defaults=(np.zeros((0, 0)),))
 WORK_TERMS = ("damping", "input", "contact")   # the columns of State.work and Series.work
 FRICTION = 3           # ... and the friction work's (Moreau–Jean with friction only)
+NC_COLUMNS = 9         # Ops.Nc's columns
 SECTORS = 12           # the hole's angular sectors of the normal work (State.sectors)
 EVENT_COLUMNS = ("value", "start_step", "end_step", "velocity", "peak_force", "impulse",
                  "max_violation", "angle", "normal_velocity", "tangential_velocity", "slip",
@@ -240,11 +245,13 @@ def record(n, ops, st, out):
     obs, obsv, energy, out_work, lam, frames_u, frames_v, frames_f = out.obs, out.obsv, \
         out.energy, out.work, out.lam, out.frames_u, out.frames_v, out.frames_f
     for r in range(y_cur.size):
+        if broached(pair, ops.Nc, r):   # its box is not its bound: violation's
+            continue
         v = max(lo[r] - y_cur[r], y_cur[r] - hi[r])
         if v > stats[0]:
             stats[0] = v
     for r in disks:           # round holes: beyond the circle (a loop of its own: 1 µs a
-        v = violation(pair, lo, hi, y_cur, r)   # step on 40 box rows)
+        v = violation(pair, ops.Nc, lo, hi, y_cur, r)   # step on 40 box rows)
         if v > stats[0]:
             stats[0] = v
     for r in range(slo.size):
@@ -303,11 +310,23 @@ def move_bounds(ops, st, phi):
 
 
 @njit(cache=True, inline="always")
-def violation(pair, lo, hi, y, j):
+def broached(pair, Nc, j):
+    """Whether the value j is a row of a broached hole's pair (Ops.Nc's lands)."""
+    return pair[j] != 0 and Nc.shape[0] > 0 and Nc[j, 6] > 0.0
+
+
+@njit(cache=True, inline="always")
+def violation(pair, Nc, lo, hi, y, j):
     """How far the value y[j] is beyond its bounds (≤ 0: within); a round hole's first
-    row: its pair's distance beyond the circle (the box [lo, hi] is the disk's square).
+    row: its pair's distance beyond the circle (the box [lo, hi] is the disk's square);
+    a broached hole's: max over its lands' φ of p·e(φ) − r (contact.lands.land_excess;
+    its box is no bound: the lobes reach beyond it).
     (Arrays, not the State: passing the tuple costs its reference counts, 5 µs a step
     in run_steps_python, measured.)"""
+    if broached(pair, Nc, j):
+        b = pair[j]
+        return land_excess(y[j] - 0.5 * (lo[j] + hi[j]), y[b] - 0.5 * (lo[b] + hi[b]),
+                           0.5 * (hi[j] - lo[j]), Nc[j, 6], Nc[j, 7], Nc[j, 8])
     v = max(lo[j] - y[j], y[j] - hi[j])
     if pair[j] > 0:
         b = pair[j]
@@ -358,6 +377,8 @@ def node_position(ops, st, j, out):
 def normal_of(ops, j, px, py):
     """The unit normal of the value j's wall at the offset (px, py) from the centre."""
     nx, ny = ops.Nc[j, 4], ops.Nc[j, 5]
+    if ops.Nc[j, 6] > 0.0:               # a broached hole: its arc's or its line's
+        return land_normal(px, py, ops.Nc[j, 6], ops.Nc[j, 7], ops.Nc[j, 8])
     if nx == 0.0 and ny == 0.0:          # a round hole: radial
         r = np.hypot(px, py)
         if r == 0.0:
@@ -441,7 +462,7 @@ def track_impacts(ops, st, out, step):
                 ev[j, 9] += abs(fc[j, 3]) * dt
                 ev[j, 10] += abs(fc[j, 1])
             if a:
-                ev[j, 4] = max(ev[j, 4], violation(pair, lo, hi, y_cur, j))
+                ev[j, 4] = max(ev[j, 4], violation(pair, ops.Nc, lo, hi, y_cur, j))
             elif step + 1 > ev[j, 5]:    # the second state off: no force can trail further
                 write_event(events, counters, j, ev[j])
         active_prev[j] = a

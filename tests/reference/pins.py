@@ -159,9 +159,9 @@ def _reference_digests() -> dict:
     return {"api": api, "cli": cli}
 
 
-def all_runs(folder: Path, workers: int = 2) -> dict:
+def all_runs(folder: Path, runs: dict = RUNS, workers: int = 2) -> dict:
     with ThreadPoolExecutor(workers) as pool:
-        futures = {k: pool.submit(execute, k, a, folder) for k, a in RUNS.items()}
+        futures = {k: pool.submit(execute, k, a, folder) for k, a in runs.items()}
         return {k: f.result() for k, f in futures.items()}
 
 

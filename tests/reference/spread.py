@@ -2,7 +2,11 @@
 run's tolerances (tolerances.json; docs/tests.md says how they were measured).
 
     python tests/reference/spread.py save DIR              # every reference run, here
+    python tests/reference/spread.py save DIR RUN [...]    # these pinned commands only
     python tests/reference/spread.py tolerances DIR [...]  # each DIR against the stored
+
+``tolerances`` measures the runs the folders hold and keeps the table's other entries (a
+command added since, measured alone, joins the table).
 
 A second sample on the same machine: another x86-64 target for numba, OpenBLAS and numpy
 (and a cache of numba's own for it):
@@ -30,12 +34,17 @@ from compare import TOLERANCES, second_impact, spread, tolerance  # noqa: E402
 FILES = {"api": "reference.npz", "cli": "reference_cli.npz", "commands": "values.npz"}
 
 
-def save(folder: Path) -> None:
+def save(folder: Path, only: list[str]) -> None:
     from make_cli import COMMANDS, outputs
-    from pins import all_runs, values_of
+    from pins import RUNS, all_runs, values_of
     from scenes import runs
     from skfem_beam import scenes
     folder.mkdir(parents=True, exist_ok=True)
+    if only:
+        with tempfile.TemporaryDirectory() as tmp:
+            outs = all_runs(Path(tmp), {k: RUNS[k] for k in only})
+            np.savez_compressed(folder / FILES["commands"], **values_of(outs))
+        return
     data = {f"{name}/{k}": np.asarray(v) for name, make in runs(scenes).items()
             for k, v in make().items()}
     np.savez_compressed(folder / FILES["api"], **data)
@@ -93,9 +102,9 @@ def measure(folders: list[Path]) -> dict:
     measured = {}
     for group, file in FILES.items():
         ref = runs_of(HERE / file)
-        for folder in folders:
+        for folder in [f for f in folders if (f / file).exists()]:
             got = runs_of(folder / file)
-            for name in ref:
+            for name in set(ref) & set(got):
                 s, key = run_spread(got[name], ref[name]), f"{group}/{name}"
                 old = measured.get(key, {"before": 0.0, "after": 0.0})
                 measured[key] = {w: max(old[w], s[w]) for w in s}
@@ -103,20 +112,22 @@ def measure(folders: list[Path]) -> dict:
 
 
 def write_tolerances(folders: list[Path]) -> None:
-    measured = measure(folders)
+    old = json.loads(TOLERANCES.read_text()) if TOLERANCES.exists() else {}
+    new = measure(folders)
+    measured = {**old.get("measured", {}), **new}
     tol = {k: {w: tolerance(v, w) for w, v in m.items()} for k, m in measured.items()}
-    for k in sorted(measured):
+    for k in sorted(new):
         m, t = measured[k], tol[k]
         print(f"{k:40s} before {m['before']:.2e} -> {t['before']:.1e}   "
               f"after {m['after']:.2e} -> {t['after']:.1e}")
-    TOLERANCES.write_text(json.dumps({"samples": [f.name for f in folders],
-                                      "measured": measured, "tolerance": tol},
-                                     indent=1, sort_keys=True) + "\n")
+    samples = sorted({*old.get("samples", ()), *(f.name for f in folders)})
+    TOLERANCES.write_text(json.dumps({"samples": samples, "measured": measured,
+                                      "tolerance": tol}, indent=1, sort_keys=True) + "\n")
 
 
 if __name__ == "__main__":
     if sys.argv[1:2] == ["save"]:
-        save(Path(sys.argv[2]))
+        save(Path(sys.argv[2]), sys.argv[3:])
     elif sys.argv[1:2] == ["tolerances"]:
         write_tolerances([Path(a) for a in sys.argv[2:]])
     else:

@@ -11,8 +11,8 @@ from .problem import (Beam, BeamProblem, Damping, InitialState, Load, Material, 
 from .results import SavedRun, read_run
 from .scheme import Result, Stepping, solve
 from .semidiscrete import SemiDiscrete, beam_system
+from ._version import __version__
 
-__version__ = "0.1.0"
 __all__ = ["Beam", "BeamProblem", "Damping", "InitialState", "InputError", "Load",
            "Material", "Modes", "Obstacles", "Result", "SavedRun", "Section", "SemiDiscrete",
            "SolverError", "Stepping", "Support", "beam_system", "modes", "read_run", "solve"]

@@ -37,7 +37,7 @@ COMMANDS = {
     "run": Command("SCENE.toml [--out DIR] [--set KEY=VALUE ...]", "run the scene a TOML file describes", "skfem_beam.scenefile:run_main"),
     "modes": Command("SCENE.toml [--n 6] [--out DIR]", "natural frequencies and mode shapes of its beam", "skfem_beam.scenefile:modes_main"),
 }
-EXIT_INPUT = 2     # as skfem_beam.cli (not imported here: the listing stays instant)
+EXIT_INPUT = 2     # as skfem_beam.errors (not imported here: the listing stays instant)
 
 
 def _first_line(module: str) -> str:

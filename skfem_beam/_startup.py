@@ -39,8 +39,10 @@ def exit_on_signals() -> None:
             signal.signal(sig, _leave)
 
 
-# the commands that draw charts: their chart process starts with them (chart_process)
+# the commands that draw charts: their chart process starts with them (chart_process) and
+# loads the output's chart functions meanwhile
 CHARTING = ("skfem_beam.cases.", "skfem_beam run")
+CHART_MODULES = ("skfem_beam.output.charts",)
 
 
 def command_starting() -> None:
@@ -59,7 +61,7 @@ def command_starting() -> None:
     command = " ".join(argv[i + 1:i + 3]) if i >= 0 else ""
     if command.startswith(CHARTING):
         from . import chart_process
-        chart_process.start()
+        chart_process.start(CHART_MODULES)
 
 
 def _ending(signum, frame):

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import atexit
 import collections
+import importlib
 import os
 import pickle
 import queue
@@ -41,18 +42,21 @@ import subprocess
 import sys
 import threading
 
-# The chart process loads the chart functions (output/charts.py: numpy and matplotlib) and
-# nothing else of the package: the packages' __init__ would import numba, scipy and
-# scikit-fem (~100 MB and 0.5 s it has no use for).  They are entered in sys.modules as
-# bare modules with their folder, so that importing a submodule does not run them.
+# The chart process loads matplotlib and the modules its caller names (a command's chart
+# functions, _startup.CHART_MODULES: numpy and matplotlib) and nothing else of the package:
+# the packages' __init__ would import numba, scipy and scikit-fem (~100 MB and 0.5 s it has
+# no use for).  They are entered in sys.modules as bare modules with their folder, so that
+# importing a submodule does not run them.  Its arguments: the command's pid, the modules
+# to load (comma-separated), then name=folder per package.
 _SERVE = """
 import sys, types
-for name, path in (("skfem_beam", sys.argv[2]), ("skfem_beam.output", sys.argv[3])):
+for entry in sys.argv[3:]:
+    name, _, path = entry.partition("=")
     package = types.ModuleType(name)
     package.__path__ = [path]
     sys.modules[name] = package
 from skfem_beam.chart_process import serve
-serve(int(sys.argv[1]))
+serve(int(sys.argv[1]), [m for m in sys.argv[2].split(",") if m])
 """
 _HERE = os.path.dirname(os.path.abspath(__file__))
 _process: subprocess.Popen | None = None
@@ -66,14 +70,26 @@ JOB_LENGTH = "<Q"          # each job on the pipe: its length in bytes, then the
 ONE_THREAD = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
 
 
-def start() -> None:
-    """Start the chart process (once; nothing when it cannot be started)."""
+def _packages(modules) -> list[str]:
+    """name=folder of this package and of every package above ``modules``, outermost
+    first."""
+    top = __name__.rpartition(".")[0]
+    names = {top} | {".".join(m.split(".")[:i]) for m in modules
+                     for i in range(2, len(m.split(".")))}
+    return [f"{name}={os.path.join(_HERE, *name.split('.')[1:])}" for name in sorted(names)]
+
+
+def start(preload=()) -> None:
+    """Start the chart process (once; nothing when it cannot be started).  ``preload``:
+    the modules of this package it imports while it waits for its first chart (the chart
+    functions its caller will send, ``_startup.CHART_MODULES``)."""
     global _process, _outbox
     if _process is not None:
         return
     try:
         _process = subprocess.Popen(
-            [sys.executable, "-c", _SERVE, str(os.getpid()), _HERE, os.path.join(_HERE, "output")],
+            [sys.executable, "-c", _SERVE, str(os.getpid()), ",".join(preload),
+             *_packages(preload)],
             stdin=subprocess.PIPE, stdout=subprocess.PIPE, start_new_session=True,
             env={**os.environ, **ONE_THREAD})
     except OSError:
@@ -165,10 +181,11 @@ def stop() -> None:
         _process.wait()
 
 
-def serve(parent: int) -> None:
-    """The chart process: draw the charts that arrive on stdin, each in a child of its own
-    (at most one per core at a time), and send one report per chart, in the order they
-    came, on the pipe that was stdout (None, or the chart's exception), until stdin ends."""
+def serve(parent: int, preload=()) -> None:
+    """The chart process: import ``preload``, then draw the charts that arrive on stdin,
+    each in a child of its own (at most one per core at a time), and send one report per
+    chart, in the order they came, on the pipe that was stdout (None, or the chart's
+    exception), until stdin ends."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     _die_with(parent)
     # below the command: on a first run it compiles its kernels on every core it has
@@ -176,7 +193,8 @@ def serve(parent: int) -> None:
     report = os.fdopen(os.dup(1), "wb")
     os.dup2(2, 1)                       # print() and warnings go to the command's stderr
     import matplotlib.pyplot  # noqa: F401  (what every chart needs, loaded while waiting)
-    import skfem_beam.output.charts  # noqa: F401
+    for module in preload:              # the chart functions the command will send
+        importlib.import_module(module)
     from .aside import cores            # the standard library only, as here
     most = cores()                      # charts drawn at once
     # a child per chart where forking is safe: Linux, and this process has one thread

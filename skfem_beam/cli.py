@@ -11,7 +11,8 @@ import sys
 import threading
 from pathlib import Path
 
-from . import __version__, _startup
+from . import _startup
+from ._version import __version__
 from . import methods
 from .contact import SOLVERS
 from .checks import check_choice, check_positive
@@ -22,17 +23,9 @@ from .output.options import OutputOptions
 from .output.folder import lock_folder
 from .output.series import (_resume_folder, check_resumable, has_checkpoint,
                             read_checkpoint, read_summary)
+from .parser import Parser
 from .scheme.stepping import MASSLESS, Stepping
 from .spec import RunSpec
-
-
-class Parser(argparse.ArgumentParser):
-    """argparse, but a bad flag gives one line on stderr, not a usage block."""
-
-    def error(self, message):
-        self.exit(EXIT_INPUT, f"{self.prog}: error: {message}\n")
-
-
 
 
 def parser(prog: str, description: str, *, J=None, dt=None, T=None, beta=None,

@@ -1,5 +1,10 @@
-"""The project's own error types: every bad input or failed run ends in one of them."""
+"""The project's own error types: every bad input or failed run ends in one of them,
+and the exit code a command ends with for each."""
 import signal
+
+# a command's exit codes: 0 success, 2 bad input (InputError), 3 a solver failed
+# (SolverError), 4 the run went unstable (its files up to the last good step written)
+EXIT_INPUT, EXIT_SOLVER, EXIT_UNSTABLE = 2, 3, 4
 
 
 class InputError(ValueError):

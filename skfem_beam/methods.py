@@ -11,116 +11,26 @@ pairs a one-step integrator with a non-smooth law.
   velocity level (a Newton impact law), what Siconos and LMGC90 users run.
 
 Each owns its default β (the papers: 1/2 for exact contact, 1/4 for springs), its checks,
-its units and how it builds its run (``method.build(system, stepping)``).  The command
-line and the scene file name a method by the words of :func:`make` (``law``,
+its units and how it builds its run (``method.build(system, stepping)``); they live with
+the integrators they build (:mod:`skfem_beam.scheme.methods`) and are importable from here.
+The command line and the scene file name a method by the words of :func:`make` (``law``,
 ``solver``, ``restitution``, ``stiffness``, ``massless``); this module is the only place
 those words are dispatched.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
-from typing import ClassVar, Union
+from dataclasses import dataclass
 
-from .checks import check_choice, check_nonnegative, check_positive, check_restitution
-from .contact import SOLVERS, ContactLaw, resolve
-from .contact.penalty import Penalty as PenaltyLaw
-from .contact.restitution import Restitution
+from .checks import check_choice, check_restitution
+from .contact import SOLVERS, resolve
 from .errors import InputError
-from .scheme.moreau_jean import NAME as MOREAU_JEAN
+from .scheme.methods import (Method, MoreauJean, Penalty, PositionLevel, mass_scale,  # noqa: F401
+                             of)
+from .scheme.moreau_jean import NAME as MOREAU_JEAN, check_theta
 from .scheme.stepping import MASSLESS
 
 LAWS = ("position", MOREAU_JEAN, "penalty")   # the classes by name
 BAR_BETA = 0.25     # the bar's scheme (7.3) of the third paper: β = 1/4 whatever the law
-
-
-def mass_scale(system) -> float:
-    """What the semi-discrete equation is divided by: ρA (kg/m) for a beam whose mass per
-    length is known (its equation is mass-normalised, docs/design.md §1), else 1 (a bar's
-    matrices carry ρ or ρA themselves)."""
-    view = system.view
-    if view is not None and view.kind == "beam" and view.rho_S:
-        return view.rho_S
-    return 1.0
-
-
-@dataclass(frozen=True)
-class PositionLevel:
-    """The β-scheme with exact contact at position level; ``massless``: how the massless
-    rows of a redistributed mass step ("beta" or "quasi-static", see Stepping)."""
-    solver: Union[str, ContactLaw] = "auto"
-    restitution: float = 0.0
-    massless: str = "beta"
-    name: ClassVar[str] = "position"
-    default_beta: ClassVar[float] = 0.5
-    theta: ClassVar[None] = None
-
-    def __post_init__(self):
-        object.__setattr__(self, "restitution", check_restitution(self.restitution))
-        check_choice("massless", self.massless, MASSLESS)
-        self.law(None)      # the solver's name and its combination with restitution
-
-    def law(self, system) -> ContactLaw:
-        return resolve(self.solver, None, self.restitution)
-
-    def build(self, system, stepping):
-        from .scheme import Run
-        return Run(system, replace(stepping, massless=self.massless), self.law(system))
-
-
-@dataclass(frozen=True)
-class Penalty:
-    """The β-scheme with one-sided springs of ``stiffness`` at the obstacles: N/m for a
-    beam whose mass per length is known and for a bar with a cross-section, Pa/m for a bar
-    per unit cross-section; ``equation_units``: the number is already in the units of the
-    semi-discrete equation (per unit mass for a beam), as ``solve(stiffness=)`` takes it.
-    ``damping``: a dashpot beside each spring (Kelvin–Voigt, N·s/m in the same units as
-    ``stiffness``), the supports' own damping; ``implicit``: the whole spring force at
-    t_{n+1} (contact.penalty: the regularisation whose limit is the exact step)."""
-    stiffness: float
-    equation_units: bool = False
-    massless: str = "beta"
-    damping: float = 0.0
-    implicit: bool = False
-    name: ClassVar[str] = "penalty"
-    default_beta: ClassVar[float] = 0.25
-    theta: ClassVar[None] = None
-
-    def __post_init__(self):
-        object.__setattr__(self, "stiffness", check_positive("stiffness", self.stiffness))
-        object.__setattr__(self, "damping", check_nonnegative("damping", self.damping))
-        check_choice("massless", self.massless, MASSLESS)
-
-    def law(self, system) -> ContactLaw:
-        scale = 1.0 if self.equation_units or system is None else mass_scale(system)
-        return PenaltyLaw(self.stiffness / scale, self.damping / scale,  # the one conversion
-                          self.implicit)
-
-    def build(self, system, stepping):
-        from .scheme import Run     # the quasi-static massless rows refuse springs there
-        return Run(system, replace(stepping, massless=self.massless), self.law(system))
-
-
-@dataclass(frozen=True)
-class MoreauJean:
-    """Moreau–Jean: θ ∈ [1/2, 1], Newton restitution e ∈ [0, 1] (see
-    :mod:`skfem_beam.scheme.moreau_jean`); the Stepping's β is not used."""
-    theta: float = 0.5
-    restitution: float = 0.0
-    name: ClassVar[str] = MOREAU_JEAN
-    default_beta: ClassVar[float] = 0.5
-    massless: ClassVar[str] = "beta"
-
-    def __post_init__(self):
-        from .scheme.moreau_jean import check_theta    # θ's range is the θ-scheme's
-        object.__setattr__(self, "theta", check_theta(self.theta))
-        object.__setattr__(self, "restitution", check_restitution(self.restitution))
-
-    def build(self, system, stepping):
-        from .scheme.moreau_jean import MoreauJean as MoreauJeanRun
-        return MoreauJeanRun(system, stepping, self.theta, self.restitution)
-
-
-Method = Union[PositionLevel, Penalty, MoreauJean]
 
 
 @dataclass(frozen=True)
@@ -161,7 +71,6 @@ def make(law: str = "position", solver: str = "auto", restitution: float = 0.0,
         if massless is not None:
             raise InputError(f"{words.massless}{massless} applies to the β-scheme "
                              f"({words.law}position); {words.law}{law} does not take it")
-        from .scheme.moreau_jean import check_theta
         return MoreauJean(0.5 if theta is None else check_theta(theta, words.theta), e)
     if law == "penalty":     # the registry's checks: no solver, no restitution with springs
         resolve("penalty" if solver == "auto" else solver, stiffness, e)
@@ -186,21 +95,6 @@ def default_beta(method: Method, kind: str = "beam") -> float:
     """β when none is given: the bar's scheme takes 1/4 (the third paper), a beam the
     method's own (1/2 exact contact, 1/4 springs: the first two papers)."""
     return BAR_BETA if kind == "bar" else method.default_beta
-
-
-def of(method: Method | str | None, stiffness: float | None = None,
-       restitution: float = 0.0) -> Method:
-    """A method from :func:`skfem_beam.scheme.solve`'s arguments: a method object, or a
-    position-level solver's name / law object with ``stiffness`` (equation units) and
-    ``restitution`` as ``contact.resolve`` takes them."""
-    if isinstance(method, (PositionLevel, Penalty, MoreauJean)):
-        return method
-    law = resolve("auto" if method is None else method, stiffness, restitution)
-    if isinstance(law, PenaltyLaw):
-        return Penalty(law.stiffness, equation_units=True)
-    if isinstance(law, Restitution):
-        return PositionLevel("auto", law.e)
-    return PositionLevel(law if isinstance(method, ContactLaw) else (method or "auto"))
 
 
 __all__ = ["LAWS", "Method", "MoreauJean", "Penalty", "PositionLevel", "Words", "check_massless",

@@ -28,10 +28,18 @@ from skfem.refdom import RefLine
 
 from .errors import InputError
 from .problem import BeamProblem
-from .semidiscrete import beam_space
-from .spaces import has_rigid_motion  # noqa: F401  (kept importable from here)
+from .spaces import has_rigid_motion, make_space
 
 DENSE_MAX = 400   # up to this many dofs a dense solve is fast and needs no iteration
+
+
+def beam_space(problem: BeamProblem):
+    """The space of ``problem`` (weighted per element when the beam is stepped)."""
+    weights = None
+    if problem.beam.segments:
+        x = problem.nodes
+        weights = problem.beam.factors(0.5 * (x[:-1] + x[1:]))
+    return make_space(problem.element, problem.nodes, problem.ends, problem.supports, weights)
 
 
 @dataclass(frozen=True)

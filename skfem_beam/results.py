@@ -37,6 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import InputError
+from .parser import Parser
 
 SERIES, SUMMARY, IMPACTS = "timeseries.csv", "summary.json", "impacts.csv"
 FORMATS = ("npz", "mat")
@@ -329,7 +330,6 @@ def export(folder, to: str, out=None) -> Path:
 
 def export_main(argv=None) -> int:
     """``python -m skfem_beam export DIR --to npz|mat [--out FILE]``."""
-    from .cli import Parser
     p = Parser(prog="python -m skfem_beam export",
                description="write a run folder's results as one .npz (numpy) or .mat "
                            "(MATLAB) file")

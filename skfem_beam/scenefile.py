@@ -862,7 +862,7 @@ def _bar(data: dict, reader: _Reader) -> Bar:
 # ---------------------------------------------------------------- commands
 
 def _run_parser() -> argparse.ArgumentParser:
-    from .cli import Parser
+    from .parser import Parser
     p = Parser(prog="python -m skfem_beam run",
                description="Run the scene a TOML file describes (docs/scene_files.md).")
     p.add_argument("scene", nargs="?", default=None, help="the scene file (TOML)")
@@ -978,7 +978,7 @@ def _chart_stops(problem: BeamProblem) -> tuple:
 
 def modes_main(argv) -> int:
     """``python -m skfem_beam modes``: natural frequencies of the scene's beam."""
-    from .cli import Parser
+    from .parser import Parser
     from .modes import modes
     from .two_planes import plane_problems
     p = Parser(prog="python -m skfem_beam modes",

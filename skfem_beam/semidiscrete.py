@@ -1,14 +1,14 @@
-"""From a scene to the semi-discrete system the integrator steps:
+"""From a beam scene to the semi-discrete system the integrator steps:
 
     M ü + B u̇ + K u = Σ_k a_k(t) b_k + Cᵀλ,   lo ≤ C u ≤ hi   (λ: nodal contact forces)
 
-The same object serves the beam (Hermite or B-spline, B = 0) and the bar (P1, with
-Kelvin–Voigt damping), so there is one time scheme for all scenes.
+The same object (:class:`~skfem_beam.system.SemiDiscrete`, importable from here too)
+serves the beam (Hermite or B-spline, B = 0) and the bar (P1, with Kelvin–Voigt damping),
+so there is one time scheme for all scenes.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Callable
 
 import numpy as np
 import scipy.sparse as sp
@@ -16,110 +16,14 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .errors import InputError
+from .modes import beam_space, modes
 from .problem import BeamProblem, lifting, lifting_d, lifting_dd
-from .spaces import has_rigid_motion, make_space
+from .spaces import has_rigid_motion
 from .spaces.ends import fixed_dofs
 from .spaces.hermite import five_point_slope
+from .system import Lifting, SceneView, SemiDiscrete, snap
 from .timefunctions import Constant
-
-
-@dataclass(frozen=True)
-class Lifting:
-    """The lifting of a moving support: ũ = u + h(x)φ(t) (docs/design.md §1).
-
-    ``kind``: "paper" or "static"; ``h(x)``, ``h_d(x)``, ``h_dd(x)``: h, h', h'' at any
-    abscissae; ``motion``: the support (``phi``, ``phi_d``, ``phi_dd`` of t).
-    """
-    kind: str
-    h: Callable
-    h_d: Callable
-    h_dd: Callable
-    motion: Any
-
-
-@dataclass(frozen=True)
-class SceneView:
-    """What the output (fields, renders, charts) needs from the scene beyond the matrices.
-
-    ``kind``: "beam" or "bar"; ``L``: length; ``k2``: bending stiffness per unit mass
-    (beams, for the bending moment; None otherwise); ``support``: the moving support
-    (with ``phi(t)``, optionally ``phi_d(t)``) when the lifting is the first paper's h,
-    None otherwise; ``obstacles``: an object with ``bounds(x) -> (g1, g2)``, None when
-    the obstacles are the bounds of the constrained values alone.
-
-    Units (docs/design.md §1, Units): the beam's equation is divided by ``rho_S`` = ρA_ref
-    (kg/m; None when unknown), so forces × rho_S are in N (per length: N/m) and energies
-    × rho_S in J; ``EI`` = k2·rho_S (N·m², the first segment's for a stepped beam).
-    ``lift``: the lifting (:class:`Lifting`) when the support moves, whatever its kind;
-    the physical displacement is u + lift.h(x)·φ(t).  ``observed_x``: where the default
-    series (``tip_displacement``) observes the beam when its end at L is held (None:
-    x = L, the tip), see :func:`observed_node`.
-    """
-    kind: str = "beam"
-    L: float | None = None
-    k2: float | None = None
-    support: Any = None
-    obstacles: Any = None
-    rho_S: float | None = None
-    EI: float | None = None
-    lift: Lifting | None = None
-    observed_x: float | None = None     # the default observed point (None: the tip, x = L)
-    planes: int = 1                     # 2: coefficients [v; w] (two_planes)
-    direction: tuple = (1.0, 0.0)       # two planes: the support moves along it
-    k2_w: float | None = None           # two planes: the second plane's k2
-    holes: tuple = ()                   # two planes: the holes (holes.HoleAt)
-
-
-@dataclass
-class SemiDiscrete:
-    M: sp.csr_matrix
-    K: sp.csr_matrix
-    C: sp.csr_matrix                 # constrained values y = C u (only finite bounds)
-    lo: np.ndarray
-    hi: np.ndarray
-    x_contact: np.ndarray            # abscissae of the constrained values
-    loads: np.ndarray                # (n, K): b_k as load vectors (b_k, φ_i)
-    load_time: list[Callable]        # a_k(t), vectorised
-    u0: np.ndarray
-    v0: np.ndarray
-    observe: dict[str, np.ndarray]   # name -> row vector (e.g. tip displacement)
-    B: sp.csr_matrix | None = None   # damping
-    space: Any = None
-    sample_x: np.ndarray | None = None       # abscissae where penetration is measured
-    sample_E: sp.csr_matrix | None = None    # values there = sample_E @ u
-    sample_lo: np.ndarray | None = None
-    sample_hi: np.ndarray | None = None
-    meta: dict = field(default_factory=dict)
-    view: SceneView | None = None            # what the output needs (see SceneView)
-    # moving bounds (obstacles fixed to the ground or carried by a moving support, in the
-    # lifted variable): at time t the bounds are lo + bound_shift·φ(t), hi + bound_shift·φ(t)
-    # (and sample_lo/hi + sample_shift·φ(t)); φ = bound_motion, vectorised in t
-    bound_motion: Callable | None = None
-    bound_shift: np.ndarray | None = None    # (m,)
-    sample_shift: np.ndarray | None = None   # (samples,)
-    # two planes (two_planes): the round holes' row pairs (q, 2); per constrained row its
-    # node's values v, w (rows 2j, 2j+1 of row_nodes) and [cy, cz, sy, sz]: the centre of
-    # its hole at rest and how it moves per unit φ (None: one plane)
-    planes: int = 1
-    disks: np.ndarray | None = None
-    lands: np.ndarray | None = None          # per disk (lands, half width, angle): a
-    #                                          broached hole's; (0, 0, 0) round (None: all)
-    friction: np.ndarray | None = None       # Coulomb's μ per row (a round hole's first)
-    row_nodes: sp.csr_matrix | None = None
-    row_centres: np.ndarray | None = None
-
-    @property
-    def n(self) -> int:
-        return self.M.shape[0]
-
-
-def beam_space(problem: BeamProblem):
-    """The space of ``problem`` (weighted per element when the beam is stepped)."""
-    weights = None
-    if problem.beam.segments:
-        x = problem.nodes
-        weights = problem.beam.factors(0.5 * (x[:-1] + x[1:]))
-    return make_space(problem.element, problem.nodes, problem.ends, problem.supports, weights)
+from .two_planes import plane_problems, two_plane_system
 
 
 def static_lifting(space, at: float, k2: float) -> np.ndarray:
@@ -210,19 +114,13 @@ def _initial(problem: BeamProblem, space, lift: Lifting | None):
     return u0, v0
 
 
-def _snap(shift: np.ndarray) -> np.ndarray:
-    """Shifts within 1e-9 of 0 are 0: h is 1 or 0 there up to round-off (the paper's h(L)
-    is −5.6e-17 in floating point, the static h of a cantilever 1 ± 1e-11), and an exactly
-    zero shift keeps bounds at rest (the papers' runs unchanged)."""
-    return np.where(np.abs(shift) <= 1e-9, 0.0, shift)
-
-
 def beam_system(problem: BeamProblem, samples_per_element: int = 20) -> SemiDiscrete:
     """Discretise a beam scene (the papers' V_h, K_h of (8), loads with the lifting; two
     planes: :func:`skfem_beam.two_planes.two_plane_system`)."""
     if problem.planes == 2:
-        from .two_planes import two_plane_system
-        return two_plane_system(problem, samples_per_element)
+        pv, pw = plane_problems(problem)
+        return two_plane_system(problem, beam_system(pv, samples_per_element),
+                                beam_system(pw, samples_per_element))
     beam, sup = problem.beam, problem.support
     space = beam_space(problem)
     x_nodes = problem.nodes[space.value_nodes]     # where u is free (x_1..x_J when clamped)
@@ -244,7 +142,7 @@ def beam_system(problem: BeamProblem, samples_per_element: int = 20) -> SemiDisc
     motion = shift = s_shift = None
     if lift is not None:
         xs = sampler.x[keep]
-        shift, s_shift = (_snap(problem.obstacles.carried_at(x) - lift.h(x)) for x in (x_c, xs))
+        shift, s_shift = (snap(problem.obstacles.carried_at(x) - lift.h(x)) for x in (x_c, xs))
         if np.any(shift != 0) or np.any(s_shift != 0):
             motion = sup.phi
         else:
@@ -308,7 +206,6 @@ def observed_node(problem: BeamProblem, space) -> int | None:
     tip x = L, whose value is free."""
     if space.nodes.size - 1 in space.value_nodes:
         return None
-    from .modes import modes       # here: modes builds on this module's space
     values = np.abs(space.nodal @ modes(problem, 1).vectors[:, 0])
     return int(np.argmax(values))
 

@@ -24,6 +24,7 @@ import scipy.sparse as sp
 from .errors import InputError
 from .holes import land_excess
 from .problem import InitialState, Load, Obstacles, Support
+from .system import SemiDiscrete, snap
 from .timefunctions import Scaled
 
 
@@ -64,13 +65,12 @@ def plane_problems(problem):
     return pv, pw
 
 
-def two_plane_system(problem, samples_per_element: int = 20):
-    """The semi-discrete system of a ``planes = 2`` BeamProblem (module docstring)."""
-    from .semidiscrete import SemiDiscrete, _snap, beam_system
+def two_plane_system(problem, sv: SemiDiscrete, sw: SemiDiscrete) -> SemiDiscrete:
+    """The semi-discrete system of a ``planes = 2`` BeamProblem (module docstring) from the
+    systems ``sv``, ``sw`` of its two planes (:func:`plane_problems`, each discretised by
+    :func:`skfem_beam.semidiscrete.beam_system`, which calls this)."""
     sup = problem.support
     dy, dz = sup.direction
-    pv, pw = plane_problems(problem)
-    sv, sw = beam_system(pv, samples_per_element), beam_system(pw, samples_per_element)
     space, n = sv.space, sv.n
     lift = sv.view.lift or sw.view.lift
     phi = sup.phi if lift is not None else None
@@ -80,7 +80,7 @@ def two_plane_system(problem, samples_per_element: int = 20):
         return int(np.abs(nodes - x).argmin())
 
     def shift_at(x, carried):
-        return 0.0 if lift is None else float(_snap(np.array([float(carried)
+        return 0.0 if lift is None else float(snap(np.array([float(carried)
                                                               - lift.h(np.array([x]))[0]]))[0])
 
     # the first plane's flat obstacles: rows [C, 0]; their shifts were per dy·φ

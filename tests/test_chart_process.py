@@ -14,6 +14,7 @@ import pytest
 from PIL import Image
 
 from skfem_beam import chart_process
+from skfem_beam._startup import CHART_MODULES
 from skfem_beam.cases import flat_obstacles
 from skfem_beam.output.charts import trajectory_chart
 
@@ -41,7 +42,7 @@ def servers(parent: int) -> list[int]:
 @pytest.fixture
 def process():
     """A chart process for this test process, stopped after it."""
-    chart_process.start()
+    chart_process.start(CHART_MODULES)
     assert chart_process.running()
     yield chart_process
     chart_process.stop()

@@ -14,7 +14,7 @@ from skfem_beam.errors import InputError
 from skfem_beam.methods import MoreauJean, Penalty, PositionLevel
 from skfem_beam.scheme import Stepping, drive, solve
 from skfem_beam.scenefile import load
-from skfem_beam.scheme.moreau_jean import moreau_jean
+from skfem_beam.scheme.solve import moreau_jean
 from skfem_beam.semidiscrete import beam_system
 
 from test_motion import observe_constraints, span_problem

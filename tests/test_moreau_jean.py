@@ -9,7 +9,7 @@ import scipy.sparse as sp
 from skfem_beam import InputError, scenes
 from skfem_beam.bar import bar_system, l2_time
 from skfem_beam.reference import exact_of
-from skfem_beam.scheme.moreau_jean import moreau_jean
+from skfem_beam.scheme.solve import moreau_jean
 from skfem_beam.semidiscrete import SemiDiscrete
 
 

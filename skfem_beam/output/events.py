@@ -38,6 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from .folder import atomic_write, csv_rows
+from .supports import support_statistics, union_length, work_rate_units
 
 IMPACTS = "impacts.csv"
 COLUMNS = ("t_start", "t_end", "x", "bound", "velocity", "peak_force", "impulse",
@@ -70,21 +71,10 @@ def impact_table(events: dict, lo: np.ndarray, hi: np.ndarray, scale: float = 1.
     return {**table, "open": np.asarray(events["open"], dtype=int)}
 
 
-def _union_length(start: np.ndarray, end: np.ndarray) -> float:
-    """Total length of the union of the intervals [start, end)."""
-    total, reach = 0.0, -np.inf
-    for a, b in sorted(zip(start.tolist(), end.tolist())):
-        a = max(a, reach)
-        if b > a:
-            total += b - a
-            reach = b
-    return total
-
-
 def _stats(table: dict, rows: np.ndarray, duration: float) -> dict:
     start, end = table["t_start"][rows], table["t_end"][rows]
     return {"impacts": int(rows.size),
-            "contact_fraction": _union_length(start, end) / duration if duration > 0 else 0.0,
+            "contact_fraction": union_length(start, end) / duration if duration > 0 else 0.0,
             "max_impulse": float(np.abs(table["impulse"][rows]).max()),
             "max_peak_force": float(table["peak_force"][rows].max()),
             "max_violation": float(table["max_violation"][rows].max())}
@@ -167,7 +157,6 @@ def write_impacts(folder: Path, run, units: dict, scale: float = 1.0, sign: floa
                       "contact_fraction": "of the run's time"}
     if planes == 2:
         from ..scheme.beta import disk_rows
-        from .supports import support_statistics, work_rate_units
         stats["supports"] = support_statistics(table, run, scale, duration, last * run.dt,
                                                wear)
         stats["units"].update(work_rate_units(units["force"] == "N", wear))

@@ -26,10 +26,10 @@ from pathlib import Path
 import numpy as np
 import orjson
 
-from .. import __version__
-from ..errors import InputError, Interrupted, SolverError  # noqa: F401 (Interrupted: here too)
+from .._version import __version__
+from ..errors import (EXIT_INPUT, EXIT_SOLVER, EXIT_UNSTABLE,  # noqa: F401 (here too)
+                      InputError, Interrupted, SolverError)
 
-EXIT_INPUT, EXIT_SOLVER, EXIT_UNSTABLE = 2, 3, 4
 SUMMARY = "summary.json"
 LOCK = ".lock"          # flock'ed by the one process writing the folder
 RESERVE = ".reserve"    # a little disk kept back, freed to write the final summary

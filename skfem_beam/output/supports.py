@@ -101,13 +101,24 @@ def row_planes(pair, Nc) -> np.ndarray:
     return out
 
 
+def union_length(start: np.ndarray, end: np.ndarray) -> float:
+    """Total length of the union of the intervals [start, end) (a contact fraction's
+    time: per support here, per node and obstacle in output.events)."""
+    total, reach = 0.0, -np.inf
+    for a, b in sorted(zip(start.tolist(), end.tolist())):
+        a = max(a, reach)
+        if b > a:
+            total += b - a
+            reach = b
+    return total
+
+
 def support_statistics(table: dict, run, scale: float, duration: float, T: float,
                        wear: Wear | None = None) -> list[dict]:
     """Per node with a hole or flat obstacles: impacts, contact fraction (of ``duration``,
     as the run's own), the histogram of the impact angles (ANGLE_BINS bins over [−π, π])
     and the work rates over the run's time ``T`` (module docstring), forces times
     ``scale`` (ρS: W); with friction its work rate, with ``wear`` the support's wear."""
-    from .events import _union_length
     x_rows = np.asarray(run.system.x_contact, dtype=float)
     work = run.st.rowwork
     T = T if T > 0 else math.nan
@@ -120,7 +131,7 @@ def support_statistics(table: dict, run, scale: float, duration: float, T: float
         counts, _ = np.histogram(angles[np.isfinite(angles)], edges)
         entry = {
             "x": float(x), "impacts": int(ev.size),
-            "contact_fraction": _union_length(table["t_start"][ev], table["t_end"][ev])
+            "contact_fraction": union_length(table["t_start"][ev], table["t_end"][ev])
             / duration if ev.size and duration > 0 else 0.0,
             "impact_angle_histogram": {"edges_rad": edges.tolist(), "counts": counts.tolist()},
             "impact_work_rate": -scale * float(work[rows, 0].sum()) / T,

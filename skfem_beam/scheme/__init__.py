@@ -17,7 +17,9 @@ u^{n+1} = x_free + A⁻¹Cᵀμ.
 
 Modules: ``stepping`` (the time grid, the result), ``operators`` (A, its factor, W, D,
 the energy's matrix), ``kernels`` (the compiled loop on one state), ``run`` (start step
-with the chosen law, chunks, checkpoints), ``solve`` (the entry point).
+with the chosen law, chunks, checkpoints), ``moreau_jean`` (the velocity-level
+integrator), ``methods`` (an integrator and its law as one object: what a run steps
+with), ``solve`` (the entry point, on top of them all).
 """
 from .run import Run
 from .solve import drive, solve

@@ -55,7 +55,7 @@ from .kernels import (EVENT_COLUMNS, FAILED, FRICTION, IMPACT_FIELDS, ITERATIONS
                       track_impacts)
 from .operators import csr_arrays, load_norms, step_operators
 from .run import Run
-from .stepping import Result, Stepping
+from .stepping import Stepping
 
 MJOps = namedtuple("MJOps", [
     "dt", "theta", "e", "save_every", "frame_every",
@@ -373,15 +373,3 @@ class MoreauJean(Run):
                  restitution: float = 0.0):
         with Deferred():           # signals wait while the kernels compile or load
             self._drive(MoreauJeanScheme(system, stepping, theta, restitution))
-
-
-def moreau_jean(system, dt: float, T: float, theta: float = 0.5, restitution: float = 0.0,
-                save_every: int = 1, frames: int = 200, progress: bool | None = None) -> Result:
-    """Integrate ``system`` over [0, T] with Moreau–Jean (θ-scheme, Newton impact law
-    with coefficient ``restitution``): ``solve(..., method=methods.MoreauJean(theta,
-    restitution))``, whose :class:`Result` has ``theta`` and ``beta`` None."""
-    from .solve import solve
-    from ..methods import MoreauJean as Method
-    return solve(system, dt, T, method=Method(theta, restitution), save_every=save_every,
-                 frames=frames, progress=progress)
-

@@ -1,4 +1,5 @@
-"""The one entry point: ``solve(system, dt, T, beta)`` → :class:`Result`."""
+"""The one entry point: ``solve(system, dt, T, beta)`` → :class:`Result` (and
+``moreau_jean(system, dt, T, theta, restitution)``, the same with Moreau–Jean)."""
 from __future__ import annotations
 
 import math
@@ -6,6 +7,7 @@ import sys
 
 from ..contact import ContactLaw
 from ..errors import InputError, SolverError
+from .methods import MoreauJean, of
 from .run import Run
 from .stepping import Result, Stepping
 
@@ -32,12 +34,11 @@ def solve(system, dt: float, T: float, beta: float | None = None,
     or a value turns non-finite; what was computed up to the last good saved state is
     returned.
     """
-    from .. import methods      # here: methods builds its runs from this package
     if method is not None and (solver != "auto" or stiffness is not None):
         raise InputError("pass either method= or solver=/stiffness=, not both")
     if beta is None:     # the method's own; 1/2 for solver=/stiffness= (as they always were)
         beta = method.default_beta if method is not None else 0.5
-    method = methods.of(method if method is not None else solver, stiffness)
+    method = of(method if method is not None else solver, stiffness)
     stepping = Stepping(dt, T, beta, save_every, frames, load_window, growth_limit,
                         massless=method.massless)
     rows = stepping.steps // stepping.save_every + 1
@@ -50,6 +51,15 @@ def solve(system, dt: float, T: float, beta: float | None = None,
     run = method.build(system, stepping)
     drive(run, progress=progress)
     return run.result()
+
+
+def moreau_jean(system, dt: float, T: float, theta: float = 0.5, restitution: float = 0.0,
+                save_every: int = 1, frames: int = 200, progress: bool | None = None) -> Result:
+    """Integrate ``system`` over [0, T] with Moreau–Jean (θ-scheme, Newton impact law
+    with coefficient ``restitution``): ``solve(..., method=methods.MoreauJean(theta,
+    restitution))``, whose :class:`Result` has ``theta`` and ``beta`` None."""
+    return solve(system, dt, T, method=MoreauJean(theta, restitution), save_every=save_every,
+                 frames=frames, progress=progress)
 
 
 def drive(run: Run, chunk: int = 20000, progress: bool | None = None, on_chunk=None) -> None:

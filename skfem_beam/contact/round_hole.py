@@ -129,9 +129,11 @@ def land_project(a, b, d, za, zb, r, lands, half, angle, root, out):
 
 
 @njit(cache=True)
-def _piece_rows(D, act, k, i, a, b, pa, pb, r, mua, mub, code, lands, F, J):
+def _piece_rows(D, act, k, i, ab, offset, mu, code, lands, F, J):
     """Rows i, i+1 of the polish for a broached block on a line (e·p = r and μ ∥ e) or a
-    corner (p = q): both linear in μ.  Returns False for an arc (the disk's rows)."""
+    corner (p = q): both linear in μ.  ``ab``: the block's rows (a, b); ``offset``: its
+    (p_a, p_b, r); ``mu``: its (μ_a, μ_b).  Returns False for an arc (the disk's rows)."""
+    (a, b), (pa, pb, r), (mua, mub) = ab, offset, mu
     kind, x, y, _, _ = piece_of(code, r, lands[0], lands[1], lands[2])
     if kind == PIECE_LINE:
         F[i] = x * pa + y * pb - r
@@ -223,8 +225,9 @@ def _polish(D, yf, lo, hi, kind, lands, piece, mu, tol):
             else:
                 a, b = j, kind[j]
                 pa, pb, _, r = radial(y[a], y[b], lo[a], hi[a], lo[b], hi[b])
-                if piece[a] > 0 and _piece_rows(D, act, k, i, a, b, pa, pb, r, mu_new[a],
-                                                mu_new[b], piece[a], lands[a], F, J):
+                if piece[a] > 0 and _piece_rows(D, act, k, i, (a, b), (pa, pb, r),
+                                                (mu_new[a], mu_new[b]), piece[a], lands[a],
+                                                F, J):
                     i += 2
                     continue
                 F[i] = 0.5 * (pa * pa + pb * pb - r * r) / r

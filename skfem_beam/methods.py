@@ -1,21 +1,10 @@
-"""How a run steps in time: the integrator and its contact law as one object, as Siconos
-pairs a one-step integrator with a non-smooth law.
+"""The words that name a method, and the only place they are dispatched.
 
-- :class:`PositionLevel` ``(solver="auto", restitution=0.0, massless="beta")``: the
-  papers' contact-implicit β-scheme, exact contact at position level (the step's QP
-  solved by ``solver``: a name of ``contact.LAWS`` or a law object), with a Newton
-  coefficient of restitution e > 0 if asked (Paoli–Schatzman);
-- :class:`Penalty` ``(stiffness)``: the same β-scheme with the obstacles as one-sided
-  springs (normal compliance);
-- :class:`MoreauJean` ``(theta=0.5, restitution=0.0)``: the θ-scheme with contact at
-  velocity level (a Newton impact law), what Siconos and LMGC90 users run.
-
-Each owns its default β (the papers: 1/2 for exact contact, 1/4 for springs), its checks,
-its units and how it builds its run (``method.build(system, stepping)``); they live with
-the integrators they build (:mod:`skfem_beam.scheme.methods`) and are importable from here.
-The command line and the scene file name a method by the words of :func:`make` (``law``,
-``solver``, ``restitution``, ``stiffness``, ``massless``); this module is the only place
-those words are dispatched.
+The method classes (:class:`PositionLevel`, :class:`Penalty`, :class:`MoreauJean`: an
+integrator and its contact law as one object) live with the integrators they build, in
+:mod:`skfem_beam.scheme.methods`, and are importable from here.  The command line and the
+scene file name a method by the words of :func:`make` (``law``, ``solver``,
+``restitution``, ``stiffness``, ``massless``, ``theta``).
 """
 from __future__ import annotations
 

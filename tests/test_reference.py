@@ -12,22 +12,14 @@ from skfem_beam import scenes
 
 HERE = Path(__file__).parent / "reference"
 sys.path.insert(0, str(HERE))
-from compare import assert_close, decorrelated  # noqa: E402
+from compare import assert_run_close, decorrelated, runs_of  # noqa: E402
 from make_cli import COMMANDS, SUMMARY, outputs  # noqa: E402
 from pins import digest  # noqa: E402
 from scenes import runs  # noqa: E402
-from spread import compared, runs_of, time_and_second_impact  # noqa: E402
 
 REF = runs_of(HERE / "reference.npz")
 REF_CLI = runs_of(HERE / "reference_cli.npz")
 RUNS = runs(scenes)
-
-
-def assert_same_run(group, name, got, ref):
-    t, t2 = time_and_second_impact(ref)
-    np.testing.assert_array_equal(got["t"], ref["t"])
-    for key in compared(ref):
-        assert_close(f"{group}/{name}", key, got[key], ref[key], t, t2)
 
 
 @pytest.mark.parametrize("name", list(RUNS))
@@ -38,7 +30,7 @@ def test_api_outputs_are_pinned(name, machine_pins):
     if "stats" in got:           # steps, and impacts where the trajectories stay close
         counts = [4] if decorrelated(f"api/{name}") else [0, 4]
         assert got["stats"][counts].tolist() == REF[name]["stats"][counts].tolist()
-    assert_same_run("api", name, got, REF[name])
+    assert_run_close(f"api/{name}", got, REF[name])
 
 
 @pytest.mark.parametrize("name", list(COMMANDS))
@@ -54,4 +46,4 @@ def test_command_outputs_are_pinned(name, tmp_path, machine_pins):
     counts = 1 if decorrelated(f"cli/{name}") else 2
     assert got["summary"][:counts].tolist() == REF_CLI[name]["summary"][:counts].tolist(), \
         SUMMARY
-    assert_same_run("cli", name, got, REF_CLI[name])
+    assert_run_close(f"cli/{name}", got, REF_CLI[name])

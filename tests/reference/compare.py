@@ -74,6 +74,46 @@ def spread(got, ref, t, t2) -> dict:
     return {"before": float(before), "after": float(after)}
 
 
+def runs_of(path: Path) -> dict:
+    """run name -> {key: array}, from one of the stored .npz files."""
+    out = {}
+    with np.load(path) as data:
+        for k in data.files:
+            name, key = k.split("/", 1)
+            out.setdefault(name, {})[key] = data[k]
+    return out
+
+
+def time_and_second_impact(arrays: dict):
+    """A run's time column and the start of its second impact (from its impacts table,
+    or where its contact force switches on for the second time)."""
+    t = arrays["t"]
+    if "impacts_t_start" in arrays:
+        s = arrays["impacts_t_start"]
+        return t, float(s[1]) if len(s) > 1 else np.inf
+    return t, second_impact(t, arrays.get("contact_force", arrays.get("force")))
+
+
+ROUND_OFF = ("friction_residual",)   # a solver's residual is round-off itself: its bound
+#                                    is asserted where it is computed (tests/test_friction.py)
+
+
+def compared(arrays: dict) -> list:
+    """The keys of a run compared across machines: all but time, impact times and
+    round-off measures."""
+    return [k for k in arrays if k != "t" and not k.startswith("impacts_")
+            and k not in ROUND_OFF]
+
+
+def run_spread(got: dict, ref: dict) -> dict:
+    t, t2 = time_and_second_impact(ref)
+    worst = {"before": 0.0, "after": 0.0}
+    for key in compared(ref):
+        s = spread(got[key], ref[key], t, t2)
+        worst = {w: max(worst[w], s[w]) for w in worst}
+    return worst
+
+
 @cache
 def _table() -> dict:
     return json.loads(TOLERANCES.read_text())
@@ -92,3 +132,12 @@ def assert_close(run, key, got, ref, t, t2) -> None:
         f"{run}/{key}: differs by {s['before']:.3g} before the second impact (t = {t2:.6g}) " \
         f"and {s['after']:.3g} in its statistics after it (bounds {tol['before']:.3g}, " \
         f"{tol['after']:.3g}: tests/reference/tolerances.json)"
+
+
+def assert_run_close(run, got: dict, ref: dict) -> None:
+    """Every compared array of a run (``got``) is its stored one (``ref``) to the run's
+    tolerances, on the same time grid."""
+    t, t2 = time_and_second_impact(ref)
+    np.testing.assert_array_equal(got["t"], t)
+    for key in compared(ref):
+        assert_close(run, key, got[key], ref[key], t, t2)

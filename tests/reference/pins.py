@@ -179,11 +179,12 @@ def main(argv) -> int:
         print(line)
         if old is None:
             return 1
-        bad = [(part, k) for part in ("commands", "api", "cli") for k in old[part]
-               if old[part][k] != pins[part].get(k)]
+        parts = ("commands", "api", "cli")     # a run added or gone is a difference too
+        bad = [(part, k) for part in parts for k in sorted({*old[part], *pins[part]})
+               if old[part].get(k) != pins[part].get(k)]
         for part, k in bad:
-            print(f"{part}/{k}: {old[part][k]} != {pins[part].get(k)}")
-        total = sum(len(old[p]) for p in ("commands", "api", "cli"))
+            print(f"{part}/{k}: {old[part].get(k)} != {pins[part].get(k)}")
+        total = sum(len({*old[p], *pins[p]}) for p in parts)
         print(f"{total - len(bad)} of {total} pins equal")
         return 1 if bad else 0
     PIN_DIR.mkdir(exist_ok=True)

@@ -29,7 +29,7 @@ import numpy as np
 
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE))
-from compare import TOLERANCES, second_impact, spread, tolerance  # noqa: E402
+from compare import TOLERANCES, run_spread, runs_of, tolerance  # noqa: E402
 
 FILES = {"api": "reference.npz", "cli": "reference_cli.npz", "commands": "values.npz"}
 
@@ -55,46 +55,6 @@ def save(folder: Path, only: list[str]) -> None:
         np.savez_compressed(folder / FILES["cli"], **data)
     with tempfile.TemporaryDirectory() as tmp:      # its names are COMMANDS' too
         np.savez_compressed(folder / FILES["commands"], **values_of(all_runs(Path(tmp))))
-
-
-def runs_of(path: Path) -> dict:
-    """run name -> {key: array}, from one of FILES."""
-    out = {}
-    with np.load(path) as data:
-        for k in data.files:
-            name, key = k.split("/", 1)
-            out.setdefault(name, {})[key] = data[k]
-    return out
-
-
-def time_and_second_impact(arrays: dict):
-    """A run's time column and the start of its second impact (from its impacts table,
-    or where its contact force switches on for the second time)."""
-    t = arrays["t"]
-    if "impacts_t_start" in arrays:
-        s = arrays["impacts_t_start"]
-        return t, float(s[1]) if len(s) > 1 else np.inf
-    return t, second_impact(t, arrays.get("contact_force", arrays.get("force")))
-
-
-ROUND_OFF = ("friction_residual",)   # a solver's residual is round-off itself: its bound
-#                                    is asserted where it is computed (tests/test_friction.py)
-
-
-def compared(arrays: dict) -> list:
-    """The keys of a run compared across machines: all but time, impact times and
-    round-off measures."""
-    return [k for k in arrays if k != "t" and not k.startswith("impacts_")
-            and k not in ROUND_OFF]
-
-
-def run_spread(got: dict, ref: dict) -> dict:
-    t, t2 = time_and_second_impact(ref)
-    worst = {"before": 0.0, "after": 0.0}
-    for key in compared(ref):
-        s = spread(got[key], ref[key], t, t2)
-        worst = {w: max(worst[w], s[w]) for w in worst}
-    return worst
 
 
 def measure(folders: list[Path]) -> dict:

@@ -2,6 +2,10 @@
 
     python -m skfem_beam.bench.cold_compile [--repeat 3] [--job skfem_beam.cases.flat_obstacles]
                                             [--against OTHER_CHECKOUT/skfem_beam]
+    python -m skfem_beam.bench.cold_compile --scene NAME.toml [--scene ...] | --scenes
+
+``--scene`` measures ``python -m skfem_beam run NAME.toml`` instead of a job (a shipped
+scene by file name, or a path); ``--scenes`` every shipped scene file in turn, then a table.
 
 Each repeat copies the package's sources to a fresh temporary folder and byte-compiles them,
 as ``pip install`` does, so that no numba cache exists, and runs ``python -m JOB`` there
@@ -36,6 +40,7 @@ from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parents[1]
 COLD_TARGET = 6.0   # seconds: the main job's first run after an install, on 2 cores
+WARM_TARGET = 1.5   # seconds: its later runs
 
 
 def _listen() -> list:
@@ -71,15 +76,30 @@ def _listen() -> list:
     return records
 
 
-def _child(job: str, out: str, threshold: str) -> None:
-    """Runs ``python -m job --out out`` in this process with the compile listener, its
-    garbage collected at ``threshold`` (a command's: "n0,n1,n2")."""
-    import gc
+def _argv(job: str) -> list:
+    """The command's arguments after ``python``: ``-m job``, or ``-m skfem_beam run FILE``
+    for a scene file (a job ending in .toml)."""
+    return ["-m", "skfem_beam", "run", job] if job.endswith(".toml") else ["-m", job]
+
+
+def _main_of(job: str):
+    """The function ``python -m job`` (or ``skfem_beam run`` for a scene file) calls."""
     import importlib
+    if job.endswith(".toml"):
+        from skfem_beam.__main__ import COMMANDS
+        module, name = COMMANDS["run"].target.split(":")
+        return lambda argv: getattr(importlib.import_module(module), name)([job, *argv])
+    return importlib.import_module(job).main
+
+
+def _child(job: str, out: str, threshold: str) -> None:
+    """Runs the job (_argv) with ``--out out`` in this process with the compile listener,
+    its garbage collected at ``threshold`` (a command's: "n0,n1,n2")."""
+    import gc
     gc.set_threshold(*map(int, threshold.split(",")))
     records = _listen()
     t0 = time.process_time()
-    code = importlib.import_module(job).main(["--out", out, "--overwrite"])
+    code = _main_of(job)(["--out", out, "--overwrite"])
     cpu = time.process_time() - t0
     rows = []
     for i, (name, a, b, depth, args) in enumerate(records):
@@ -97,7 +117,7 @@ def _run(folder: Path, job: str, listen: bool, one_core: bool) -> tuple[float, f
     # calls main(), so it compiles at the level and collects garbage as a command does
     argv = ([sys.executable, str(Path(__file__).resolve()), "--child", job, str(out),
              ",".join(map(str, GC_THRESHOLD))]
-            if listen else [sys.executable, "-m", job, "--out", str(out), "--overwrite"])
+            if listen else [sys.executable, *_argv(job), "--out", str(out), "--overwrite"])
     before, t0 = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
     # one core: the run compiles its law itself (not aside), so every compile is listed
     pin = (lambda: os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})) if one_core else None
@@ -121,6 +141,14 @@ def _fresh(tmp: str, package: str) -> Path:
                     ignore=shutil.ignore_patterns("__pycache__"))
     compileall.compile_dir(Path(tmp) / "skfem_beam", quiet=1)
     return Path(tmp)
+
+
+def _listened(package: str, job: str, one_core: bool) -> None:
+    """The job cold in a listener run (_child), and its compile times per function."""
+    with tempfile.TemporaryDirectory() as tmp:
+        _, listened, info = _run(_fresh(tmp, package), job, True, one_core)
+    print(f"  listener run (it draws its charts itself): wall {listened:.2f} s")
+    _attribution(info)
 
 
 def _attribution(info: dict) -> None:
@@ -147,11 +175,42 @@ def _cold_then_warm(package: str, job: str, one_core: bool) -> tuple[float, floa
     met = "yes" if cold_wall <= COLD_TARGET else "NO"
     notice = "compiling numerical kernels"
     return cold_wall, warm_wall, (
-        f"python -m {job}: wall cold {cold_wall:.2f} s (≤ {COLD_TARGET:g} s: {met}), warm "
+        f"python {' '.join(_argv(job))}: wall cold {cold_wall:.2f} s (≤ {COLD_TARGET:g} s: {met}), warm "
         f"{warm_wall:.2f} s, compile {cold_wall - warm_wall:.2f} s; CPU cold {cold:.2f} s, warm "
         f"{warm:.2f} s; its loop {info['loop_s']:.4f} s (cold {cold_wall / info['loop_s']:.0f}×, "
         f"warm {warm_wall / again['loop_s']:.0f}× the loop); notice: cold "
         f"{info['stderr'].count(notice)}, warm {again['stderr'].count(notice)}")
+
+
+def _scene_path(name: str) -> str:
+    """A shipped scene by file name, or a path (absolute: the runs' folder is a temporary
+    one)."""
+    shipped = PACKAGE / "scene_files" / name
+    path = shipped if shipped.exists() and not Path(name).exists() else Path(name)
+    if not path.exists():
+        raise SystemExit(f"--scene {name}: no such file (shipped: "
+                         f"{', '.join(sorted(p.name for p in shipped.parent.glob('*.toml')))})")
+    return str(path.resolve())
+
+
+def _scenes(args, paths: list) -> int:
+    """Each scene cold then warm, ``--repeat`` times, then one row each: the medians."""
+    rows = []
+    for path in paths:
+        runs = []
+        for r in range(args.repeat):
+            runs.append(_cold_then_warm(args.package, path, args.one_core))
+            print(f"run {r + 1}: {runs[-1][2]}", flush=True)
+        if not args.no_attribute:
+            _listened(args.package, path, args.one_core)
+        rows.append((Path(path).name, statistics.median(c for c, _, _ in runs),
+                     statistics.median(w for _, w, _ in runs)))
+    print(f"\n{'scene file':34s} {'cold s':>7s} {'warm s':>7s}   (medians of {args.repeat}; "
+          f"targets: cold ≤ {COLD_TARGET:g} s, warm ≤ {WARM_TARGET:g} s)")
+    for name, cold, warm in rows:
+        print(f"{name:34s} {cold:7.2f} {warm:7.2f}   {'yes' if cold <= COLD_TARGET else 'NO':>3s}"
+              f" {'yes' if warm <= WARM_TARGET else 'NO':>3s}")
+    return 0
 
 
 def _env() -> dict:
@@ -163,6 +222,10 @@ def main(argv=None) -> int:
                                  description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--job", default="skfem_beam.cases.flat_obstacles")
+    ap.add_argument("--scene", action="append", default=[], metavar="FILE",
+                    help="a scene file (a shipped one by name) run by `python -m skfem_beam "
+                         "run`, instead of --job (repeatable)")
+    ap.add_argument("--scenes", action="store_true", help="every shipped scene file")
     ap.add_argument("--package", default=str(PACKAGE),
                     help="the skfem_beam folder to copy (another checkout, to compare)")
     ap.add_argument("--against", metavar="FOLDER",
@@ -178,6 +241,10 @@ def main(argv=None) -> int:
     if args.child:
         _child(*args.child)
         return 0
+    scenes = sorted(p.name for p in (PACKAGE / "scene_files").glob("*.toml")) \
+        if args.scenes else args.scene
+    if scenes:
+        return _scenes(args, [_scene_path(s) for s in scenes])
     packages = [args.package] + ([args.against] if args.against else [])
     walls = {p: [] for p in packages}
     for r in range(args.repeat):
@@ -186,11 +253,7 @@ def main(argv=None) -> int:
             label = f" ({package})" if args.against else ""
             print(f"run {r + 1}{label}: {walls[package][-1][2]}", flush=True)
         if not args.no_attribute:
-            with tempfile.TemporaryDirectory() as tmp:
-                _, listened, info = _run(_fresh(tmp, args.package), args.job, True,
-                                         args.one_core)
-            print(f"  listener run (it draws its charts itself): wall {listened:.2f} s")
-            _attribution(info)
+            _listened(args.package, args.job, args.one_core)
     if args.against:
         for package, runs in walls.items():
             print(f"{package}: median cold {statistics.median(r[0] for r in runs):.2f} s, warm "

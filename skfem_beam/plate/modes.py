@@ -1,0 +1,25 @@
+"""The lowest natural frequencies and mode shapes: K φ = ω² M φ on the free dofs."""
+import numpy as np
+from scipy.linalg import eigh
+from scipy.sparse.linalg import eigsh
+
+from .space import PlateSpace
+
+DENSE_UP_TO = 200   # free dofs below which a dense eigh is quicker than shift-invert
+
+
+def natural_frequencies(space: PlateSpace, n: int = 6) -> tuple[np.ndarray, np.ndarray]:
+    """The n lowest circular frequencies ω (rad/s), ascending, and their mode shapes
+    (all dofs, one column each, M-normalised)."""
+    free = space.free_dofs
+    K = space.K[free][:, free]
+    M = space.M[free][:, free]
+    if len(free) <= DENSE_UP_TO:
+        omega2, phi = eigh(K.toarray(), M.toarray(), subset_by_index=[0, n - 1])
+    else:
+        # shift-invert about 0 finds the eigenvalues nearest 0: the lowest ones
+        omega2, phi = eigsh(K.tocsc(), k=n, M=M.tocsc(), sigma=0.0, which="LM")
+    order = np.argsort(omega2)
+    shapes = np.zeros((space.basis.N, n))
+    shapes[free] = phi[:, order]
+    return np.sqrt(np.abs(omega2[order])), shapes

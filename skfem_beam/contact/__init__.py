@@ -17,10 +17,11 @@ and then x = x_free + W μ; μ/Δt² are the nodal contact forces.  Laws (regist
 - ``restitution``: exact contact with a Newton coefficient of restitution e (Paoli–Schatzman).
 - ``auto``: the cheapest exact one for the scene.
 
-The protocol a law follows (and how to write one) is in :mod:`.base`.
+The protocol a law follows (and how to write one) is in :mod:`.base`; ``register(name,
+law)`` makes a law of one's own a solver of every front end.
 """
 from .base import LAW_SIGNATURE, ContactLaw, StepData, compiled_law
-from .registry import LAWS, SOLVERS, resolve
+from .registry import LAWS, SOLVERS, register, resolve
 
 __all__ = ["LAW_SIGNATURE", "LAWS", "SOLVERS", "ContactLaw", "StepData", "compiled_law",
-           "resolve"]
+           "register", "resolve"]

@@ -1,4 +1,6 @@
-"""The contact laws by name: one line per law."""
+"""The contact laws by name: one line per law, and :func:`register` for a law of the
+user's (then named by ``--solver``, a scene file's ``[contact] law`` and
+``PositionLevel(solver=)`` like the shipped ones, with no edit of the front end)."""
 from __future__ import annotations
 
 from ..errors import InputError
@@ -20,7 +22,40 @@ LAWS = {
     "restitution": Restitution,   # needs restitution= (e)
     "round-hole": RoundHole,      # round holes (and boxes beside them), exact
 }
-SOLVERS = ("auto", *LAWS)
+
+
+class _Names:
+    """The solvers' names as LAWS holds them now ("auto" first): a registered law joins
+    every list and check that holds this object, wherever it was imported."""
+
+    def __iter__(self):
+        return iter(("auto", *LAWS))
+
+    def __contains__(self, name) -> bool:
+        return name == "auto" or name in LAWS
+
+    def __len__(self) -> int:
+        return 1 + len(LAWS)
+
+    def __repr__(self) -> str:
+        return repr(tuple(self))
+
+
+SOLVERS = _Names()
+
+
+def register(name: str, law) -> None:
+    """Adds the position-level law ``law`` (a :class:`ContactLaw` subclass, or any callable
+    of no arguments returning a law, e.g. ``functools.partial(MyLaw, gain=0.5)`` for a
+    law with parameters) under ``name``: from then on it is a solver like the shipped
+    ones.  A name already taken is refused."""
+    if not isinstance(name, str) or not name or name in SOLVERS:
+        raise InputError(f"register({name!r}): a new, non-empty name is needed (taken: "
+                         f"{', '.join(SOLVERS)})")
+    if not callable(law):
+        raise InputError(f"register({name!r}, {law!r}): a ContactLaw subclass or a callable "
+                         f"returning a law is needed")
+    LAWS[name] = law
 
 
 def resolve(law: str | ContactLaw = "auto", stiffness: float | None = None,
@@ -50,7 +85,11 @@ def resolve(law: str | ContactLaw = "auto", stiffness: float | None = None,
         raise InputError("solver='restitution' needs restitution= (the coefficient e)")
     if law not in LAWS:
         raise InputError(f"solver={law!r} is not one of: {', '.join(SOLVERS)}")
-    return LAWS[law]()
+    made = LAWS[law]()
+    if not isinstance(made, ContactLaw):
+        raise InputError(f"solver={law!r}: its registered maker returned {made!r}, not a "
+                         f"ContactLaw")
+    return made
 
 
 class Auto(ContactLaw):

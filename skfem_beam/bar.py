@@ -261,7 +261,7 @@ def bar_system(bar: Bar) -> SemiDiscrete:
     the obstacle: u(0) ≥ 0 or u(L) ≤ 0.
 
     The constraint row is there for both obstacles: the rigid one enforces it, the
-    elastic one is a spring on the same value (``solve(…, stiffness=bar.k)``).
+    elastic one is a spring on the same value (``Penalty(bar.k)``).
     """
     left = bar.obstacle_at == "left"
     fixed = () if bar.far_end == "free" else ((bar.N,) if left else (0,))

@@ -13,8 +13,7 @@ from dataclasses import dataclass
 from .checks import check_choice, check_restitution
 from .contact import SOLVERS, resolve
 from .errors import InputError
-from .scheme.methods import (Method, MoreauJean, Penalty, PositionLevel, mass_scale,  # noqa: F401
-                             of)
+from .scheme.methods import Method, MoreauJean, Penalty, PositionLevel, mass_scale  # noqa: F401
 from .scheme.moreau_jean import NAME as MOREAU_JEAN, check_theta
 from .scheme.stepping import MASSLESS
 
@@ -87,4 +86,4 @@ def default_beta(method: Method, kind: str = "beam") -> float:
 
 
 __all__ = ["LAWS", "Method", "MoreauJean", "Penalty", "PositionLevel", "Words", "check_massless",
-           "default_beta", "make", "mass_scale", "of"]
+           "default_beta", "make", "mass_scale"]

@@ -37,10 +37,11 @@ def test_cold_then_warm_run_same_files_one_notice(tmp_path):
 
 CALLEES_CHILD = """
 from skfem_beam import aside, beam_system, scenes, solve
+from skfem_beam.methods import PositionLevel
 from skfem_beam.scheme.kernels import CALLEES
 child = aside.start(CALLEES)
 assert child is not None and child.wait() == 0, "the child failed"
-solve(beam_system(scenes.flat_obstacles(J=8)), dt=1e-3, T=0.05, solver="active-set")
+solve(beam_system(scenes.flat_obstacles(J=8)), dt=1e-3, T=0.05, method=PositionLevel("active-set"))
 for f, sig in CALLEES:   # loaded from the child's cache entry, compiled for no other types
     print(f.py_func.__name__, sum(f.stats.cache_hits.values()),
           sum(f.stats.cache_misses.values()), len(f.signatures))

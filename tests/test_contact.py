@@ -16,6 +16,7 @@ from skfem_beam.contact.active_set import box_qp
 from skfem_beam.contact.daqp_solver import DAQPSolver
 from skfem_beam.contact.osqp_solver import OSQPSolver
 from skfem_beam.contact.projection import project
+from skfem_beam.methods import PositionLevel
 
 
 # ---------------------------------------------------------------- random step problems
@@ -317,7 +318,7 @@ def test_python_engines_are_called_only_on_steps_in_contact(solver):
     system = beam_system(scenes.flat_obstacles(J=40))
     runs = {}
     for name in (solver, "active-set"):
-        runs[name] = methods.of(name).build(system, Stepping(1e-3, 0.3, 0.5, frames=300))
+        runs[name] = methods.PositionLevel(name).build(system, Stepping(1e-3, 0.3, 0.5, frames=300))
     engine, calls = runs[solver].pysolver, []
     engine_solve = engine.solve
     engine.solve = lambda *a: calls.append(1) or engine_solve(*a)
@@ -356,7 +357,7 @@ def test_a_python_law_with_a_force_inside_its_bounds_is_called_every_step():
 def test_all_solvers_give_the_same_run(element):
     """200 steps of the convex-obstacle scene: every solver, every step, to 1e-8."""
     sysm = beam_system(scenes.convex_obstacles(J=40, element=element))
-    runs = {s: solve(sysm, dt=1e-3, T=0.2, beta=0.5, solver=s, frames=200)
+    runs = {s: solve(sysm, dt=1e-3, T=0.2, beta=0.5, method=PositionLevel(s), frames=200)
             for s in ["active-set", "osqp", "daqp"]}
     ref = runs["active-set"]
     assert ref.frames_u.shape[0] == 201 and ref.impacts > 0

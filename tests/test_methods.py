@@ -38,12 +38,12 @@ def test_defaults_and_checks():
 
 
 def test_penalty_stiffness_in_newtons_is_converted_once():
-    """Penalty(k N/m) on the papers' pipe (ρS known) is the law solve(stiffness=k/ρS)
+    """Penalty(k N/m) on the papers' pipe (ρS known) is the law Penalty(k/ρS, equation_units=True)
     gives, bit for bit."""
     system = beam_system(scenes.point_stops())
     k = 1e7
     a = solve(system, 5e-5, 0.15, 0.25, method=Penalty(k))
-    b = solve(system, 5e-5, 0.15, 0.25, stiffness=k / scenes.PIPE_RHO_S)
+    b = solve(system, 5e-5, 0.15, 0.25, Penalty(k / scenes.PIPE_RHO_S, equation_units=True))
     assert a.impacts > 0 and np.array_equal(a.energy, b.energy)
     assert np.array_equal(a.contact_force, b.contact_force)
 
@@ -109,8 +109,8 @@ def test_python_laws_take_moving_bounds(solver):
     """Obstacles carried by a shaken support (bounds moving every step): OSQP and daqp
     give the active set's run to round-off and hold the moving bounds at the nodes."""
     s = observe_constraints(beam_system(span_problem(True, "paper")))
-    ref = solve(s, dt=1e-4, T=0.3, solver="active-set")
-    r = solve(s, dt=1e-4, T=0.3, solver=solver)
+    ref = solve(s, dt=1e-4, T=0.3, method=PositionLevel("active-set"))
+    r = solve(s, dt=1e-4, T=0.3, method=PositionLevel(solver))
     assert ref.impacts > 3 and r.impacts == ref.impacts
     y = np.column_stack([r.observed[f"y{i}"] for i in range(s.C.shape[0])])
     shift = np.outer(s.bound_motion(r.t), s.bound_shift)

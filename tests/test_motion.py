@@ -5,6 +5,8 @@ import dataclasses
 import numpy as np
 import pytest
 
+from skfem_beam.methods import PositionLevel
+
 from skfem_beam import (Beam, BeamProblem, InitialState, InputError, Obstacles, Support,
                         beam_system, scenes, solve)
 from skfem_beam.timefunctions import Constant, Sine, SumOfSines, Table, band_limited
@@ -132,7 +134,7 @@ def test_moving_support_with_obstacles_over_the_span(carried, lifting):
     else:
         np.testing.assert_allclose(s.bound_shift, want, atol=1e-12)
         phi, shift0 = s.bound_motion, s.bound_shift
-    r = solve(s, dt=1e-4, T=1.0, solver="active-set")
+    r = solve(s, dt=1e-4, T=1.0, method=PositionLevel("active-set"))
     assert r.success and r.impacts > 5
     y = np.column_stack([r.observed[f"y{i}"] for i in range(s.C.shape[0])])
     shift = np.outer(phi(r.t), shift0)
@@ -147,7 +149,7 @@ def test_still_support_carried_and_fixed_are_identical():
         for carried in (False, True):
             p = span_problem(carried, motion=motion) if motion is not None else \
                 dataclasses.replace(span_problem(carried), support=Support())
-            runs.append(solve(beam_system(p), dt=1e-4, T=0.3, solver="active-set"))
+            runs.append(solve(beam_system(p), dt=1e-4, T=0.3, method=PositionLevel("active-set")))
         assert np.array_equal(runs[0].observed["tip_displacement"],
                               runs[1].observed["tip_displacement"])
 

@@ -7,6 +7,7 @@ import pytest
 from conftest import assert_refused, exit_code
 from skfem_beam import beam_system, scenes, solve
 from skfem_beam.cases import stability_map
+from skfem_beam.methods import Penalty
 from skfem_beam.semidiscrete import beam_system as system_of
 from skfem_beam.stability import (PAPER_KAPPA_BOUNDS, kappa_h, linear_limit, prop31_limit,
                                   stability_table)
@@ -57,7 +58,7 @@ def test_penalty_penetrates_less_as_stiffness_grows(pipe_system):
     """Normal compliance penetrates (the contact scheme does not), less for stiffer springs."""
     pen = []
     for stiffness in (1e6, 1e7, 1e8):
-        r = solve(pipe_system, 5e-6, 0.25, 0.25, stiffness=stiffness / scenes.PIPE_RHO_S,
+        r = solve(pipe_system, 5e-6, 0.25, 0.25, Penalty(stiffness / scenes.PIPE_RHO_S, equation_units=True),
                   save_every=5, frames=2)
         assert r.status == "success"
         pen.append(np.abs(r.observed["tip_displacement"]).max() - 0.1)

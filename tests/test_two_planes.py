@@ -10,6 +10,7 @@ import pytest
 
 from conftest import assert_refused, exit_code, resumed
 from skfem_beam import methods
+from skfem_beam.methods import PositionLevel
 from skfem_beam.contact.round_hole import cone_solve, disk_kinds, disk_root
 from skfem_beam.holes import Hole, HoleAt
 from skfem_beam.problem import (Beam, BeamProblem, Damping, Load, Material, Obstacles,
@@ -375,7 +376,7 @@ def test_the_linear_laws_take_a_polygons_faces():
     system = beam_system(replace(problem, holes=tuple(replace(h, hole=Hole.regular(3, R))
                                                       for h in problem.holes)))
     ref = solve(system, 1e-4, 0.2)
-    osqp = solve(system, 1e-4, 0.2, solver="osqp")
+    osqp = solve(system, 1e-4, 0.2, method=PositionLevel("osqp"))
     assert ref.solver == "active-set" and osqp.impacts == ref.impacts > 20
     k = int(round(ref.impact_events["t_start"][2] / 1e-4))     # before the second impact
     assert np.abs(orbit(osqp, 0.5)[:k] - orbit(ref, 0.5)[:k]).max() <= 1e-12 * R
@@ -383,4 +384,4 @@ def test_the_linear_laws_take_a_polygons_faces():
         r = solve(system, 1e-4, 0.2, method=method)
         assert r.success and r.impacts > 20
     with pytest.raises(InputError, match="independent constraint rows"):
-        solve(system, 1e-4, 0.2, solver="daqp")
+        solve(system, 1e-4, 0.2, method=PositionLevel("daqp"))

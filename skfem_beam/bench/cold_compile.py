@@ -166,15 +166,16 @@ def _attribution(info: dict) -> None:
             print(f"  {name:40s} {s:7.2f} {t:11.2f} {k:8d}")
 
 
-def _cold_then_warm(package: str, job: str, one_core: bool) -> tuple[float, float, str]:
-    """A fresh copy of ``package`` runs the job cold, then warm: both wall times and a line."""
+def _cold_then_warm(package: str, job: str, one_core: bool) -> tuple:
+    """A fresh copy of ``package`` runs the job cold, then warm: both wall times, both CPU
+    times and a line."""
     with tempfile.TemporaryDirectory() as tmp:
         folder = _fresh(tmp, package)
         cold, cold_wall, info = _run(folder, job, False, one_core)
         warm, warm_wall, again = _run(folder, job, False, one_core)
     met = "yes" if cold_wall <= COLD_TARGET else "NO"
     notice = "compiling numerical kernels"
-    return cold_wall, warm_wall, (
+    return cold_wall, warm_wall, cold, warm, (
         f"python {' '.join(_argv(job))}: wall cold {cold_wall:.2f} s (≤ {COLD_TARGET:g} s: {met}), warm "
         f"{warm_wall:.2f} s, compile {cold_wall - warm_wall:.2f} s; CPU cold {cold:.2f} s, warm "
         f"{warm:.2f} s; its loop {info['loop_s']:.4f} s (cold {cold_wall / info['loop_s']:.0f}×, "
@@ -200,16 +201,17 @@ def _scenes(args, paths: list) -> int:
         runs = []
         for r in range(args.repeat):
             runs.append(_cold_then_warm(args.package, path, args.one_core))
-            print(f"run {r + 1}: {runs[-1][2]}", flush=True)
+            print(f"run {r + 1}: {runs[-1][-1]}", flush=True)
         if not args.no_attribute:
             _listened(args.package, path, args.one_core)
-        rows.append((Path(path).name, statistics.median(c for c, _, _ in runs),
-                     statistics.median(w for _, w, _ in runs)))
-    print(f"\n{'scene file':34s} {'cold s':>7s} {'warm s':>7s}   (medians of {args.repeat}; "
-          f"targets: cold ≤ {COLD_TARGET:g} s, warm ≤ {WARM_TARGET:g} s)")
-    for name, cold, warm in rows:
-        print(f"{name:34s} {cold:7.2f} {warm:7.2f}   {'yes' if cold <= COLD_TARGET else 'NO':>3s}"
-              f" {'yes' if warm <= WARM_TARGET else 'NO':>3s}")
+        rows.append((Path(path).name, *(statistics.median(r[k] for r in runs) for k in range(4))))
+    print(f"\n{'scene file':34s} {'cold s':>7s} {'warm s':>7s} {'CPU cold':>9s} {'CPU warm':>9s}"
+          f"   (wall and CPU, medians of {args.repeat}; targets: cold ≤ {COLD_TARGET:g} s, warm "
+          f"≤ {WARM_TARGET:g} s)")
+    for name, cold, warm, cpu_cold, cpu_warm in rows:
+        print(f"{name:34s} {cold:7.2f} {warm:7.2f} {cpu_cold:9.2f} {cpu_warm:9.2f}   "
+              f"{'yes' if cold <= COLD_TARGET else 'NO':>3s} "
+              f"{'yes' if warm <= WARM_TARGET else 'NO':>3s}")
     return 0
 
 
@@ -251,7 +253,7 @@ def main(argv=None) -> int:
         for package in packages if r % 2 == 0 else packages[::-1]:   # alternated: drift
             walls[package].append(_cold_then_warm(package, args.job, args.one_core))
             label = f" ({package})" if args.against else ""
-            print(f"run {r + 1}{label}: {walls[package][-1][2]}", flush=True)
+            print(f"run {r + 1}{label}: {walls[package][-1][-1]}", flush=True)
         if not args.no_attribute:
             _listened(args.package, args.job, args.one_core)
     if args.against:

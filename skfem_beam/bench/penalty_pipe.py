@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from ..scheme import solve
+from ..scheme.methods import Penalty
 from ..semidiscrete import beam_system
 from ..scenes import PIPE_RHO_S, point_stops
 from ..stability import kappa_h
@@ -40,7 +41,8 @@ def main(argv=None) -> int:
         for reading, stiffness in (("1e8 in the normalised eq.", 1e8),
                                ("1e8 N/m / rhoS (physical)", 1e8 / PIPE_RHO_S),
                                ("contact-implicit", None)):
-            r = solve(system, dt, T, 0.25, stiffness=stiffness, save_every=max(1, int(5e-6 / dt)),
+            law = Penalty(stiffness, equation_units=True) if stiffness else None
+            r = solve(system, dt, T, 0.25, law, save_every=max(1, int(5e-6 / dt)),
                       frames=2, progress=False)
             pen = float(np.abs(r.observed["tip_displacement"]).max() - 0.1)
             rows.append({"dt": dt, "reading": reading, "penetration_m": pen,
@@ -65,7 +67,7 @@ def force_chart(system, out: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     dt = 1e-6
-    rp = solve(system, dt, 0.25, 0.25, stiffness=1e8 / PIPE_RHO_S, frames=2, progress=False)
+    rp = solve(system, dt, 0.25, 0.25, Penalty(1e8 / PIPE_RHO_S, equation_units=True), frames=2, progress=False)
     rc = solve(system, dt, 0.25, 0.25, frames=2, progress=False)
     fig, ax = plt.subplots(1, 2, figsize=(11, 4), dpi=110)
     tip_p, tip_c = rp.observed["tip_displacement"], rc.observed["tip_displacement"]
@@ -101,7 +103,7 @@ def stiffness_chart(system, out: Path):
         kp = k / PIPE_RHO_S
         stiff = type(system)(**{**system.__dict__, "K": (system.K + kp * (C.T @ C)).tocsr()})
         dts_stable.append(2 / np.sqrt(kappa_h(stiff)))
-        r = solve(system, 1e-6, 0.25, 0.25, stiffness=kp, save_every=5, frames=2, progress=False)
+        r = solve(system, 1e-6, 0.25, 0.25, Penalty(kp, equation_units=True), save_every=5, frames=2, progress=False)
         pens.append(float(np.abs(r.observed["tip_displacement"]).max() - 0.1))
     fig, ax = plt.subplots(figsize=(7, 4), dpi=110)
     ax.loglog(ks, pens, "o-", label="max penetration (β = 1/4, Δt = 1e-6 s)")

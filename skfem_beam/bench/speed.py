@@ -83,7 +83,7 @@ def child(scene: str, p: dict, solver: str, repeat: int) -> dict:
     stepping = Stepping(p["dt"], p["T"], beta, save_every=p.get("save_every", 1), frames=50)
     best = repairs = None
     for _ in range(repeat):
-        run = methods.of(solver).build(system, stepping)
+        run = methods.PositionLevel(solver).build(system, stepping)
         drive(run, progress=False)
         r = run.result()
         if best is None or r.wall_time_s < best.wall_time_s:

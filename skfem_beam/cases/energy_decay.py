@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from .. import cli, scenes
 from ..scheme import solve
+from ..scheme.methods import PositionLevel
 from ..output.folder import write_timeseries
 from ..chart_process import draw
 from ..output.charts import trajectory_chart
@@ -33,7 +34,7 @@ def main(argv=None) -> int:
     def energy_files(folder, data, run):
         columns = {"t": data["t"], f"energy_{run.label.replace('=', '_')}": data["energy"]}
         if other is not None:
-            r2 = solve(beam_system(pb), args.dt, args.T, other, solver=args.solver,
+            r2 = solve(beam_system(pb), args.dt, args.T, other, PositionLevel(args.solver),
                        save_every=args.save_every, frames=2)
             columns[f"energy_beta_{other:g}"] = r2.energy[:data["t"].size]
         write_timeseries(folder, columns, "energy.csv")

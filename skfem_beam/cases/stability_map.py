@@ -20,6 +20,7 @@ import numpy as np
 from .. import cli, scenes
 from ..errors import InputError
 from ..scheme import solve
+from ..scheme.methods import Penalty
 from ..output.charts import figure
 from ..output.folder import Folder, check_output_dir
 from ..checks import check_beta, check_positive
@@ -57,8 +58,8 @@ def run_map(system, betas, ratios, methods, T, stiffness, kappa, kappa_paper, ma
     rows = []
     for beta, ratio, method in grid:
         dt = ratio * reference_step(kappa, kappa_paper, beta)
-        r = solve(system, dt, T, beta, stiffness=stiffness if method == "penalty" else None,
-                  save_every=max(1, int(1e-4 / dt)), frames=2, progress=False)
+        law = Penalty(stiffness, equation_units=True) if method == "penalty" else None
+        r = solve(system, dt, T, beta, law, save_every=max(1, int(1e-4 / dt)), frames=2, progress=False)
         tip = r.observed["tip_displacement"]
         rows.append({"beta": beta, "ratio": ratio, "dt": dt, "method": method,
                      "status": r.status, "steps": r.steps, "t_end": float(r.t[-1]),

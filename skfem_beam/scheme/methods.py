@@ -12,8 +12,7 @@ pairs a one-step integrator with a non-smooth law.
 
 Each owns its default β (the papers: 1/2 for exact contact, 1/4 for springs), its checks,
 its units and how it builds its run (``method.build(system, stepping)``: a :class:`.run.Run`
-or a :class:`.moreau_jean.MoreauJean`); :func:`of` turns :func:`.solve.solve`'s arguments
-into one.  They are importable from :mod:`skfem_beam.methods` too, where the command
+or a :class:`.moreau_jean.MoreauJean`); :func:`.solve.solve` takes one as ``method=``.  They are importable from :mod:`skfem_beam.methods` too, where the command
 line's and the scene file's words name them (``methods.make``).
 """
 from __future__ import annotations
@@ -68,7 +67,7 @@ class Penalty:
     """The β-scheme with one-sided springs of ``stiffness`` at the obstacles: N/m for a
     beam whose mass per length is known and for a bar with a cross-section, Pa/m for a bar
     per unit cross-section; ``equation_units``: the number is already in the units of the
-    semi-discrete equation (per unit mass for a beam), as ``solve(stiffness=)`` takes it.
+    semi-discrete equation (per unit mass for a beam).
     ``damping``: a dashpot beside each spring (Kelvin–Voigt, N·s/m in the same units as
     ``stiffness``), the supports' own damping; ``implicit``: the whole spring force at
     t_{n+1} (contact.penalty: the regularisation whose limit is the exact step)."""
@@ -116,19 +115,4 @@ class MoreauJean:
 Method = Union[PositionLevel, Penalty, MoreauJean]
 
 
-def of(method: Method | str | None, stiffness: float | None = None,
-       restitution: float = 0.0) -> Method:
-    """A method from :func:`.solve.solve`'s arguments: a method object, or a
-    position-level solver's name / law object with ``stiffness`` (equation units) and
-    ``restitution`` as ``contact.resolve`` takes them."""
-    if isinstance(method, (PositionLevel, Penalty, MoreauJean)):
-        return method
-    law = resolve("auto" if method is None else method, stiffness, restitution)
-    if isinstance(law, PenaltyLaw):
-        return Penalty(law.stiffness, equation_units=True)
-    if isinstance(law, Restitution):
-        return PositionLevel("auto", law.e)
-    return PositionLevel(law if isinstance(method, ContactLaw) else (method or "auto"))
-
-
-__all__ = ["Method", "MoreauJean", "Penalty", "PositionLevel", "mass_scale", "of"]
+__all__ = ["Method", "MoreauJean", "Penalty", "PositionLevel", "mass_scale"]

@@ -5,40 +5,40 @@ from __future__ import annotations
 import math
 import sys
 
-from ..contact import ContactLaw
 from ..errors import InputError, SolverError
-from .methods import MoreauJean, of
+from .methods import MoreauJean, Penalty, PositionLevel
 from .run import Run
 from .stepping import Result, Stepping
 
 MAX_VALUES = 2 * 10**8    # saved values a Result may hold (1.6 GB)
 
 
-def solve(system, dt: float, T: float, beta: float | None = None,
-          solver: str | ContactLaw = "auto", stiffness: float | None = None,
+def solve(system, dt: float, T: float, beta: float | None = None, method=None,
           save_every: int = 1, frames: int = 200, progress: bool | None = None,
-          load_window: str = "forward", growth_limit: float = 10.0, method=None) -> Result:
+          load_window: str = "forward", growth_limit: float = 10.0) -> Result:
     """Integrate ``system`` over [0, T] with step ``dt``, in the style of ``solve_ivp``.
 
-    ``method``: a :mod:`skfem_beam.methods` object, which reaches every class
-    (``PositionLevel(solver, restitution, massless)``, ``Penalty(stiffness)`` in N/m,
-    ``MoreauJean(theta, restitution)``); without it, ``solver`` names the position-level
-    contact law (see :mod:`skfem_beam.contact`) or is a law object, and ``stiffness`` = κ
-    makes the obstacles one-sided springs (normal compliance, κ in the units of the
-    semi-discrete equation, i.e. per unit mass for the beam).  ``beta``: the β-scheme's
-    β (default: a method's own, 1/2 for exact contact, 1/4 for springs; 1/2 without one).
-    ``save_every``, ``frames``, ``load_window``, ``growth_limit``: see :class:`Stepping`.
+    ``method``: a :mod:`skfem_beam.methods` object, the one way a run names its method
+    (``PositionLevel(solver, restitution, massless)``: the solver a name of
+    ``contact.LAWS`` or a law object; ``Penalty(stiffness)`` in N/m, or in the units of the
+    semi-discrete equation with ``equation_units=True``; ``MoreauJean(theta,
+    restitution)``); None: ``PositionLevel()``, exact contact by the cheapest exact law.
+    ``beta``: the β-scheme's β (default: the method's own, 1/2 for exact contact, 1/4 for
+    springs).  ``save_every``, ``frames``, ``load_window``, ``growth_limit``: see
+    :class:`Stepping`.
 
     The run stops with status "unstable" when the discrete energy exceeds
     ``growth_limit`` × the a-priori bound (√E¹ + Σ‖Gⁿ‖_{N⁻¹}Δt)² (operators.load_norms)
     or a value turns non-finite; what was computed up to the last good saved state is
     returned.
     """
-    if method is not None and (solver != "auto" or stiffness is not None):
-        raise InputError("pass either method= or solver=/stiffness=, not both")
-    if beta is None:     # the method's own; 1/2 for solver=/stiffness= (as they always were)
-        beta = method.default_beta if method is not None else 0.5
-    method = of(method if method is not None else solver, stiffness)
+    method = PositionLevel() if method is None else method
+    if not isinstance(method, (PositionLevel, Penalty, MoreauJean)):
+        raise InputError(f"method={method!r}: a method object is needed "
+                         f"(skfem_beam.methods.PositionLevel(solver=...), Penalty(stiffness), "
+                         f"MoreauJean(theta))")
+    if beta is None:
+        beta = method.default_beta
     stepping = Stepping(dt, T, beta, save_every, frames, load_window, growth_limit,
                         massless=method.massless)
     rows = stepping.steps // stepping.save_every + 1

@@ -21,8 +21,8 @@ from .output.folder import (EXIT_INPUT, EXIT_SOLVER, EXIT_UNSTABLE, OPENED,  # n
                             Interrupted, release, report, stamp)
 from .output.options import OutputOptions
 from .output.folder import lock_folder
-from .output.series import (_resume_folder, check_resumable, has_checkpoint,
-                            read_checkpoint, read_summary)
+from .output.checkpoint import (_resume_folder, check_resumable, has_checkpoint,
+                                read_checkpoint, read_summary)
 from .parser import Parser
 from .scheme.stepping import MASSLESS, Stepping
 from .spec import RunSpec
@@ -214,7 +214,7 @@ def stored_args(args, parser, argv=None):
     locked and its summary, checkpoint and rows agree.  ``--T`` may grow (extending the
     run); any other flag that differs from the stored one is refused by name.  A run
     stopped before its first checkpoint has only its summary to agree with: it is run
-    again from step 0 with these flags (output.series.execute)."""
+    again from step 0 with these flags (output.stream.execute)."""
     if not getattr(args, "resume", None):
         return args
     out = _resume_folder(args.resume)

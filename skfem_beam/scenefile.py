@@ -901,7 +901,7 @@ def run_main(argv) -> int:
 
 def _scene_of(path, sets, resume) -> Scene:
     """The scene file (or, resuming, the text the run stored) with the --set overrides."""
-    from .output.series import read_summary
+    from .output.checkpoint import read_summary
     stored = {}
     if resume:
         config = read_summary(Path(resume))["config"]

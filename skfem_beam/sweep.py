@@ -52,6 +52,7 @@ from . import cli, scenes
 from .errors import InputError, SolverError
 from .output.folder import EXIT_SOLVER, Folder, atomic_write, check_output_dir, stamp
 from .checks import check_beta, check_nonnegative, check_positive
+from .sweep_cluster import dask_client, on_cluster
 
 # scene name -> (problem factory, parameters that may be swept or set)
 SCENES = {
@@ -315,6 +316,7 @@ def assemble(out: Path, settings: dict, results: list[dict], extra: dict | None 
         fh, [param] + [c for c in cols if c != param] + damp + ["status"],
         [[r["value"]] + [r[c] for c in cols if c != param]
          + [(r.get("damping") or {}).get(c) for c in damp] + [r["status"]] for r in results]))
+    from .output.charts import bifurcation_chart   # charts where one is drawn, not in workers
     bifurcation_chart(out / "bifurcation.png", settings, results)
     summary = {"settings": settings, "values": len(results),
                "failed": sum(r["status"] != "success" for r in results),
@@ -334,107 +336,7 @@ def assemble(out: Path, settings: dict, results: list[dict], extra: dict | None 
     return summary
 
 
-# periodic values, by period; no red (the stops) and no black (the irregular values)
-PERIOD_COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink",
-                 "tab:olive", "tab:cyan")
-
-
-def bifurcation_chart(path: Path, settings: dict, results: list[dict]) -> None:
-    from .output.charts import figure   # matplotlib only where a chart is drawn, not in workers
-    param = settings["param"]
-    label = {"omega": "support frequency ω (rad/s)", "amplitude": "support amplitude A (m)",
-             "gap": "gap (m)", "k2": "k² (m⁴/s²)", "L": "L (m)"}.get(param, param)
-    with figure(path, figsize=(9, 6.5), dpi=120, nrows=2, sharex=True,
-                gridspec_kw={"height_ratios": [3, 1]}) as (fig, (ax, ax2)):
-        # periodic orbits in colour, one per period (1T, 2T, ...), the rest in black
-        periods = sorted({r.get("period") or 0 for r in results})
-        for i, p in enumerate(periods):
-            rs = [r for r in results if (r.get("period") or 0) == p]
-            x = np.concatenate([[r["value"]] * len(r["tip_displacement"]) for r in rs] or [[]])
-            y = np.concatenate([r["tip_displacement"] for r in rs] or [[]])
-            color = "k" if p == 0 else PERIOD_COLORS[(i - (0 in periods)) % len(PERIOD_COLORS)]
-            ax.plot(x, y, ",", color=color, alpha=0.8)
-            ax.plot(x, y, ".", ms=1.2 if p == 0 else 3, color=color, alpha=0.5 if p == 0 else 1,
-                    label=f"period {p}T ({len(rs)} value{'s' * (len(rs) > 1)})" if p else None)
-        f1 = {(r.get("damping") or {}).get("f1") for r in results} - {None}
-        if param == "omega" and len(f1) == 1:   # the beam's first natural frequency
-            w1 = 2 * math.pi * f1.pop()
-            for a in (ax, ax2):
-                a.axvline(w1, color="0.4", lw=0.8, ls=":")
-            ax.annotate(f"ω₁ = {w1:.3g}", (w1, 1.0), xycoords=("data", "axes fraction"),
-                        xytext=(2, -10), textcoords="offset points", fontsize=8,
-                        color="0.3")
-        gap = settings["fixed"].get("gap")
-        if gap is not None:
-            for g in (-gap, gap):
-                ax.axhline(g, color="tab:red", lw=0.8, ls="--")
-        elif param == "gap" and results:   # the stops move with the swept value
-            xs = np.array([r["value"] for r in results])
-            ax.plot(xs, xs, "--", xs, -xs, "--", color="tab:red", lw=0.8)
-        bad = [r["value"] for r in results if r["status"] != "success"]
-        if bad:
-            ax.plot(bad, [0.0] * len(bad), "x", color="tab:red", label="run failed / unstable")
-        if bad or any(periods):
-            ax.legend(loc="upper right", fontsize=8)
-        fixed = ", ".join(f"{k}={v:g}" for k, v in settings["fixed"].items())
-        zeta = settings["zeta"]
-        fixed += f"; ζ={zeta:g} at f1, f2 (Rayleigh)" if zeta else "; no damping"
-        ax.set_title(f"{settings['scene']}: Poincaré section of the tip, once per forcing period\n"
-                     f"({fixed}; {settings['periods']} periods after {settings['transient']:g} s, "
-                     f"J={settings['J']}, β={settings['beta']:g}, Δt≈{settings['dt_target']:g} s)",
-                     fontsize=9)
-        ax.set_ylabel("tip displacement ũ(L, kP) (m)")
-        ax.grid(alpha=0.3)
-        ok = [r for r in results if r["status"] == "success"]
-        ax2.plot([r["value"] for r in ok], [r["impacts_per_period"] for r in ok], ".-", ms=3,
-                 lw=0.6, color="tab:blue")
-        ax2.set_ylabel("impacts / period", color="tab:blue")
-        ax3 = ax2.twinx()
-        ax3.plot([r["value"] for r in ok], [r["contact_fraction"] for r in ok], ".-", ms=3,
-                 lw=0.6, color="tab:orange")
-        ax3.set_ylabel("contact-time fraction", color="tab:orange")
-        ax2.set_xlabel(label)
-        ax2.grid(alpha=0.3)
-
-
 # ---------------------------------------------------------------- the sweep
-
-@contextlib.contextmanager
-def dask_client(workers: int | None = None, scheduler: str | None = None):
-    """A Dask client: to ``scheduler`` if given, else to a new local cluster of processes.
-
-    The local workers are spawned processes: a script that calls this must keep its
-    top-level code under ``if __name__ == "__main__":``.
-    """
-    try:
-        from distributed import Client, LocalCluster
-    except ImportError:
-        raise InputError("a sweep on workers or a --scheduler needs Dask, which a run does "
-                         "not: pip install \"skfem_beam[cluster]\", or run without it with "
-                         "--workers 0") from None
-    import logging
-    if scheduler:
-        try:
-            client = Client(scheduler, timeout="15s")
-        except (OSError, TimeoutError, ValueError) as e:
-            raise InputError(f"--scheduler {scheduler}: cannot connect ({e})") from None
-        with client:
-            yield client
-        return
-    # Dask sets MALLOC_TRIM_THRESHOLD_ in its workers, which makes every chunk's load array
-    # a fresh mmap: 3× the page faults and ~15 % more CPU per run, measured here.  Unset it.
-    import dask
-    no_trim = {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}
-    with dask.config.set(no_trim), \
-            LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                         host="127.0.0.1", dashboard_address="127.0.0.1:0", scheduler_port=0,
-                         silence_logs=logging.CRITICAL) as cluster, \
-            Client(cluster) as client:
-        yield client
-
-
-RETRIES = 2     # a value whose worker dies is tried again this many times
-
 
 def lost(settings: dict, value: float, error: BaseException, attempts: int) -> dict:
     """The result of a value whose task never finished (its worker died every time):
@@ -447,39 +349,6 @@ def lost(settings: dict, value: float, error: BaseException, attempts: int) -> d
             "message": f"{type(error).__name__} after {attempts} attempts: {error}",
             "timing": {"task_s": 0.0, "task_cpu_s": 0.0, "time_loop_s": 0.0, "steps": 0,
                        "pid": None}}
-
-
-def _on_cluster(client, task, settings: dict, todo: list[float]):
-    """Results as they finish; a task that raises (a killed worker: KilledWorker) is tried
-    again, alone, up to RETRIES times after the others, then given up as :func:`lost`.
-    Alone: a worker that dies takes the tasks queued on it along, so a value retried
-    beside the one that kills it could be lost with it (seen once in CI)."""
-    from distributed import as_completed
-    attempts = {v: 1 for v in todo}
-    key = {}
-
-    def submit(v):
-        f = client.submit(task, settings, v, key=f"sweep-{v!r}-{attempts[v]}", pure=False)
-        key[f.key] = v
-        return f
-
-    failed = {}
-    for f in as_completed([submit(v) for v in todo]):
-        v = key[f.key]
-        try:
-            yield f.result()
-        except Exception as e:     # the worker died (KilledWorker) or the task broke
-            failed[v] = e
-    for v, e in failed.items():
-        while attempts[v] <= RETRIES:
-            attempts[v] += 1
-            try:
-                yield submit(v).result()
-                break
-            except Exception as err:
-                e = err
-        else:
-            yield lost(settings, v, e, attempts[v])
 
 
 def sweep(settings: dict, values: list[float], out, client=None, progress: bool = True,
@@ -511,7 +380,7 @@ def sweep(settings: dict, values: list[float], out, client=None, progress: bool 
             warm_s = time.perf_counter() - t
         t_runs = time.perf_counter()
         finished = (task(settings, v) for v in todo) if client is None else \
-            _on_cluster(client, task, settings, todo)
+            on_cluster(client, task, settings, todo, lost)
         for r in finished:
             if r["timing"]["pid"] is not None:    # a lost value is not saved: retried later
                 save_run(out, r)

@@ -26,6 +26,7 @@ from skfem_beam.cases import impacting_bar, point_stops
 from skfem_beam.contact import ContactLaw
 from skfem_beam.errors import SolverError
 from skfem_beam.output import series
+from skfem_beam.output.folder import Folder
 from skfem_beam.results import read_run
 from skfem_beam.scheme import Run
 
@@ -164,7 +165,7 @@ def test_failed_solver_keeps_the_impacts_so_far(tmp_path, monkeypatch, capsys):
     exit 3, status "failed", impacts.csv holds the events up to the state before the
     failed step, their rows those of the same run with the compiled projection, and the
     field series the frames up to the last whole chunk (a run's first second keeps its
-    frames in memory: the failure writes them, series._Stream)."""
+    frames in memory: the failure writes them, stream._Stream)."""
     argv = ["--dt", "1e-4", "--T", "1", "--flush-every", "200", "--format", "xdmf",
             "--frames", "10"]
     ref = tmp_path / "ref"
@@ -311,7 +312,7 @@ def test_a_summary_the_disk_refused_after_the_checkpoint_resumes_from_the_checkp
             "--format", "none"]
     ref, out = tmp_path / "ref", tmp_path / "run"
     assert exit_code(point_stops.main, argv + ["--out", str(ref)]) == 0
-    write, calls = series.Folder.write, []
+    write, calls = Folder.write, []
 
     def full_at_the_third(self, **entries):
         if "checkpoint_step" in entries:
@@ -319,7 +320,7 @@ def test_a_summary_the_disk_refused_after_the_checkpoint_resumes_from_the_checkp
             if len(calls) == 3:
                 raise OSError(errno.ENOSPC, "No space left on device")
         return write(self, **entries)
-    monkeypatch.setattr(series.Folder, "write", full_at_the_third)
+    monkeypatch.setattr(Folder, "write", full_at_the_third)
     assert exit_code(point_stops.main, argv + ["--out", str(out)]) == 3
     monkeypatch.undo()
     assert summary(out)["checkpoint_step"] == calls[1] < int(checkpoint(out)["n"]) == calls[2]

@@ -43,7 +43,7 @@ def test_a_scene_loads_no_writer_or_chart_library_before_its_loop():
 
 def test_a_missing_extra_is_named_in_one_line(monkeypatch):
     from skfem_beam.output import render
-    from skfem_beam.sweep import dask_client
+    from skfem_beam.sweep_cluster import dask_client
     monkeypatch.setitem(sys.modules, "pyvista", None)        # as if not installed
     with pytest.raises(InputError, match=r'pip install "skfem_beam\[render\]"'):
         render._pyvista()

@@ -14,7 +14,7 @@ import pytest
 
 import skfem_beam
 from conftest import exit_code
-from skfem_beam.output import series as runner
+from skfem_beam.output import series, stream
 from skfem_beam.cases import point_stops
 from skfem_beam.scenefile import run_main
 
@@ -74,7 +74,7 @@ def test_disk_full_mid_run_stops_clearly_and_checkpoint_resumes(tmp_path, monkey
     out = tmp_path / "run"
     base = ["--dt", "5e-5", "--T", "0.5", "--flush-every", "1000", "--frames", "5"]
     argv = base + ["--checkpoint-every", "0", "--out", str(out)]
-    real = runner.SeriesFile.append
+    real = series.SeriesFile.append
     calls = {"n": 0}
 
     def full(self, columns):
@@ -83,12 +83,12 @@ def test_disk_full_mid_run_stops_clearly_and_checkpoint_resumes(tmp_path, monkey
             raise OSError(errno.ENOSPC, "No space left on device")
         real(self, columns)
 
-    monkeypatch.setattr(runner.SeriesFile, "append", full)
+    monkeypatch.setattr(series.SeriesFile, "append", full)
     code = exit_code(point_stops.main, argv)
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 3 and len(err) == 1 and "No space left" in err[0]
     assert json.loads((out / "summary.json").read_text())["status"] == "failed"
-    monkeypatch.setattr(runner.SeriesFile, "append", real)
+    monkeypatch.setattr(series.SeriesFile, "append", real)
     assert exit_code(point_stops.main, ["--resume", str(out)]) == 0
     ref = tmp_path / "ref"
     exit_code(point_stops.main, base + ["--out", str(ref)])
@@ -149,7 +149,7 @@ def test_a_failed_resume_of_a_moved_folder_leaves_it_resumable(tmp_path, monkeyp
 
     def full_disk(run, *args, **kw):
         raise OSError(errno.ENOSPC, "No space left on device")
-    monkeypatch.setattr(runner, "drive", full_disk)
+    monkeypatch.setattr(stream, "drive", full_disk)
     assert exit_code(point_stops.main, ["--resume", str(b)]) == 3
     s = json.loads((b / "summary.json").read_text())
     assert s["status"] == "failed" and s["checkpoint_step"] == 2000
@@ -181,7 +181,7 @@ def test_a_signal_during_the_charts_gives_its_exit_code(tmp_path, monkeypatch, c
     assert json.loads((out / "summary.json").read_text())["status"] == "success"
 
 
-@pytest.mark.parametrize("phase", runner.PHASES)
+@pytest.mark.parametrize("phase", stream.PHASES)
 def test_killed_at_each_phase_of_its_end_a_run_resumes_to_the_same_files(tmp_path, phase):
     """SIGKILL at every boundary of a run's end (after the last chunk, after the final
     checkpoint, after the charts, after impacts.csv, before the final summary), then
@@ -228,7 +228,7 @@ def kill_before_the_first_checkpoint(command, out):
     (SKFEM_BEAM_KILL_AT), with no --checkpoint-every: a folder "running" with a few rows
     and no checkpoint.  Returns the lines of its timeseries.csv."""
     p = subprocess.run(command, capture_output=True,
-                       env={**os.environ, "SKFEM_BEAM_KILL_AT": runner.FIRST_CHUNK})
+                       env={**os.environ, "SKFEM_BEAM_KILL_AT": stream.FIRST_CHUNK})
     assert p.returncode == -signal.SIGKILL, p.stderr
     assert json.loads((out / "summary.json").read_text())["status"] == "running"
     assert not (out / "checkpoint.npz").exists()

@@ -14,8 +14,9 @@ import pytest
 
 from conftest import assert_refused, exit_code
 from skfem_beam import beam_system, scenes, solve
-from skfem_beam.sweep import (dask_client, detect_period, main, make_settings,
-                              parse_values, run_value, sweep)
+from skfem_beam.sweep import (detect_period, main, make_settings, parse_values, run_value,
+                              sweep)
+from skfem_beam.sweep_cluster import dask_client
 
 SWEEP = [sys.executable, "-m", "skfem_beam.sweep"]
 # short runs: 3 forcing periods after 0.2 s, the paper's Δt

@@ -6,7 +6,7 @@ uninterrupted run.
 Each cycle starts `point_stops` (Δt = 2e-6, T = 0.4, saved every 10th step, XDMF
 fields, a checkpoint every 0.2 s) and stops it one way: SIGKILL, SIGINT or SIGTERM at a
 random instant, SIGKILL at a named boundary of the run's end (the test hook
-``SKFEM_BEAM_KILL_AT``, output.series.PHASES), or a nearly full filesystem (as root: a
+``SKFEM_BEAM_KILL_AT``, output.stream.PHASES), or a nearly full filesystem (as root: a
 tmpfs holding 55–100 % of what the run writes; the run must exit 3, then a resume with a
 little more room, which may fill it again, then room enough).  Then `--resume` until
 the folder says "success"; each resume runs under a timeout (a hang is counted, never waited for) and is

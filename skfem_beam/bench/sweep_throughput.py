@@ -40,7 +40,8 @@ def _load():
 def measure(settings, values, workers: int, repeat: int) -> dict:
     """One configuration, best of ``repeat`` sweeps: 0 = serial loop in this process,
     N = a local cluster of N workers (started once, warmed up by the first sweep)."""
-    from ..sweep import dask_client, sweep
+    from ..sweep import sweep
+    from ..sweep_cluster import dask_client
     row = {"workers": workers, "load_before": _load()}
     with contextlib.ExitStack() as stack:
         client = None

@@ -14,7 +14,8 @@ from ..output.charts import (energy_chart, orbit_chart, shape_chart, shapes,
 from ..output.events import beam_impacts
 from ..output.fields import physical_at, physical_tip
 from ..output.probes import probe_columns, probe_units
-from ..output.series import Series, execute, prepare, read_summary
+from ..output.checkpoint import read_summary
+from ..output.stream import Series, execute, prepare
 from ..output.supports import support_table, support_wear
 from ..methods import Penalty
 from ..scheme.kernels import WORK_TERMS

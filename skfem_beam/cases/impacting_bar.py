@@ -37,7 +37,7 @@ from ..bar import (Bar, BarSeries, bar_run, contact_periods, describe, energy_re
 from ..chart_process import draw
 from ..output.charts import compare_chart
 from ..output.events import bar_impacts
-from ..output.series import Series, execute, prepare
+from ..output.stream import Series, execute, prepare
 from ..methods import Penalty
 from ..spec import RunSpec
 from ..reference import BarExact

@@ -5,6 +5,7 @@ draws, and on leaving the block it is laid out, saved and closed.
 """
 from __future__ import annotations
 
+import math
 from contextlib import contextmanager
 from dataclasses import dataclass
 
@@ -279,3 +280,93 @@ def penetration_chart(path, rows: list[dict], title=""):
         ax.set_title(title, fontsize=9)
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=6.5)
+
+
+# ---------------------------------------------------------------- a sweep's bifurcation chart
+
+# periodic values, by period; no red (the stops) and no black (the irregular values)
+PERIOD_COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink",
+                 "tab:olive", "tab:cyan")
+
+
+def bifurcation_chart(path, settings: dict, results: list[dict]) -> None:
+    """The Poincaré section of a sweep's runs (:mod:`skfem_beam.sweep`) against the swept
+    value, coloured by period, over their impacts per period and contact-time fraction."""
+    param = settings["param"]
+    label = {"omega": "support frequency ω (rad/s)", "amplitude": "support amplitude A (m)",
+             "gap": "gap (m)", "k2": "k² (m⁴/s²)", "L": "L (m)"}.get(param, param)
+    with figure(path, figsize=(9, 6.5), dpi=120, nrows=2, sharex=True,
+                gridspec_kw={"height_ratios": [3, 1]}) as (fig, (ax, ax2)):
+        periods = _sections(ax, results)
+        _first_frequency(ax, ax2, param, results)
+        _sweep_stops(ax, settings, results)
+        bad = [r["value"] for r in results if r["status"] != "success"]
+        if bad:
+            ax.plot(bad, [0.0] * len(bad), "x", color="tab:red", label="run failed / unstable")
+        if bad or any(periods):
+            ax.legend(loc="upper right", fontsize=8)
+        ax.set_title(_sweep_title(settings), fontsize=9)
+        ax.set_ylabel("tip displacement ũ(L, kP) (m)")
+        ax.grid(alpha=0.3)
+        _contact_statistics(ax2, results, label)
+
+
+def _sections(ax, results: list[dict]) -> list[int]:
+    """Periodic orbits in colour, one per period (1T, 2T, ...), the rest in black; the
+    periods drawn."""
+    periods = sorted({r.get("period") or 0 for r in results})
+    for i, p in enumerate(periods):
+        rs = [r for r in results if (r.get("period") or 0) == p]
+        x = np.concatenate([[r["value"]] * len(r["tip_displacement"]) for r in rs] or [[]])
+        y = np.concatenate([r["tip_displacement"] for r in rs] or [[]])
+        color = "k" if p == 0 else PERIOD_COLORS[(i - (0 in periods)) % len(PERIOD_COLORS)]
+        ax.plot(x, y, ",", color=color, alpha=0.8)
+        ax.plot(x, y, ".", ms=1.2 if p == 0 else 3, color=color, alpha=0.5 if p == 0 else 1,
+                label=f"period {p}T ({len(rs)} value{'s' * (len(rs) > 1)})" if p else None)
+    return periods
+
+
+def _first_frequency(ax, ax2, param: str, results: list[dict]) -> None:
+    """The beam's first natural frequency, when ω is swept and every run has the same."""
+    f1 = {(r.get("damping") or {}).get("f1") for r in results} - {None}
+    if param == "omega" and len(f1) == 1:   # the beam's first natural frequency
+        w1 = 2 * math.pi * f1.pop()
+        for a in (ax, ax2):
+            a.axvline(w1, color="0.4", lw=0.8, ls=":")
+        ax.annotate(f"ω₁ = {w1:.3g}", (w1, 1.0), xycoords=("data", "axes fraction"),
+                    xytext=(2, -10), textcoords="offset points", fontsize=8,
+                    color="0.3")
+
+
+def _sweep_stops(ax, settings: dict, results: list[dict]) -> None:
+    """The stops at ±gap, fixed or moving with the swept value."""
+    gap = settings["fixed"].get("gap")
+    if gap is not None:
+        for g in (-gap, gap):
+            ax.axhline(g, color="tab:red", lw=0.8, ls="--")
+    elif settings["param"] == "gap" and results:   # the stops move with the swept value
+        xs = np.array([r["value"] for r in results])
+        ax.plot(xs, xs, "--", xs, -xs, "--", color="tab:red", lw=0.8)
+
+
+def _sweep_title(settings: dict) -> str:
+    fixed = ", ".join(f"{k}={v:g}" for k, v in settings["fixed"].items())
+    zeta = settings["zeta"]
+    fixed += f"; ζ={zeta:g} at f1, f2 (Rayleigh)" if zeta else "; no damping"
+    return (f"{settings['scene']}: Poincaré section of the tip, once per forcing period\n"
+            f"({fixed}; {settings['periods']} periods after {settings['transient']:g} s, "
+            f"J={settings['J']}, β={settings['beta']:g}, Δt≈{settings['dt_target']:g} s)")
+
+
+def _contact_statistics(ax2, results: list[dict], label: str) -> None:
+    """Impacts per period and the contact-time fraction of the runs that succeeded."""
+    ok = [r for r in results if r["status"] == "success"]
+    ax2.plot([r["value"] for r in ok], [r["impacts_per_period"] for r in ok], ".-", ms=3,
+             lw=0.6, color="tab:blue")
+    ax2.set_ylabel("impacts / period", color="tab:blue")
+    ax3 = ax2.twinx()
+    ax3.plot([r["value"] for r in ok], [r["contact_fraction"] for r in ok], ".-", ms=3,
+             lw=0.6, color="tab:orange")
+    ax3.set_ylabel("contact-time fraction", color="tab:orange")
+    ax2.set_xlabel(label)
+    ax2.grid(alpha=0.3)

@@ -18,21 +18,30 @@ time loop of :func:`skfem_beam.bench.work_precision.rung` (and max|Δ²u(0)|, th
 contact node's step-to-step oscillation), printed as a table and written
 to ``rod_study.csv`` in --out, then the best setting at each Courant number against the
 issue's targets (:func:`verdict`).  About 20 s once the kernels are compiled.
+
+    python -m skfem_beam.bench.rod_study --accuracy [--N 80] [--out docs]
+
+The accuracy study of issue 40: every named setting of :data:`ACCURACY` (scene-file keys,
+usable as ``--set`` on the bar scene) at Δt/h = 0.4 and 0.04, with ONE error measure,
+:func:`relative_error` of u(0, ·) over every step, the energy drift, the energy change
+through each impact and the penetration; the best zero-penetration setting at each
+Courant number, GetFEM's figures beside them, written to ``rod_study.json`` in --out.
 """
 from __future__ import annotations
 
 import argparse
 import csv
+import json
 import math
 from pathlib import Path
 
 import numpy as np
 
 from .. import scenes
-from ..bar import l2_time, run_bar
+from ..bar import bar_system, l2_time, run_bar
 from ..methods import MOREAU_JEAN
 from ..reference import exact_of
-from .work_precision import COURANTS, rung
+from .work_precision import COURANTS, run_method, rung
 
 KEYS = ("l2_u0", "l2_u", "linf_l2_u")
 
@@ -188,17 +197,149 @@ def classes(N: int, out: Path) -> list[dict]:
     return rows
 
 
+# --- the accuracy study (issue 40): one error measure, named settings --------------------
+
+# GetFEM's dynamic-contact demo on the same rod (issue 40): its best error at each
+# Courant number (Signorini–Newmark, β = 1/2) and its energy over T = 12
+GETFEM = {"error": {"0.04": 0.0319, "0.4": 0.0124}, "energy_drift": 0.0002,
+          "scheme": "Signorini–Newmark, β = 1/2"}
+
+# named settings: the bar scene file's keys (``--set KEY=VALUE``), nothing else
+ACCURACY = {
+    "explicit lumped": {"mesh.mass": "lumped", "time.beta": 0.0},
+    "average, β=0": {"mesh.mass": "average", "time.beta": 0.0},
+    "average, β=1/4": {"mesh.mass": "average", "time.beta": 0.25},
+    "consistent, β=1/2": {"mesh.mass": "consistent", "time.beta": 0.5},
+    "modified mass, β=1/2": {"mesh.mass": "redistributed", "time.beta": 0.5},
+    "modified mass, quasi-static, β=1/4": {"mesh.mass": "redistributed", "time.beta": 0.25,
+                                           "mesh.massless": "quasi-static"},
+    "modified mass, quasi-static, β=1/2": {"mesh.mass": "redistributed", "time.beta": 0.5,
+                                           "mesh.massless": "quasi-static"},
+    "average, β=1/4, e=1": {"mesh.mass": "average", "time.beta": 0.25,
+                            "contact.restitution": 1.0},
+    "Moreau–Jean, average, θ=1/2, e=1": {"mesh.mass": "average", "contact.law": MOREAU_JEAN,
+                                         "contact.theta": 0.5, "contact.restitution": 1.0},
+}
+# the winners (measured, docs/rod_study.json): the smallest error without penetration at
+# each Courant number, and the one setting whose energy stays within 0.5 % at both
+BEST = {0.4: "average, β=0", 0.04: "modified mass, quasi-static, β=1/4"}
+ENERGY = "modified mass, quasi-static, β=1/4"
+ACCURACY_COURANTS = (0.4, 0.04)
+
+
+def relative_error(u_h: np.ndarray, u: np.ndarray) -> float:
+    """The study's one error measure, over every saved step tₙ (n = 0 … to T):
+
+        e = √( Σₙ (u_h(0, tₙ) − u(0, tₙ))² / Σₙ u(0, tₙ)² ),
+
+    ``u_h`` the computed and ``u`` the exact values of u(0, tₙ)."""
+    u_h, u = np.asarray(u_h, dtype=float), np.asarray(u, dtype=float)
+    return float(np.sqrt(np.sum((u_h - u) ** 2) / np.sum(u * u)))
+
+
+def run_keywords(keys: dict) -> dict:
+    """The keywords of :func:`work_precision.run_method` for a setting's scene-file keys."""
+    kw = {"beta": keys.get("time.beta", 0.25),
+          "restitution": keys.get("contact.restitution", 0.0),
+          "massless": keys.get("mesh.massless", "beta")}
+    if keys.get("contact.law") == MOREAU_JEAN:
+        kw["theta"] = keys.get("contact.theta", 0.5)
+    return kw
+
+
+def impact_changes(t: np.ndarray, E: np.ndarray, period: float, E_exact: float) -> list:
+    """(E after − E before)/E_exact through each contact (one per period: before at
+    period/6, after at 5·period/6, a sixth of a period from the contact's ends)."""
+    starts = np.arange(0.0, t[-1] - 5 * period / 6 + 1e-12, period)
+    return [float((np.interp(s + 5 * period / 6, t, E) - np.interp(s + period / 6, t, E))
+                  / E_exact) for s in starts]
+
+
+def accuracy_row(name: str, courant: float, N: int = 80, T: float = 12.0) -> dict:
+    """One named setting on the periodic rod (exact energy E = 1/8): the relative error of
+    u(0, ·), the drift E(T)/E(0) − 1 of the scheme's energy (½E_β from its first two
+    states; ½|v|²_M + ½|u|²_K for Moreau–Jean), the drift against the exact energy, the
+    mean change through an impact, the largest penetration."""
+    keys = ACCURACY[name]
+    bar = scenes.periodic_rod(N, mass=keys["mesh.mass"])
+    dt = courant * bar.h / bar.c
+    r = run_method(bar_system(bar), dt, T, run_keywords(keys), frames=10)
+    exact = exact_of(scenes.periodic_rod(N), T)
+    E, E_exact = r.energy, 0.125
+    changes = impact_changes(r.t, E, exact.period, E_exact)
+    return {"name": name, "dt_over_h": courant, "N": N, "set": dict(keys),
+            "error": relative_error(r.observed["u0"], exact.u(0.0, r.t)),
+            "drift": float(E[-1] / E[0] - 1.0), "drift_exact": float(E[-1] / E_exact - 1.0),
+            "impact_change": float(np.mean(changes)), "penetration": r.max_penetration,
+            "status": r.status}
+
+
+def best_rows(rows: list[dict]) -> list[dict]:
+    """At each Courant number, the row with the smallest error that does not penetrate."""
+    out = []
+    for courant in ACCURACY_COURANTS:
+        sel = [r for r in rows if r["dt_over_h"] == courant and r["status"] == "success"
+               and r["penetration"] <= PENETRATION_TOL]
+        if sel:
+            out.append(min(sel, key=lambda r: r["error"]))
+    return out
+
+
+def energy_settings(rows: list[dict]) -> list[str]:
+    """The settings that do not penetrate and keep |drift| ≤ 0.5 % at every Courant number."""
+    names = []
+    for name in ACCURACY:
+        mine = [r for r in rows if r["name"] == name]
+        if mine and all(r["penetration"] <= PENETRATION_TOL
+                        and abs(r["drift"]) <= DRIFT_TOL for r in mine):
+            names.append(name)
+    return names
+
+
+def accuracy_line(r: dict) -> str:
+    return (f"{r['name']:36s} {r['dt_over_h']:5g} {r['error']:8.4f} {100 * r['drift']:+8.3f} "
+            f"{100 * r['drift_exact']:+8.3f} {100 * r['impact_change']:+9.4f} "
+            f"{r['penetration']:9.1e}")
+
+
+def accuracy(N: int, out: Path) -> dict:
+    """Run every setting of :data:`ACCURACY`, print the table, write rod_study.json."""
+    print(f"{'setting':36s} {'Δt/h':>5} {'error':>8} {'drift %':>8} {'vs 1/8 %':>8} "
+          f"{'impact %':>9} {'penetr.':>9}", flush=True)
+    rows = []
+    for name in ACCURACY:
+        for courant in ACCURACY_COURANTS:
+            rows.append(accuracy_row(name, courant, N))
+            print(accuracy_line(rows[-1]), flush=True)
+    study = {"N": N, "T": 12.0, "best": best_rows(rows), "energy": energy_settings(rows),
+             "getfem": GETFEM, "rows": rows}
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "rod_study.json").write_text(json.dumps(study, indent=1, ensure_ascii=False) + "\n",
+                                        encoding="utf-8")
+    for r in study["best"]:
+        print(f"best at Δt/h = {r['dt_over_h']:g}: {r['name']} ({r['error']:.4f})")
+    print(f"energy within 0.5 % at both: {', '.join(study['energy']) or 'none'}")
+    print(f"written {out}/rod_study.json")
+    return study
+
+
 def main(argv=None) -> None:
     p = argparse.ArgumentParser(prog="skfem_beam.bench.rod_study", description=__doc__)
     p.add_argument("--classes", action="store_true",
                    help="every class and option at one N (the first of --N; default 80)")
-    p.add_argument("--out", default="docs", help="folder for rod_study.csv (--classes)")
+    p.add_argument("--accuracy", action="store_true",
+                   help="the named settings at Δt/h = 0.4, 0.04 (N default 80): rod_study.json")
+    p.add_argument("--out", default="docs",
+                   help="folder for rod_study.csv (--classes) or rod_study.json (--accuracy)")
     p.add_argument("--N", default=None, help="default 20,40,80,160 (80 with --classes)")
     p.add_argument("--courant", default="0.4,0.04")
     p.add_argument("--T", type=float, default=12.0)
     p.add_argument("--mass", default="consistent,lumped,average")
     p.add_argument("--beta", default="0.25,0.5")
     args = p.parse_args(argv)
+    if args.accuracy:
+        accuracy(int(args.N.split(",")[0]) if args.N else 80, Path(args.out))
+        return
     if args.classes:
         classes(int(args.N.split(",")[0]) if args.N else 80, Path(args.out))
         return

@@ -155,7 +155,8 @@ def _initial(space, initial: PlateInitial, dofs: np.ndarray, M: sp.csr_matrix):
         u0 = static_deflection(space, initial.static.vector(space))[dofs]
     v0 = np.zeros(dofs.size)
     if not (np.isscalar(initial.v0) and initial.v0 == 0.0):
-        b = load_vector(space, lambda x, y: _values(initial.v0, x, y))[dofs]
+        rho_h = space.plate.rho * space.plate.h      # M carries ρh: (ρh v0, φ) on the right
+        b = load_vector(space, lambda x, y: rho_h * _values(initial.v0, x, y))[dofs]
         v0 = spsolve(M.tocsc(), b)
     return u0, v0
 

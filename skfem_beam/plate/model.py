@@ -4,7 +4,7 @@ from dataclasses import dataclass, field
 from ..errors import InputError
 
 EDGES = ("left", "right", "bottom", "top")
-SUPPORTS = ("clamped", "simply_supported", "free")
+SUPPORTS = ("clamped", "simply_supported", "free", "sliding")
 ELEMENTS = ("bfs", "morley", "argyris")
 
 
@@ -17,7 +17,8 @@ class Plate:
     """A rectangular Kirchhoff–Love plate [0, a] × [0, b] (SI units).
 
     ``edges`` maps an edge (left x=0, right x=a, bottom y=0, top y=b) to its support;
-    an edge not named is free.  ``element`` is "bfs" (Bogner–Fox–Schmit on an nx × ny
+    an edge not named is free; "sliding" holds ∂w/∂n = 0 and leaves w free (a line of
+    symmetry).  ``element`` is "bfs" (Bogner–Fox–Schmit on an nx × ny
     grid of rectangles), "morley" or "argyris" (the grid's rectangles cut in two
     triangles)."""
     a: float = 1.0

@@ -53,13 +53,16 @@ def is_fixed(dofname: str, support: str, normal_axis: int) -> bool:
     Along the edge w = 0 fixes w and all its tangential derivatives; clamping also fixes
     ∂w/∂n = 0 and so its tangential derivatives.  A dof is fixed when its derivatives
     include no normal one (simply supported), or at most one (clamped).  u_n, the
-    normal derivative at an edge's midpoint (Morley, Argyris), counts as one."""
+    normal derivative at an edge's midpoint (Morley, Argyris), counts as one.  Sliding
+    (∂w/∂n = 0, w free: a line of symmetry) fixes those with exactly one."""
     letters = dofname.partition("_")[2]
     normal_count = sum(c in ("n", "xy"[normal_axis]) for c in letters)
     if support == "clamped":
         return normal_count <= 1
     if support == "simply_supported":
         return normal_count == 0
+    if support == "sliding":
+        return normal_count == 1
     return False
 
 

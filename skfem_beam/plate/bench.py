@@ -1,0 +1,100 @@
+"""What a plate step costs: ``python -m skfem_beam.plate.bench [--meshes 20 40]``.
+
+A simply supported 1 × 1 m steel plate (h = 1 cm, BFS on n × n), a flat obstacle under
+the whole plate at w ≥ −0.2 w_s (w_s: the static centre deflection under the load), the
+plate starting flat at rest under a uniform −10 kPa: it falls onto the obstacle within a
+quarter period and stays pressed on it.  Printed per mesh: the half bandwidth, the setup
+(the banded Cholesky of A = M + βΔt²K alone, and the whole of scheme.operators:
+step_operators, with W = A⁻¹Cᵀ and D = C W) and the bytes of W and D; per step, one
+banded solve with A's factor, the scheme's step without obstacles, and the step pressed
+on the obstacle with each exact law (its mean over the run, with the fraction of steps
+in contact).  Only measured, nothing tuned (docs/plate.md, Dynamics).
+"""
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+from ..linalg import Banded, band_solve
+from ..scheme import solve
+from ..scheme.operators import step_operators
+from .model import Plate
+from .space import plate_space
+from .system import PlateInitial, PlateObstacle, Pressure, half_bandwidth, plate_system
+
+LOAD = -1e4                  # Pa
+DT = 2e-4                    # s (the first period is 20 ms)
+LAWS = {"active-set": 200, "daqp": 200, "osqp": 40}     # steps of each law's run
+
+
+def timed(f, repeat: int = 1) -> float:
+    """The best of ``repeat`` wall times of f() (s)."""
+    best = np.inf
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        f()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def systems(n: int):
+    """(the plate without obstacles, the plate over the flat obstacle) on n × n."""
+    space = plate_space(Plate(nx=n, ny=n))
+    load = [Pressure(LOAD)]
+    free = plate_system(space, loads=load)
+    w_s = float(free.observe["w(0.5,0.5)"]
+                @ plate_system(space, initial=PlateInitial(static=load[0])).u0)
+    return free, plate_system(space, obstacles=[PlateObstacle(g1=0.2 * w_s)], loads=load)
+
+
+def setup_row(system) -> dict:
+    """The band, the factor's and step_operators' times, and W's and D's bytes."""
+    A = system.M + 0.5 * DT**2 * system.K
+    factor = timed(lambda: Banded(A, factor=True), 3)
+    t0 = time.perf_counter()
+    ops = step_operators(system, DT, 0.5)
+    total = time.perf_counter() - t0
+    b = np.ones(system.n)
+    solve_s = timed(lambda: band_solve(ops.Ab.chol, b), 50)
+    return {"n": system.n, "m": system.C.shape[0], "kd": half_bandwidth(A),
+            "factor_s": factor, "operators_s": total, "W_MB": ops.W.nbytes / 1e6,
+            "D_MB": ops.D.nbytes / 1e6, "band_solve_ms": 1e3 * solve_s}
+
+
+def step_ms(system, solver: str, steps: int) -> tuple[float, float]:
+    """(the scheme's mean wall time per step in ms, the fraction of steps in contact),
+    from a first short run (compiles, builds the operators) and the timed run's own
+    loop time."""
+    solve(system, DT, 2 * DT, solver=solver, progress=False)
+    r = solve(system, DT, steps * DT, solver=solver, progress=False)
+    return 1e3 * r.wall_time_s / r.steps, r.contact_fraction
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--meshes", type=int, nargs="+", default=[20, 40])
+    args = parser.parse_args(argv)
+    for n in args.meshes:
+        free, pressed = systems(n)
+        row = setup_row(pressed)
+        print(f"BFS {n} x {n}: {row['n']} unknowns, {row['m']} constrained vertices, half "
+              f"bandwidth {row['kd']}")
+        print(f"  setup: Cholesky of A {row['factor_s']:.3f} s, step_operators (A, W, D) "
+              f"{row['operators_s']:.2f} s; W {row['W_MB']:.1f} MB, D {row['D_MB']:.1f} MB")
+        print(f"  one banded solve: {row['band_solve_ms']:.3f} ms")
+        ms, _ = step_ms(free, "auto", 200)
+        print(f"  step without obstacles: {ms:.3f} ms")
+        for law, steps in LAWS.items():
+            try:
+                ms, fraction = step_ms(pressed, law, steps)
+            except Exception as e:          # a law that does not run here says why
+                print(f"  step with {law}: not run ({type(e).__name__}: {e})")
+                continue
+            print(f"  step with {law}: {ms:.3f} ms ({steps} steps, {100 * fraction:.0f} % "
+                  f"in contact)")
+
+
+if __name__ == "__main__":
+    main()

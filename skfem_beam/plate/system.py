@@ -1,0 +1,213 @@
+"""The plate's semi-discrete system for the one time scheme (:func:`skfem_beam.scheme.solve`):
+
+    M ẅ + K w = Σ_k a_k(t) b_k + Cᵀλ,   g1 ≤ C w ≤ g2 at the constrained vertices
+
+in physical units (SI): M = ρh(w, v) in kg, K the bending form in N/m, b_k = ∫ p_k φ in N
+(p_k a pressure in Pa), λ the nodal contact forces in N, energies in J.  Only the free
+dofs are kept, ordered by their location along the plate's longer side, then its shorter
+side (``grid_order``): the banded Cholesky of the scheme then has half bandwidth about
+4(n_short + 2) for BFS (87 at 20 × 20, 167 at 40 × 40; docs/plate.md, Dynamics).
+``system.meta["dofs"]`` maps the system's unknowns back to skfem's dof numbers
+(:func:`full_dofs`).  A row of C is the deflection dof w at one vertex: contact is exact
+there, as at the beam's nodes.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import spsolve
+
+from ..errors import InputError
+from ..system import SemiDiscrete
+from .space import PlateSpace, load_vector
+from .static import static_deflection
+
+
+def one(t):
+    """a(t) = 1, vectorised."""
+    return np.ones(np.shape(t))
+
+
+def _values(g, x, y) -> np.ndarray:
+    """g (a number or a vectorised function of x, y) at the points (x, y)."""
+    v = g(x, y) if callable(g) else g
+    return np.broadcast_to(np.asarray(v, dtype=float), np.shape(x)).copy()
+
+
+def _inside(region, x, y, tol: float) -> np.ndarray:
+    """Whether (x, y) lies in the rectangle region = (x0, x1, y0, y1) (None: everywhere)."""
+    if region is None:
+        return np.ones(np.shape(x), dtype=bool)
+    x0, x1, y0, y1 = region
+    return (x >= x0 - tol) & (x <= x1 + tol) & (y >= y0 - tol) & (y <= y1 + tol)
+
+
+@dataclass(frozen=True)
+class PlateObstacle:
+    """g1(x, y) ≤ w ≤ g2(x, y) (numbers or vectorised functions of x, y; ±inf: one-sided)
+    at the vertices of ``region`` = (x0, x1, y0, y1) (None: the whole plate), or, with
+    ``points`` = ((x, y), ...), at those vertices only (point stops)."""
+    g1: float | Callable = -np.inf
+    g2: float | Callable = np.inf
+    region: tuple[float, float, float, float] | None = None
+    points: tuple[tuple[float, float], ...] = ()
+
+    def bounds(self, space: PlateSpace) -> tuple[np.ndarray, np.ndarray]:
+        """(g1, g2) at every vertex of the mesh, ±inf where this obstacle does not act."""
+        x, y = space.vertices
+        if self.points:
+            where = np.zeros(x.size, dtype=bool)
+            where[[vertex_index(space, px, py) for px, py in self.points]] = True
+        else:
+            where = _inside(self.region, x, y, 1e-9 * max(space.plate.a, space.plate.b))
+        lo = np.where(where, _values(self.g1, x, y), -np.inf)
+        hi = np.where(where, _values(self.g2, x, y), np.inf)
+        return lo, hi
+
+
+@dataclass(frozen=True)
+class Pressure:
+    """A pressure p(x, y)·a(t) (Pa, positive along w) over ``region`` = (x0, x1, y0, y1)
+    (None: the whole plate; a region whose sides are not grid lines is integrated at the
+    quadrature points, i.e. approximately)."""
+    p: float | Callable = 0.0
+    time: Callable = one
+    region: tuple[float, float, float, float] | None = None
+
+    def vector(self, space: PlateSpace) -> np.ndarray:
+        """b = ∫ p·1_region φ (N), all dofs."""
+        tol = 1e-9 * max(space.plate.a, space.plate.b)
+        return load_vector(space, lambda x, y: _values(self.p, x, y)
+                           * _inside(self.region, x, y, tol))
+
+
+@dataclass(frozen=True)
+class PlateInitial:
+    """The start: w⁰ = the static deflection under ``static`` (a :class:`Pressure` whose
+    time function is ignored; None: w⁰ = 0), ẇ⁰ = ``v0`` (m/s, a number or a function of
+    x, y), L²-projected on the free dofs as the beam's v0 is."""
+    static: Pressure | None = None
+    v0: float | Callable = 0.0
+
+
+def vertex_index(space: PlateSpace, x: float, y: float) -> int:
+    """The mesh vertex at (x, y); a point that is not a vertex is an InputError."""
+    distance = np.hypot(space.vertices[0] - x, space.vertices[1] - y)
+    nearest = int(np.argmin(distance))
+    if distance[nearest] > 1e-9 * max(space.plate.a, space.plate.b):
+        raise InputError(f"({x:g}, {y:g}) is not a vertex of the plate's mesh; the nearest "
+                         f"is ({space.vertices[0, nearest]:g}, {space.vertices[1, nearest]:g})")
+    return nearest
+
+
+def grid_order(space: PlateSpace) -> np.ndarray:
+    """The free dofs sorted by their location (skfem's doflocs) along the longer side,
+    then the shorter side, then dof number: a narrow band for any of the elements."""
+    free = space.free_dofs
+    loc = space.basis.doflocs[:, free]
+    long_axis = 0 if space.plate.a >= space.plate.b else 1
+    return free[np.lexsort((free, loc[1 - long_axis], loc[long_axis]))]
+
+
+def half_bandwidth(A) -> int:
+    """max |i − j| over the nonzeros of A."""
+    coo = sp.coo_matrix(A)
+    return int(np.abs(coo.col - coo.row).max()) if coo.nnz else 0
+
+
+def full_dofs(system: SemiDiscrete, u: np.ndarray) -> np.ndarray:
+    """The system's coefficients (last axis) as all of skfem's dofs (fixed ones 0):
+    for :func:`~skfem_beam.plate.deflection_at_vertex`, plotting, skfem's tools."""
+    u = np.asarray(u, dtype=float)
+    full = np.zeros(u.shape[:-1] + (system.meta["space"].basis.N,))
+    full[..., system.meta["dofs"]] = u
+    return full
+
+
+def _contact_rows(space, obstacles, position):
+    """(vertices, lo, hi) of the constrained vertices: the highest g1 and the lowest g2
+    of the obstacles at each vertex whose w is free and bounded."""
+    nv = space.vertices.shape[1]
+    lo, hi = np.full(nv, -np.inf), np.full(nv, np.inf)
+    for obstacle in obstacles:
+        g1, g2 = obstacle.bounds(space)
+        lo, hi = np.maximum(lo, g1), np.minimum(hi, g2)
+    if np.isnan(lo).any() or np.isnan(hi).any() or np.any(lo >= hi):
+        i = int(np.argmax(np.isnan(lo) | np.isnan(hi) | (lo >= hi)))
+        raise InputError(f"obstacles at vertex ({space.vertices[0, i]:g}, "
+                         f"{space.vertices[1, i]:g}) need g1 < g2 (g1={lo[i]:g}, g2={hi[i]:g})")
+    held = position[space.w_dofs] < 0       # w fixed to 0 by a support
+    if np.any(held & ((lo > 0) | (hi < 0))):
+        i = int(np.argmax(held & ((lo > 0) | (hi < 0))))
+        raise InputError(f"vertex ({space.vertices[0, i]:g}, {space.vertices[1, i]:g}) is "
+                         f"held at w = 0 by its support, outside [{lo[i]:g}, {hi[i]:g}]")
+    rows = np.flatnonzero(~held & (np.isfinite(lo) | np.isfinite(hi)))
+    return rows, lo[rows], hi[rows]
+
+
+def _initial(space, initial: PlateInitial, dofs: np.ndarray, M: sp.csr_matrix):
+    """(u0, v0) on the system's unknowns."""
+    u0 = np.zeros(dofs.size)
+    if initial.static is not None:
+        u0 = static_deflection(space, initial.static.vector(space))[dofs]
+    v0 = np.zeros(dofs.size)
+    if not (np.isscalar(initial.v0) and initial.v0 == 0.0):
+        rho_h = space.plate.rho * space.plate.h      # M carries ρh: (ρh v0, φ) on the right
+        b = load_vector(space, lambda x, y: rho_h * _values(initial.v0, x, y))[dofs]
+        v0 = spsolve(M.tocsc(), b)
+    return u0, v0
+
+
+def _observers(space, points, position) -> dict[str, np.ndarray]:
+    """{"w(x,y)": the row reading w at that vertex}; default: the vertex nearest the
+    centre."""
+    if points is None:
+        x, y = space.vertices
+        c = int(np.argmin(np.hypot(x - space.plate.a / 2, y - space.plate.b / 2)))
+        points = [(float(x[c]), float(y[c]))]
+    rows = {}
+    for px, py in points:
+        j = position[space.w_dofs[vertex_index(space, px, py)]]
+        row = np.zeros(space.free_dofs.size)
+        if j >= 0:                          # a held vertex reads 0
+            row[j] = 1.0
+        rows[f"w({px:g},{py:g})"] = row
+    return rows
+
+
+def plate_system(space: PlateSpace, obstacles=(), loads=(), initial: PlateInitial | None = None,
+                 observe=None) -> SemiDiscrete:
+    """The plate's :class:`~skfem_beam.system.SemiDiscrete` (physical units, see the
+    module docstring): ``obstacles`` a sequence of :class:`PlateObstacle`, ``loads`` of
+    :class:`Pressure`, ``initial`` a :class:`PlateInitial` (None: at rest, flat),
+    ``observe`` the vertices (x, y) whose w is observed (None: the one nearest the
+    centre).  ``meta``: "dofs" (skfem's dof of each unknown), "contact_vertices",
+    "y_contact" (x_contact holds the x of each constrained vertex)."""
+    dofs = grid_order(space)
+    position = np.full(space.basis.N, -1)
+    position[dofs] = np.arange(dofs.size)
+    M = space.M[dofs][:, dofs].tocsr()
+    K = space.K[dofs][:, dofs].tocsr()
+    vertices, lo, hi = _contact_rows(space, obstacles, position)
+    cols = position[space.w_dofs[vertices]]
+    C = sp.csr_matrix((np.ones(cols.size), (np.arange(cols.size), cols)),
+                      shape=(cols.size, dofs.size))
+    b = [load.vector(space)[dofs] for load in loads]
+    u0, v0 = _initial(space, initial or PlateInitial(), dofs, M)
+    y0 = C @ u0
+    tol = 1e-12 * max(1.0, np.abs(u0).max(initial=0.0))
+    if np.any((y0 < lo - tol) | (y0 > hi + tol)):
+        i = int(np.argmax((y0 < lo - tol) | (y0 > hi + tol)))
+        x, y = space.vertices[:, vertices[i]]
+        raise InputError(f"the initial deflection violates the obstacles at ({x:g}, {y:g}): "
+                         f"w0={y0[i]:g} not in [{lo[i]:g}, {hi[i]:g}]")
+    return SemiDiscrete(
+        M=M, K=K, C=C, lo=lo, hi=hi, x_contact=space.vertices[0, vertices].copy(),
+        loads=np.column_stack(b) if b else np.zeros((dofs.size, 0)),
+        load_time=[load.time for load in loads], u0=u0, v0=v0,
+        observe=_observers(space, observe, position), space=space,
+        meta={"kind": "plate", "plate": space.plate, "space": space, "dofs": dofs,
+              "contact_vertices": vertices, "y_contact": space.vertices[1, vertices].copy()})

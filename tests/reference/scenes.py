@@ -9,6 +9,7 @@ import numpy as np
 
 from skfem_beam import beam_system, solve
 from skfem_beam.bar import Bar, run_bar
+from skfem_beam.methods import Penalty, PositionLevel
 
 
 def _beam(problem, dt, T, **kw):
@@ -19,6 +20,11 @@ def _beam(problem, dt, T, **kw):
             "frames_force": r.frames_force,
             "stats": np.array([r.impacts, r.max_nodal_violation, r.max_penetration,
                                r.contact_fraction, r.steps])}
+
+
+def spring(k):
+    """The penalty springs of stiffness k in the equation's units (per unit mass)."""
+    return Penalty(k, equation_units=True)
 
 
 def _bar(bar, dt, T, **kw):
@@ -41,14 +47,16 @@ def runs(scenes):
         "point_stops_centered": lambda: _beam(s.point_stops(), 5e-5, 0.1,
                                               load_window="centered"),
         "point_stops_penalty": lambda: _beam(s.point_stops(), 5e-5, 0.1, beta=0.25,
-                                             stiffness=1e8 / s.PIPE_RHO_S),
+                                             method=spring(1e8 / s.PIPE_RHO_S)),
         "flat_obstacles": lambda: _beam(s.flat_obstacles(), 1e-3, 1.0),
         "flat_obstacles_bspline": lambda: _beam(s.flat_obstacles(element="bspline"), 1e-3, 1.0),
         "flat_obstacles_penalty": lambda: _beam(s.flat_obstacles(), 1e-3, 1.0, beta=0.25,
-                                                stiffness=1e8 / s.PIPE_RHO_S),
+                                                method=spring(1e8 / s.PIPE_RHO_S)),
         "convex_obstacles": lambda: _beam(s.convex_obstacles(), 1e-3, 1.0),
-        "convex_obstacles_osqp": lambda: _beam(s.convex_obstacles(), 1e-3, 0.3, solver="osqp"),
-        "convex_obstacles_daqp": lambda: _beam(s.convex_obstacles(), 1e-3, 0.3, solver="daqp"),
+        "convex_obstacles_osqp": lambda: _beam(s.convex_obstacles(), 1e-3, 0.3,
+                                               method=PositionLevel("osqp")),
+        "convex_obstacles_daqp": lambda: _beam(s.convex_obstacles(), 1e-3, 0.3,
+                                               method=PositionLevel("daqp")),
         "energy_decay_half": lambda: _beam(s.energy_decay(), 1e-3, 1.0, beta=0.5),
         "energy_decay_quarter": lambda: _beam(s.energy_decay(), 1e-3, 1.0, beta=0.25),
         "bar_rigid": lambda: _bar(Bar(), 1e-3, 3.0),

@@ -39,17 +39,17 @@ from pathlib import Path
 
 import numpy as np
 
-from .bar import Bar
-from .errors import InputError
-from .problem import (Beam, BeamProblem, Damping, InitialState, Load, Material, Obstacles,
+from ..bar import Bar
+from ..errors import InputError
+from ..problem import (Beam, BeamProblem, Damping, InitialState, Load, Material, Obstacles,
                       Section, Support)
-from .checks import check_choice
-from . import methods
-from .contact import SOLVERS
-from .output.options import OutputOptions
-from .scheme import Stepping
-from .spec import RunSpec
-from .timefunctions import Constant, Sine, SumOfSines, Table, band_limited, psd_from_csv
+from ..checks import check_choice
+from .. import methods
+from ..contact import SOLVERS
+from ..output.options import OutputOptions
+from ..scheme import Stepping
+from ..spec import RunSpec
+from ..timefunctions import Constant, Sine, SumOfSines, Table, band_limited, psd_from_csv
 
 BEAM_MASSES = ("consistent", "redistributed")        # [mesh] mass of a beam
 SCENE_WORDS = methods.Words(solver="[contact] law = ", massless="[mesh] massless = ",
@@ -496,7 +496,7 @@ def _section(d: dict, where: str) -> Section:
 def _bar_area(d: dict) -> float:
     """A bar's [section]: its area A (m²), given as A or by a tube, rod or rect (a bar
     has no bending, so no I)."""
-    from .checks import check_positive
+    from ..checks import check_positive
     forms = [k for k in ("tube", "rod", "rect", "A") if k in d]
     if len(forms) != 1 or "I" in d:
         raise InputError(f"a bar's [section] needs one of A, tube, rod, rect (got "
@@ -522,7 +522,7 @@ PLAUSIBLE = {"E": (1e6, 1.2e12, "Pa"), "rho": (10.0, 23000.0, "kg/m³")}
 def _material(d: dict, where: str, plausible: bool = True) -> Material:
     """[material] E, rho; a beam's outside PLAUSIBLE warns (a bar's may be the papers'
     dimensionless a = ρ = 1)."""
-    from .cli import warn
+    from ..cli import warn
     material = Material(**_need(d, ("E", "rho"), where))
     for key, (low, high, unit) in PLAUSIBLE.items():
         value = d[key]
@@ -589,7 +589,7 @@ def _g(value, where: str):
 def _hole(o: dict, i: int, friction: float = 0.0):
     """A [[obstacles]] hole = {...} at x or over [x_from, x_to] (holes.HoleAt); its
     ``friction`` μ, else the scene's [contact] friction."""
-    from .holes import HoleAt, hole_from_table
+    from ..holes import HoleAt, hole_from_table
     where = f"obstacles.{i}"
     if "g1" in o or "g2" in o:
         raise InputError(f"[{where}] a hole bounds (v, w) itself: leave out g1, g2")
@@ -671,7 +671,7 @@ def _support(data: dict, L: float, reader: _Reader) -> Support:
 
 def _direction(d: dict, data: dict, where: str) -> tuple[float, float]:
     """A table's direction = [dy, dz] (two planes only; default the first plane)."""
-    from .problem import check_direction
+    from ..problem import check_direction
     if "direction" not in d:
         return (1.0, 0.0)
     if _planes(data) != 2:
@@ -792,7 +792,7 @@ def _initial(data: dict, problem: BeamProblem) -> BeamProblem:
 
 def _mode_shape(problem: BeamProblem, k, amplitude):
     """amplitude × the k-th mode shape (its largest |u| 1, on 50 samples per element)."""
-    from .modes import modes
+    from ..modes import modes
     if isinstance(k, bool) or not isinstance(k, int) or k < 1:
         raise InputError(f"[initial] mode={k!r} must be a whole number ≥ 1")
     m = modes(problem, k, samples_per_element=50)
@@ -862,7 +862,7 @@ def _bar(data: dict, reader: _Reader) -> Bar:
 # ---------------------------------------------------------------- commands
 
 def _run_parser() -> argparse.ArgumentParser:
-    from .parser import Parser
+    from ..parser import Parser
     p = Parser(prog="python -m skfem_beam run",
                description="Run the scene a TOML file describes (docs/scene_files.md).")
     p.add_argument("scene", nargs="?", default=None, help="the scene file (TOML)")
@@ -886,22 +886,22 @@ def _run_parser() -> argparse.ArgumentParser:
 
 def run_main(argv) -> int:
     """``python -m skfem_beam run``: the scene through the scenes' own pipeline."""
-    from .cli import stored_args
+    from ..cli import stored_args
     p = _run_parser()
     args = stored_args(p.parse_args(argv), p, argv)
     scene = _scene_of(args.scene, args.set, args.resume)
     spec = _spec(scene, {k: v for k, v in vars(args).items() if k != "resume"}, args.resume)
     name = f"scene {Path(args.scene).stem}" if args.scene else "scene"
     if scene.kind == "bar":
-        from .cases.impacting_bar import run_bar_case
+        from ..cases.impacting_bar import run_bar_case
         return run_bar_case(scene.problem, spec)
-    from .cases._beam import run_beam_case
+    from ..cases._beam import run_beam_case
     return run_beam_case(name, scene.problem, spec, stops=_chart_stops(scene.problem))
 
 
 def _scene_of(path, sets, resume) -> Scene:
     """The scene file (or, resuming, the text the run stored) with the --set overrides."""
-    from .output.series import read_summary
+    from ..output.series import read_summary
     stored = {}
     if resume:
         config = read_summary(Path(resume))["config"]
@@ -917,7 +917,7 @@ def _wear(scene: Scene):
     """[wear] as output.supports.Wear (radius defaults to a tube's or rod's outer one).
     Without land: volumes only (a depth spreads the volume over the land), so no radius
     is needed either."""
-    from .output.supports import Wear
+    from ..output.supports import Wear
     d = scene.data.get("wear")
     if d is None:
         return None
@@ -978,9 +978,9 @@ def _chart_stops(problem: BeamProblem) -> tuple:
 
 def modes_main(argv) -> int:
     """``python -m skfem_beam modes``: natural frequencies of the scene's beam."""
-    from .parser import Parser
-    from .modes import modes
-    from .two_planes import plane_problems
+    from ..parser import Parser
+    from ..modes import modes
+    from ..two_planes import plane_problems
     p = Parser(prog="python -m skfem_beam modes",
                description="Natural frequencies and mode shapes of a scene file's beam, with "
                            "its ends and supports (obstacles ignored).")
@@ -997,7 +997,7 @@ def modes_main(argv) -> int:
                          "beams")
     out = None
     if args.out is not None:
-        from .output.folder import check_output_dir
+        from ..output.folder import check_output_dir
         out = check_output_dir(args.out, args.overwrite)
     problem = scene.problem
     # two planes: each plane's modes (its own EI), the lowest n of both, with their plane
@@ -1024,7 +1024,7 @@ def modes_main(argv) -> int:
 
 def example(name: str) -> Path:
     """The path of a shipped scene file (``skfem_beam/scene_files/NAME.toml``)."""
-    p = Path(__file__).resolve().parent / "scene_files" / f"{Path(name).stem}.toml"
+    p = Path(__file__).resolve().parents[1] / "scene_files" / f"{Path(name).stem}.toml"
     if not p.is_file():
         shipped = sorted(q.stem for q in p.parent.glob("*.toml"))
         raise InputError(f"no scene file {name!r}; shipped: {', '.join(shipped)}")

@@ -8,8 +8,8 @@ The subcommands are the table ``COMMANDS``: name → Command(usage, one-line hel
 the function taking the remaining arguments and returning an exit code; the module is
 imported only when its subcommand runs.  Adding a subcommand is one line, e.g.::
 
-    "run": Command("SCENE.toml", "run the scene a TOML file describes", "skfem_beam.scenefile:run_main"),
-    "modes": Command("SCENE.toml", "its natural frequencies", "skfem_beam.scenefile:modes_main"),
+    "run": Command("SCENE.toml", "run the scene a TOML file describes", "skfem_beam.scenefile.commands:run_main"),
+    "modes": Command("SCENE.toml", "its natural frequencies", "skfem_beam.scenefile.commands:modes_main"),
 
 The list also shows the commands that are modules of their own (``python -m
 skfem_beam.cases.<scene>``, ``skfem_beam.sweep``, ``skfem_beam.bench.<study>``), each with the
@@ -34,8 +34,8 @@ class Command(NamedTuple):
 COMMANDS = {
     "export": Command("DIR --to npz|mat [--out FILE]", "a run folder as one .npz or .mat "
                       "(MATLAB) file", "skfem_beam.results:export_main"),
-    "run": Command("SCENE.toml [--out DIR] [--set KEY=VALUE ...]", "run the scene a TOML file describes", "skfem_beam.scenefile:run_main"),
-    "modes": Command("SCENE.toml [--n 6] [--out DIR]", "natural frequencies and mode shapes of its beam", "skfem_beam.scenefile:modes_main"),
+    "run": Command("SCENE.toml [--out DIR] [--set KEY=VALUE ...]", "run the scene a TOML file describes", "skfem_beam.scenefile.commands:run_main"),
+    "modes": Command("SCENE.toml [--n 6] [--out DIR]", "natural frequencies and mode shapes of its beam", "skfem_beam.scenefile.commands:modes_main"),
 }
 EXIT_INPUT = 2     # as skfem_beam.errors (not imported here: the listing stays instant)
 

@@ -1,6 +1,7 @@
 """What every key of a scene file means: the text of the reference the documentation
 generates (docs/scene_files.md includes :func:`reference`), one entry per section of
-:data:`skfem_beam.scenefile.BEAM_KEYS` and :data:`~skfem_beam.scenefile.BAR_KEYS`.
+:data:`skfem_beam.scenefile.schema.BEAM_KEYS` and
+:data:`~skfem_beam.scenefile.schema.BAR_KEYS`.
 
 The keys themselves are read from those tables, so a key added to the code appears in the
 docs; tests/test_docs.py fails when a key is not named in its section's text here.
@@ -135,7 +136,7 @@ def _keys(schema, prefix: str = "") -> list[str]:
 
 def sections() -> dict[str, dict[str, list[str]]]:
     """section → {"beam": keys, "bar": keys} ("(top level)": the scalar keys)."""
-    from .scenefile import BAR_KEYS, BEAM_KEYS
+    from .scenefile.schema import BAR_KEYS, BEAM_KEYS
     out: dict[str, dict[str, list[str]]] = {}
     for kind, schema in (("beam", BEAM_KEYS), ("bar", BAR_KEYS)):
         for key, sub in schema.items():
@@ -150,7 +151,7 @@ def sections() -> dict[str, dict[str, list[str]]]:
 def reference() -> str:
     """The scene-file reference as a Markdown table: section, its keys (from the code),
     what they mean."""
-    from .scenefile import BAR_KEYS, BEAM_KEYS
+    from .scenefile.schema import BAR_KEYS, BEAM_KEYS
     rows = ["| section | keys (from the code) | what they mean (SI units) |", "|---|---|---|"]
     for name, kinds in sections().items():
         array = isinstance(BEAM_KEYS.get(name, BAR_KEYS.get(name)), list)

@@ -1,7 +1,7 @@
 """What every front end builds once and hands to a scene's runner (``cases._beam``,
 ``cases.impacting_bar``): the time grid, the method, the output options and the
 summary's config.  The command line builds it from its flags (``cli.spec``), a scene
-file from its keys (``scenefile.run_main``); nothing below them reads their words."""
+file from its keys (``scenefile.commands.run_main``); nothing below them reads their words."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field

@@ -1,0 +1,118 @@
+"""A beam scene's parsed keys → a BeamProblem: the beam ([material] with [section],
+[mass_normalised] or [[segments]], [mass] added), its ends, supports, obstacles, motion,
+loads, [damping] and [initial] state."""
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+
+from ..errors import InputError
+from ..problem import Beam, BeamProblem, Damping, InitialState
+from .forcing import loads_of, support_of
+from .obstacles import obstacles_and_holes
+from .parts import material_of, need, plane_count, section_of
+from .read import Tables
+
+
+def _beam(data: dict) -> Beam:
+    """The beam of [material] + [section], [mass_normalised] or [[segments]], with its
+    [mass] added (kg/m, e.g. the fluid's hydrodynamic mass)."""
+    beam = _structure(data)
+    added = data.get("mass", {}).get("added")
+    return beam if added is None else beam.with_added_mass(added)
+
+
+def _structure(data: dict) -> Beam:
+    mn, segs = data.get("mass_normalised"), data.get("segments")
+    forms = [k for k in ("mass_normalised", "segments") if k in data] + \
+        (["material/section"] if "material" in data or "section" in data else [])
+    if len(forms) != 1:
+        raise InputError("a beam needs one of [material] with [section], [mass_normalised] "
+                         f"(k2, rho_S) or [[segments]] (got {', '.join(forms) or 'none'})")
+    if segs is not None:
+        if "geometry" in data:
+            raise InputError("[[segments]] give the length: leave out [geometry]")
+        return Beam.stepped([(s.get("length", math.nan), material_of(s.get("material", {}),
+                                                                    f"segments.{i}.material"),
+                              section_of(s.get("section", {}), f"segments.{i}.section"))
+                             for i, s in enumerate(segs)])
+    L = need(data.get("geometry", {}), ("L",), "geometry")["L"]
+    if mn is not None:
+        return Beam(L, need(mn, ("k2",), "mass_normalised")["k2"], mn.get("rho_S"))
+    return Beam.physical(L, material_of(data.get("material", {}), "material"),
+                         section_of(data.get("section", {}), "section"))
+
+
+def _damping(data: dict) -> Damping:
+    d = data.get("damping")
+    if d is None:
+        return Damping()
+    if "modal" in d:
+        if len(d) > 1:
+            raise InputError("[damping] modal = ζ (every mode) stands alone: not with "
+                             f"{', '.join(k for k in d if k != 'modal')}")
+        return Damping(modal=d["modal"])
+    if set(d) & {"zeta", "f1", "f2"}:
+        if set(d) & {"alpha", "alpha_K"}:
+            raise InputError("[damping] give zeta, f1, f2 or alpha, alpha_K, not both")
+        return Damping.ratio(**need(d, ("zeta", "f1", "f2"), "damping"))
+    return Damping(d.get("alpha", 0.0), d.get("alpha_K", 0.0))
+
+
+def _spline(d: dict, name: str, value: str):
+    """(f, f') of a {x, u} table: a not-a-knot cubic spline."""
+    pairs = need(d, ("x", value), f"initial.{name}")
+    try:
+        from scipy.interpolate import CubicSpline
+        s = CubicSpline(np.asarray(pairs["x"], dtype=float),
+                        np.asarray(pairs[value], dtype=float), bc_type="not-a-knot")
+    except ValueError as e:
+        raise InputError(f"[initial.{name}] table x = [...], {value} = [...]: {e}") from None
+    return s, s.derivative()
+
+
+def _initial(data: dict, problem: BeamProblem) -> BeamProblem:
+    ini = data.get("initial", {})
+    fixed = ini.get("fixed_frame", True)
+    if "mode" in ini:
+        if "u0" in ini:
+            raise InputError("[initial] give mode or u0, not both")
+        u0, du0 = _mode_shape(problem, ini["mode"], ini.get("amplitude", 1.0))
+    elif "u0" in ini:
+        u0, du0 = _spline(ini["u0"], "u0", "u")
+    else:
+        u0 = du0 = None
+    v0 = _spline(ini["v0"], "v0", "v")[0] if "v0" in ini else None
+    return replace(problem, initial=InitialState(u0, v0, du0, fixed_frame=fixed))
+
+
+def _mode_shape(problem: BeamProblem, k, amplitude):
+    """amplitude × the k-th mode shape (its largest |u| 1, on 50 samples per element)."""
+    from ..modes import modes
+    if isinstance(k, bool) or not isinstance(k, int) or k < 1:
+        raise InputError(f"[initial] mode={k!r} must be a whole number ≥ 1")
+    m = modes(problem, k, samples_per_element=50)
+    v = m.vectors[:, k - 1] * (float(amplitude) / np.abs(m.shapes[:, k - 1]).max())
+    space = m.space
+
+    def shape(derivative):
+        return lambda x: np.asarray(space.point_rows(np.ravel(x), derivative) @ v).reshape(
+            np.shape(x))
+    return shape(0), shape(1)
+
+
+def beam_problem(data: dict, reader: Tables) -> BeamProblem:
+    beam = _beam(data)
+    ends = data.get("ends", {})
+    mesh = data.get("mesh", {})
+    obstacles, holes = obstacles_and_holes(data)
+    load, load_w = loads_of(data, reader)
+    problem = BeamProblem(
+        beam, obstacles, support_of(data, beam.L, reader), load,
+        J=mesh.get("J", 19), element=mesh.get("element", "hermite"), nodes=mesh.get("nodes"),
+        ends=(ends.get("left", "clamped"), ends.get("right", "free")),
+        supports=tuple(s.get("x", math.nan) for s in data.get("supports", [])),
+        damping=_damping(data), planes=plane_count(data), holes=holes, load_w=load_w)
+    return _initial(data, problem)

@@ -1,0 +1,173 @@
+"""A parsed scene → :class:`Scene`, the Python API's objects: the problem (a beam's or a
+bar's), and what the file leaves to inference: the contact law (from [contact], the
+obstacles' own stiffness and the holes' friction), the time grid and its β, the output
+options and [wear]."""
+from __future__ import annotations
+
+import tempfile
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+from .. import methods
+from ..checks import check_choice
+from ..contact import SOLVERS
+from ..errors import InputError
+from ..scheme import Stepping
+from .bar import bar_problem
+from .beam import beam_problem
+from .parts import need, plane_count
+from .read import Parsed, Tables, read
+
+
+BEAM_MASSES = ("consistent", "redistributed")        # [mesh] mass of a beam
+SCENE_WORDS = methods.Words(solver="[contact] law = ", massless="[mesh] massless = ",
+                            law="[contact] law = ", restitution="[contact] restitution = ",
+                            theta="[contact] theta = ")
+OUTPUT_DEFAULTS = {"format": "both", "save_every": 1, "frames": 200, "flush_every": 20000,
+                   "checkpoint_every": None}
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A scene file read into the Python API's objects.
+
+    ``problem``: a BeamProblem or a Bar; ``stepping``: the time grid; ``law``,
+    ``stiffness`` (N/m), ``restitution``: the [contact] keys, ``damping`` (N·s/m): the
+    supports' dashpots ([[obstacles]] damping) (``method`` builds the run's method from
+    them);
+    ``output``: format, save_every, frames, flush_every, checkpoint_every; ``text``: the
+    file as read and ``files`` the tables it read (path as written → text), so that a run
+    can be rebuilt from its summary.json; ``data``: the parsed TOML with the overrides.
+    """
+    kind: str
+    problem: object
+    stepping: Stepping
+    law: str = "auto"
+    stiffness: float | None = None
+    restitution: float = 0.0
+    output: dict = field(default_factory=dict)
+    text: str = ""
+    files: dict = field(default_factory=dict)
+    data: dict = field(default_factory=dict)
+    damping: float = 0.0
+
+    @property
+    def method(self) -> methods.Method:
+        """The run's method (:mod:`skfem_beam.methods`): ``law`` names a class
+        (methods.LAWS) or a position-level solver."""
+        law, solver = (self.law, "auto") if self.law in methods.LAWS else ("position", self.law)
+        if law == "penalty" and self.stiffness is None:
+            raise InputError("[contact] law='penalty' needs stiffness (N/m)")
+        massless = self.data.get("mesh", {}).get("massless")    # as written: None if not
+        theta = self.data.get("contact", {}).get("theta")
+        return methods.make(law, solver, self.restitution or 0.0, self.stiffness, massless,
+                            words=SCENE_WORDS, damping=self.damping, theta=theta)
+
+
+def load(path, overrides=(), files: dict | None = None, text: str | None = None,
+         dynamic: bool = True) -> Scene:
+    """Read the scene file ``path`` (``overrides``: ``KEY=VALUE`` strings as ``--set``).
+    ``text``/``files``: the file's and its tables' stored texts (a resumed run) instead of
+    the file system.  ``dynamic=False``: the structure alone (natural frequencies need
+    no [time], [contact] or [output]: they are not read, and ``stepping`` is None)."""
+    return build(read(path, overrides, files, text), dynamic)
+
+
+def build(parsed: Parsed, dynamic: bool = True) -> Scene:
+    """The scene :func:`~skfem_beam.scenefile.read.read` parsed as the API's objects
+    (``dynamic``: as :func:`load`); every error line names the file."""
+    path = parsed.path
+    tables = Tables(path.parent, parsed.files)
+    try:    # every error line names the file
+        with tempfile.TemporaryDirectory() as tmp:
+            tables.tmp = Path(tmp)
+            problem = (beam_problem if parsed.kind == "beam" else bar_problem)(parsed.data,
+                                                                              tables)
+        if not dynamic:
+            return Scene(parsed.kind, problem, None, text=parsed.text, files=tables.read,
+                         data=parsed.data)
+        return _scene(parsed.kind, problem, parsed.data, parsed.text, tables.read)
+    except InputError as e:
+        raise InputError(f"{path.name}: {e}") from None
+
+
+def _supports(data: dict) -> tuple[float, float] | None:
+    """A beam's [[obstacles]] stiffness (N/m) and damping (N·s/m, default 0): the supports'
+    own compliance, one pair for all of them (the penalty law's springs and dashpots;
+    their deflection is the support's).  None: rigid supports."""
+    if data.get("kind", "beam") != "beam":
+        return None
+    obstacles = data.get("obstacles", [])
+    pairs = {(o.get("stiffness"), o.get("damping")) for o in obstacles}
+    if pairs <= {(None, None)}:
+        return None
+    if len(pairs) > 1 or None in {k for k, _ in pairs}:
+        raise InputError("[[obstacles]] stiffness, damping: give every obstacle the same "
+                         f"(got {', '.join(f'{k}, {c}' for k, c in sorted(pairs, key=str))})")
+    if "stiffness" in data.get("contact", {}) or \
+            data.get("contact", {}).get("law", "penalty") not in ("penalty", "auto"):
+        raise InputError("[[obstacles]] stiffness makes the supports springs (the penalty "
+                         "law): leave out [contact] law and stiffness")
+    (k, c), = pairs
+    return k, 0.0 if c is None else c
+
+
+def _scene(kind, problem, data, text, files) -> Scene:
+    contact = data.get("contact", {})
+    law, k, c = contact.get("law", "auto"), contact.get("stiffness"), 0.0
+    if any(h.friction > 0 for h in getattr(problem, "holes", ())) and "law" not in contact:
+        law = methods.MoreauJean.name    # Coulomb friction is a velocity-level law
+    supports = _supports(data)
+    if supports is not None:
+        law, (k, c) = "penalty", supports
+    if k is not None and law == "auto":
+        law = "penalty"
+    check_choice("[contact] law", law, (*methods.LAWS, *SOLVERS))
+    if k is not None and law in methods.LAWS and law != methods.Penalty.name:
+        raise InputError(f"[contact] stiffness is the penalty spring: law = {law!r} does not "
+                         "take it")
+    t, mesh = data.get("time", {}), data.get("mesh", {})
+    if "dt" not in t or "T" not in t:
+        raise InputError("[time] needs dt and T (s)")
+    out = {**OUTPUT_DEFAULTS, **data.get("output", {})}
+    if kind == "beam":
+        check_choice("[mesh] mass", mesh.get("mass", "consistent"), BEAM_MASSES)
+        if mesh.get("mass") == "redistributed" and plane_count(data) == 2:
+            raise InputError("[mesh] mass = \"redistributed\" is for one plane; planes = 2 "
+                             "takes the consistent mass")
+    rows = mesh.get("massless")
+    methods.check_massless(rows, mesh.get("mass", "consistent"), "[mesh] massless")
+    scene = Scene(kind, problem, Stepping(t["dt"], t["T"], 0.5, massless=rows or "beta"), law, k,
+                  contact.get("restitution", 0.0), out, text, files, data, c)
+    method = scene.method          # the method's own checks (law, stiffness, restitution)
+    beta = t.get("beta", methods.default_beta(method, kind))
+    stepping = Stepping(t["dt"], t["T"], beta, out["save_every"], out["frames"],
+                        t.get("load_window", "forward"), massless=rows or "beta")
+    return replace(scene, stepping=stepping)
+
+
+def wear(scene: Scene):
+    """[wear] as output.supports.Wear (radius defaults to a tube's or rod's outer one).
+    Without land: volumes only (a depth spreads the volume over the land), so no radius
+    is needed either."""
+    from ..output.supports import Wear
+    d = scene.data.get("wear")
+    if d is None:
+        return None
+    holes = getattr(scene.problem, "holes", ())
+    if not holes:
+        raise InputError("[wear] needs holes (planes = 2 and [[obstacles]] hole = ...): wear "
+                         "comes from the normal force times the sliding along a wall")
+    radius = d.get("radius", _outer_radius(scene.data.get("section", {})))
+    if radius is None and "land" in d:
+        raise InputError("[wear] radius (m, the tube's outer radius) is needed for the depth "
+                         "(land) when [section] is not a tube or a rod")
+    given = need(d, ("coefficient", "service_years"), "wear")
+    return Wear(given["coefficient"], given["service_years"], d.get("land"), radius)
+
+
+def _outer_radius(section: dict) -> float | None:
+    """A tube's or rod's outer radius (m) from [section], else None."""
+    diameter = section.get("tube", {}).get("outer_diameter") or \
+        section.get("rod", {}).get("diameter")
+    return None if diameter is None else 0.5 * diameter

@@ -1,0 +1,160 @@
+"""The ``run`` and ``modes`` subcommands of ``python -m skfem_beam`` on a scene file."""
+from __future__ import annotations
+
+import argparse
+import csv
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from .. import methods
+from ..errors import InputError
+from ..output.options import OutputOptions
+from ..problem import BeamProblem
+from ..spec import RunSpec
+from .build import Scene, load, wear
+
+
+def _run_parser() -> argparse.ArgumentParser:
+    from ..parser import Parser
+    p = Parser(prog="python -m skfem_beam run",
+               description="Run the scene a TOML file describes (docs/scene_files.md).")
+    p.add_argument("scene", nargs="?", default=None, help="the scene file (TOML)")
+    p.add_argument("--set", action="append", default=None, metavar="KEY=VALUE",
+                   help="override a key of the file, e.g. time.dt=1e-5 (repeatable)")
+    p.add_argument("--T", type=float, default=None, help="final time (s): [time] T")
+    p.add_argument("--out", default=None, help="output folder (default out/<scene name>)")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing --out folder")
+    for flag in ("format", "frames", "save-every", "flush-every", "checkpoint-every"):
+        p.add_argument(f"--{flag}", default=None,
+                       type=str if flag == "format" else float if flag == "checkpoint-every"
+                       else int, help=f"[output] {flag.replace('-', '_')}")
+    p.add_argument("--probe", action="append", type=float, default=None, metavar="X",
+                   help="also record u, velocity, moment and shear at x = X (m), with "
+                        "[output] probes (repeatable)")
+    p.add_argument("--resume", metavar="DIR", default=None,
+                   help="continue the stopped run in DIR from its last checkpoint (with "
+                        "none: run it again from step 0)")
+    return p
+
+
+def run_main(argv) -> int:
+    """``python -m skfem_beam run``: the scene through the scenes' own pipeline."""
+    from ..cli import stored_args
+    p = _run_parser()
+    args = stored_args(p.parse_args(argv), p, argv)
+    scene = _scene_of(args.scene, args.set, args.resume)
+    spec = _spec(scene, {k: v for k, v in vars(args).items() if k != "resume"}, args.resume)
+    name = f"scene {Path(args.scene).stem}" if args.scene else "scene"
+    if scene.kind == "bar":
+        from ..cases.impacting_bar import run_bar_case
+        return run_bar_case(scene.problem, spec)
+    from ..cases._beam import run_beam_case
+    return run_beam_case(name, scene.problem, spec, stops=_chart_stops(scene.problem))
+
+
+def _scene_of(path, sets, resume) -> Scene:
+    """The scene file (or, resuming, the text the run stored) with the --set overrides."""
+    from ..output.checkpoint import read_summary
+    stored = {}
+    if resume:
+        config = read_summary(Path(resume))["config"]
+        if "scene_text" not in config:
+            raise InputError(f"--resume {resume}: not a run of python -m skfem_beam run")
+        stored = {"text": config["scene_text"], "files": config.get("scene_files", {})}
+    elif path is None:
+        raise InputError("run needs a scene file: python -m skfem_beam run SCENE.toml")
+    return load(path or "scene.toml", sets or (), **stored)
+
+
+def _spec(scene: Scene, flags: dict, resume) -> RunSpec:
+    """The scene and the command line's flags (which override its [output] and [time] T)
+    as one RunSpec; summary.json's config records both, in the flags' names."""
+    given = flags.pop("probe", None) or []
+    for key, value in scene.output.items():
+        if key != "probes" and flags[key] is None:
+            flags[key] = value
+    flags["T"] = scene.stepping.T if flags["T"] is None else flags["T"]
+    flags["out"] = flags["out"] or f"out/{Path(flags['scene']).stem}"
+    options = OutputOptions(flags["out"], flags["overwrite"], resume, flags["format"],
+                            flags["frames"], flags["save_every"], flags["flush_every"],
+                            flags["checkpoint_every"])
+    stepping = replace(scene.stepping, T=flags["T"], save_every=options.save_every,
+                       frames=options.frames)
+    law, restitution = scene.law, scene.restitution
+    mass = scene.data.get("mesh", {}).get("mass", "consistent") if scene.kind == "beam" \
+        else scene.problem.mass
+    probes = [float(x) for x in np.atleast_1d(scene.output.get("probes", []))] + \
+        [x for x in given if x not in scene.output.get("probes", [])]
+    config = {"command": "python -m skfem_beam run", "scene_text": scene.text,
+              "scene_files": scene.files, **flags, "dt": stepping.dt, "beta": stepping.beta,
+              "method": "penalty" if law == "penalty" else "contact",
+              "law": law if law in methods.LAWS else "position",
+              "solver": "auto" if law in methods.LAWS or restitution else law,
+              "stiffness": scene.stiffness, "restitution": restitution, "mass": mass,
+              "massless": stepping.massless, "probe": probes}
+    return RunSpec(stepping, scene.method, options, config, mass, tuple(probes),
+                   wear(scene) if scene.kind == "beam" else None)
+
+
+def _chart_stops(problem: BeamProblem) -> tuple:
+    """The obstacle at the tip, for the tip chart (none when it has none)."""
+    lo, hi = problem.obstacles.bounds([problem.beam.L])
+    return tuple(float(g) for g in (lo[0], hi[0]) if np.isfinite(g))
+
+
+def _modes_parser() -> argparse.ArgumentParser:
+    from ..parser import Parser
+    p = Parser(prog="python -m skfem_beam modes",
+               description="Natural frequencies and mode shapes of a scene file's beam, with "
+                           "its ends and supports (obstacles ignored).")
+    p.add_argument("scene", help="the scene file (TOML)")
+    p.add_argument("--n", type=int, default=6, help="number of modes")
+    p.add_argument("--set", action="append", default=None, metavar="KEY=VALUE",
+                   help="override a key of the file (repeatable)")
+    p.add_argument("--out", default=None, help="write DIR/modes.csv")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing --out folder")
+    return p
+
+
+def modes_main(argv) -> int:
+    """``python -m skfem_beam modes``: natural frequencies of the scene's beam."""
+    from ..modes import modes
+    from ..two_planes import plane_problems
+    args = _modes_parser().parse_args(argv)
+    scene = load(args.scene, args.set or (), dynamic=False)
+    if scene.kind != "beam":
+        raise InputError(f"modes: {args.scene} is a {scene.kind}; modes are computed for "
+                         "beams")
+    out = None
+    if args.out is not None:
+        from ..output.folder import check_output_dir
+        out = check_output_dir(args.out, args.overwrite)
+    problem = scene.problem
+    # two planes: each plane's modes (its own EI), the lowest n of both, with their plane
+    planes = [("", modes(problem, args.n))] if problem.planes == 1 else \
+        [(p, modes(one, args.n)) for p, one in zip("vw", plane_problems(problem))]
+    rows = sorted(((m.f[i], m.omega[i], p, m.shapes[:, i]) for p, m in planes
+                   for i in range(m.f.size)), key=lambda r: r[0])[:args.n]
+    two = problem.planes == 2
+    print(f"{'mode':>4s}{' plane' if two else ''} {'f (Hz)':>14s} {'ω (rad/s)':>14s}")
+    for i, (f, w, p, _) in enumerate(rows, 1):
+        print(f"{i:4d}{p:>6s} {f:14.6g} {w:14.6g}" if two else f"{i:4d} {f:14.6g} {w:14.6g}")
+    if out is not None:
+        _write_modes(out, rows, planes[0][1].x, two)
+    return 0
+
+
+def _write_modes(out: Path, rows: list, x, two: bool) -> None:
+    """DIR/modes.csv: each mode's number, plane (two planes), f, ω and shape at ``x``."""
+    out.mkdir(parents=True, exist_ok=True)
+    with open(out / "modes.csv", "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["mode"] + (["plane"] if two else []) + ["f_Hz", "omega_rad_s"]
+                   + [f"u({float(xi):.12g})" for xi in x])
+        for i, (f, om, p, shape) in enumerate(rows, 1):
+            w.writerow([i] + ([p] if two else []) + [f"{f:.17g}", f"{om:.17g}"]
+                       + [f"{u:.17g}" for u in shape])
+    print(f"written: {out / 'modes.csv'}", file=sys.stderr)

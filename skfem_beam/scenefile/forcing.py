@@ -1,0 +1,146 @@
+"""What drives a beam: the support's [motion] and the [[loads]], each with its time
+function (a sine, a constant, a sum of sines, a table, band-limited noise or a PSD)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import InputError
+from ..problem import Load, Support
+from ..timefunctions import Constant, Sine, SumOfSines, Table, band_limited, psd_from_csv
+from .parts import need, plane_count
+from .read import Tables
+
+
+def _time_function(d: dict, where: str, reader: Tables):
+    """A time function from the keys of TIME (one form), or None when none is given."""
+    forms = [k for k in ("amplitude", "value", "sines", "table", "random", "psd") if k in d]
+    if "omega" in d and "amplitude" not in d:
+        forms.append("omega")
+    if len(forms) > 1:
+        raise InputError(f"[{where}] give one of amplitude/omega, value, sines, table, "
+                         f"random, psd (got {', '.join(forms)})")
+    if not forms:
+        return None
+    form = forms[0]
+    if form in ("amplitude", "omega"):
+        return Sine(d.get("amplitude", 0.0), d.get("omega", 0.0), d.get("phase", 0.0))
+    if form == "value":
+        return Constant(d["value"])
+    if form == "sines":
+        rows = d["sines"]
+        if not isinstance(rows, list) or not all(isinstance(r, list) and len(r) in (2, 3)
+                                                 for r in rows):
+            raise InputError(f"[{where}] sines must be [[amplitude, omega, phase], ...]")
+        return SumOfSines(tuple(r[0] for r in rows), tuple(r[1] for r in rows),
+                          tuple(r[2] if len(r) == 3 else 0.0 for r in rows))
+    if form == "table":
+        return Table.from_csv(reader.path(d["table"]))
+    if form == "psd":   # a one-sided PSD table f (Hz), S (unit²/Hz), synthesised with a seed
+        psd = d["psd"] if isinstance(d["psd"], dict) else {"table": d["psd"]}
+        if "table" not in psd:
+            raise InputError(f"[{where}] psd = {{ table = \"file.csv\", seed, df }} needs table")
+        return psd_from_csv(reader.path(psd["table"]), psd.get("seed", 0), psd.get("df"))
+    return band_limited(**d["random"])
+
+
+def support_of(data: dict, L: float, reader: Tables) -> Support:
+    m = data.get("motion")
+    if m is None:
+        return Support()
+    if "end" in m and "at" in m:
+        raise InputError("[motion] give end (left | right) or at (x of a support), not both")
+    at = m.get("at", 0.0)
+    if "end" in m:
+        ends = {"left": 0.0, "right": L}
+        if m["end"] not in ends:
+            raise InputError(f"[motion] end={m['end']!r} must be one of: left, right")
+        at = ends[m["end"]]
+    lifting = m.get("lifting", "auto")
+    direction = _direction(m, data, "motion")
+    time = {k: v for k, v in m.items() if k != "direction"}
+    if set(time) & {"amplitude", "omega"} and not set(time) & {"phase", "value", "sines",
+                                                                "table", "random", "psd"}:
+        return Support(m.get("amplitude", 0.0), m.get("omega", 0.0), at=at, lifting=lifting,
+                       direction=direction)
+    return Support(motion=_time_function(time, "motion", reader), at=at, lifting=lifting,
+                   direction=direction)
+
+
+def _direction(d: dict, data: dict, where: str) -> tuple[float, float]:
+    """A table's direction = [dy, dz] (two planes only; default the first plane)."""
+    from ..problem import check_direction
+    if "direction" not in d:
+        return (1.0, 0.0)
+    if plane_count(data) != 2:
+        raise InputError(f"[{where}] direction acts in the cross-section: it needs planes = 2")
+    return check_direction(f"[{where}] direction", d["direction"])
+
+
+def loads_of(data: dict, reader: Tables) -> tuple[Load, Load]:
+    """The loads of the first and the second plane: a load along ``direction`` = [dy, dz]
+    acts dy× in v and dz× in w; ``rotating`` = {amplitude, omega, phase} is
+    amplitude·cos(ωt + phase) in v and amplitude·sin(ωt + phase) in w (two planes)."""
+    total_v, total_w = Load(), Load()
+    for i, d in enumerate(data.get("loads", [])):
+        where = f"loads.{i}"
+        dy, dz = _direction(d, data, where)
+        d = {k: v for k, v in d.items() if k != "direction"}
+        if "rotating" in d:
+            if plane_count(data) != 2:
+                raise InputError(f"[{where}] rotating acts in the cross-section: it needs "
+                                 "planes = 2")
+            if "gravity" in d or (dy, dz) != (1.0, 0.0) or \
+                    set(d) & {"amplitude", "omega", "phase", "value", "sines", "table",
+                              "random", "psd"}:
+                raise InputError(f"[{where}] rotating is the load's time function and "
+                                 "direction: give it alone with x, distributed or per_mass")
+            rot = need(d["rotating"], ("amplitude", "omega"), f"{where}.rotating")
+            phase = d["rotating"].get("phase", 0.0)
+            rest = {k: v for k, v in d.items() if k != "rotating"}
+            total_v = total_v + _load(rest, where, Sine(rot["amplitude"], rot["omega"],
+                                                        phase + math.pi / 2))
+            total_w = total_w + _load(rest, where, Sine(rot["amplitude"], rot["omega"], phase))
+            continue
+        if "gravity" in d:
+            if len(d) > 1:
+                raise InputError(f"[{where}] gravity = g stands alone, with a direction in "
+                                 f"two planes (got {', '.join(d)})")
+            part = Load.gravity(d["gravity"])
+        else:
+            time = _time_function(d, where, reader)
+            if time is None:
+                raise InputError(f"[{where}] needs a time function: amplitude/omega, value, "
+                                 "sines, table, random or (two planes) rotating")
+            part = _load(d, where, time)
+        total_v, total_w = total_v + part.scaled(dy), total_w + part.scaled(dz)
+    return total_v, total_w
+
+
+def _load(d: dict, where: str, time) -> Load:
+    """One [[loads]] item's load with the time function ``time``."""
+    kinds = [k for k in ("x", "distributed", "per_mass") if d.get(k, False) is not False]
+    span = [k for k in ("x_from", "x_to") if k in d]
+    if span and kinds != ["distributed"]:
+        raise InputError(f"[{where}] x_from, x_to bound a distributed load (distributed = "
+                         "true)")
+    if len(kinds) != 1:
+        raise InputError(f"[{where}] needs one of x (a point force, N), distributed = "
+                         "true (N/m) or per_mass = true (m/s²)")
+    if kinds[0] == "x":
+        return Load(points=((d["x"], time),))
+    if kinds[0] == "distributed" and span:
+        a, b = need(d, ("x_from", "x_to"), where).values()
+        if not a < b:
+            raise InputError(f"[{where}] x_from={a:g} must be below x_to={b:g}")
+        return Load.distributed(_span(a, b), time)
+    if kinds[0] == "distributed":
+        return Load.distributed(1.0, time)
+    return Load.uniform(time)
+
+
+def _span(a: float, b: float):
+    """1 N/m on [a, b], 0 elsewhere (exact when a and b are mesh nodes; else the load
+    quadrature cuts the element there)."""
+    return lambda x: ((np.asarray(x) >= a) & (np.asarray(x) <= b)).astype(float)

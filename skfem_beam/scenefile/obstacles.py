@@ -1,0 +1,87 @@
+"""A beam's [[obstacles]]: the flat ones (numbers, polynomials or tables g1 ≤ v ≤ g2 at a
+point, over a span or along the whole beam) and the holes (two planes)."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import InputError
+from ..problem import Obstacles
+from .parts import need, plane_count
+
+
+def _g(value, where: str):
+    """An obstacle g: a number, {poly, about} or {x, g} (a table, linear between points)."""
+    if not isinstance(value, dict):
+        return value
+    if set(value) == {"poly", "about"} or set(value) == {"poly"}:
+        c = [float(v) for v in value["poly"]]
+        x0 = float(value.get("about", 0.0))
+
+        def poly(x):
+            d = np.asarray(x, dtype=float) - x0
+            out = c[0] + c[1] * d if len(c) > 1 else np.full(d.shape, c[0])
+            for k in range(2, len(c)):
+                out = out + c[k] * d**k
+            return out
+        return poly
+    if set(value) == {"x", "g"}:
+        xs, gs = np.asarray(value["x"], dtype=float), np.asarray(value["g"], dtype=float)
+        if xs.ndim != 1 or xs.shape != gs.shape or xs.size < 2 or np.any(np.diff(xs) <= 0):
+            raise InputError(f"{where} = {{x, g}}: x must increase, with one g per x (at "
+                             "least two)")
+        return lambda x: np.interp(np.asarray(x, dtype=float), xs, gs)
+    raise InputError(f"{where} must be a number, {{ poly = [c0, c1, ...], about = x0 }} or "
+                     f"{{ x = [...], g = [...] }} (got keys {', '.join(value)})")
+
+
+def _hole(o: dict, i: int, friction: float = 0.0):
+    """A [[obstacles]] hole = {...} at x or over [x_from, x_to] (holes.HoleAt); its
+    ``friction`` μ, else the scene's [contact] friction."""
+    from ..holes import HoleAt, hole_from_table
+    where = f"obstacles.{i}"
+    if "g1" in o or "g2" in o:
+        raise InputError(f"[{where}] a hole bounds (v, w) itself: leave out g1, g2")
+    hole = hole_from_table(o["hole"], f"{where}.hole")
+    mu = o.get("friction", friction)
+    if "x" in o:
+        if "x_from" in o or "x_to" in o:
+            raise InputError(f"[{where}] give x or x_from, x_to, not both")
+        return HoleAt(hole, o["x"], carried=o.get("carried", False), friction=mu)
+    a, b = need(o, ("x_from", "x_to"), where).values()
+    return HoleAt(hole, a, b, carried=o.get("carried", False), friction=mu)
+
+
+def _obstacle(o: dict, i: int) -> Obstacles:
+    where = f"obstacles.{i}"
+    g1, g2 = _g(o.get("g1", -np.inf), f"{where}.g1"), _g(o.get("g2", np.inf), f"{where}.g2")
+    carried = o.get("carried", False)
+    if "x" in o:
+        if "x_from" in o or "x_to" in o or callable(g1) or callable(g2):
+            raise InputError(f"[{where}] a point stop (x) takes numbers g1, g2 and no "
+                             "x_from/x_to")
+        return Obstacles.stops([o["x"]], g1, g2, carried=carried)
+    if "x_from" in o or "x_to" in o:
+        a, b = need(o, ("x_from", "x_to"), where).values()
+        return Obstacles.span(a, b, g1, g2, carried=carried)
+    return Obstacles(g1, g2, carried=carried)
+
+
+def obstacles_and_holes(data: dict) -> tuple[Obstacles, tuple]:
+    """The flat obstacles (the first plane's, g1 ≤ v ≤ g2) and the holes."""
+    items = list(enumerate(data.get("obstacles", [])))
+    mu = data.get("contact", {}).get("friction", 0.0)
+    holes = tuple(_hole(o, i, mu) for i, o in items if "hole" in o)
+    if (mu or any("friction" in o for _, o in items)) and plane_count(data) != 2:
+        raise InputError("friction acts along the wall of a hole, in the cross-section: the "
+                         "one-plane beam has no tangential direction (planes = 2 and a hole)")
+    for i, o in items:
+        if "friction" in o and "hole" not in o:
+            raise InputError(f"[obstacles.{i}] friction acts at a hole's wall: this obstacle "
+                             "has no hole")
+    if holes and plane_count(data) != 2:
+        raise InputError("[[obstacles]] hole bounds (v, w) in the cross-section: it needs "
+                         "planes = 2 at the top of the file")
+    parts = [_obstacle(o, i) for i, o in items if "hole" not in o]
+    if not parts:
+        return Obstacles(), holes
+    return (parts[0] if len(parts) == 1 else Obstacles.combine(*parts)), holes

@@ -1,0 +1,60 @@
+"""What the builders of a beam and a bar share: the keys a table needs, a [section], a
+[material] (a beam's checked for plausible units) and the number of bending planes."""
+from __future__ import annotations
+
+from ..errors import InputError
+from ..problem import Material, Section
+
+
+def need(d: dict, keys, where: str) -> dict:
+    missing = [k for k in keys if k not in d]
+    if missing:
+        raise InputError(f"[{where}] needs {', '.join(keys)} (missing {', '.join(missing)})")
+    return {k: d[k] for k in keys}
+
+
+# beyond these a value is more likely in the wrong unit than a material (rubber to
+# diamond; aerogel-free foams to osmium): one warning line, the run goes on
+PLAUSIBLE = {"E": (1e6, 1.2e12, "Pa"), "rho": (10.0, 23000.0, "kg/m³")}
+
+
+def material_of(d: dict, where: str, plausible: bool = True) -> Material:
+    """[material] E, rho; a beam's outside PLAUSIBLE warns (a bar's may be the papers'
+    dimensionless a = ρ = 1)."""
+    from ..cli import warn
+    material = Material(**need(d, ("E", "rho"), where))
+    for key, (low, high, unit) in PLAUSIBLE.items():
+        value = d[key]
+        if plausible and not low <= value <= high:
+            warn(f"[{where}] {key} = {value:g} {unit} is outside engineering materials "
+                 f"({low:g}–{high:g} {unit}): is it in {unit}?")
+    return material
+
+
+def section_of(d: dict, where: str) -> Section:
+    """A [section]: I and A, I_y, I_z and A (two planes: v along y bends with I_z, w
+    along z with I_y), tube, rod or rect."""
+    forms = [k for k in ("tube", "rod", "rect") if k in d] + (["I/A"] if set(d) & {
+        "I", "A", "I_y", "I_z"} else [])
+    if len(forms) != 1:
+        raise InputError(f"[{where}] needs one of I and A, I_y, I_z and A, tube, rod, rect "
+                         f"(got {', '.join(forms) or 'none'})")
+    if "I_y" in d or "I_z" in d:
+        if "I" in d:
+            raise InputError(f"[{where}] give I (one plane) or I_y and I_z, not both")
+        axes = need(d, ("I_y", "I_z", "A"), where)
+        return Section(axes["I_z"], axes["A"], axes["I_y"])
+    if "tube" in d:
+        return Section.tube(**need(d["tube"], ("outer_diameter", "wall"), f"{where}.tube"))
+    if "rod" in d:
+        return Section.rod(**need(d["rod"], ("diameter",), f"{where}.rod"))
+    if "rect" in d:
+        return Section.rect(**need(d["rect"], ("b", "h"), f"{where}.rect"))
+    return Section(**need(d, ("I", "A"), where))
+
+
+def plane_count(data: dict) -> int:
+    planes = data.get("planes", 1)
+    if planes not in (1, 2) or isinstance(planes, bool):
+        raise InputError(f"planes = {planes!r} must be 1 or 2 (bending planes)")
+    return int(planes)

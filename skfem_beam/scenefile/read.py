@@ -1,0 +1,134 @@
+"""A scene file read once: its text, parsed as TOML, its kind, the ``--set`` overrides
+applied and its shape checked against the schema (:class:`Parsed`, a plain object the
+builders read; nothing after :func:`read` opens the file again); the tables it names
+(:class:`Tables`); the shipped scene files (:func:`example`)."""
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..errors import InputError
+from .schema import BEAM_KEYS, KINDS, check_keys, key_path
+
+
+@dataclass(frozen=True)
+class Parsed:
+    """A scene file as read: ``path`` (relative tables are relative to its folder),
+    ``text`` (the file as read), ``data`` (the parsed TOML with the overrides), ``kind``
+    ("beam" or "bar") and ``files`` (the stored texts of its tables, path as written →
+    text: a resumed run's, else empty)."""
+    path: Path
+    text: str
+    data: dict
+    kind: str
+    files: dict
+
+
+def read(path, overrides=(), files: dict | None = None, text: str | None = None) -> Parsed:
+    """Read the scene file ``path`` once (or take its stored ``text``), parse it, apply
+    ``overrides`` (``KEY=VALUE`` strings as ``--set``) and check its keys and the values
+    the schema marks (every such error line names the file)."""
+    path = Path(path)
+    if text is None:
+        try:
+            text = path.read_text(encoding="utf-8")
+        except OSError as e:
+            raise InputError(f"cannot read the scene file {path}: {e.strerror}") from None
+        except UnicodeDecodeError:
+            raise InputError(f"{path}: not a UTF-8 text file") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise InputError(f"{path}: not valid TOML: {e}") from None
+    kind = data.get("kind", "beam")
+    if kind not in KINDS:
+        raise InputError(f"{path}: kind={kind!r} must be one of: {', '.join(KINDS)}")
+    sets = dict(apply_set(data, assignment) for assignment in overrides)
+    kind = data.get("kind", "beam")
+    try:
+        check_keys(data, KINDS[kind], sets=sets)
+    except InputError as e:
+        raise InputError(f"{path.name}: {e}") from None
+    return Parsed(path, text, data, kind, dict(files or {}))
+
+
+def _toml_value(text: str):
+    """``text`` as a TOML value (number, boolean, array, inline table, quoted string);
+    a bare word is a string (``--set ends.right=free``)."""
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        return text
+
+
+def apply_set(data: dict, assignment: str) -> tuple[str, str]:
+    """``KEY=VALUE`` (KEY dotted, array items by index: ``obstacles.0.g1``) into
+    ``data``; a key the scene's kind does not allow is refused by name.  Returns (KEY,
+    VALUE) as written."""
+    key, eq, text = assignment.partition("=")
+    if not eq or not key.strip():
+        raise InputError(f"--set {assignment!r}: expected KEY=VALUE, e.g. time.dt=1e-5")
+    parts = key.strip().split(".")
+    schema = KINDS.get(data.get("kind", "beam"), BEAM_KEYS)
+    node, sub = data, schema
+    for i, part in enumerate(parts):
+        last = i == len(parts) - 1
+        if isinstance(sub, list):
+            items = node
+            if not part.isdigit() or int(part) > len(items):
+                raise InputError(f"--set {key}: {key_path(parts[:i])} has {len(items)} "
+                                 f"item(s); index {part!r} must be 0..{len(items)}")
+            if int(part) == len(items):
+                items.append({})
+            node, sub = items[int(part)], sub[0]
+            if last:
+                raise InputError(f"--set {key}: name a key of the item, e.g. "
+                                 f"{key}.{next(iter(sub))}")
+            continue
+        if not isinstance(sub, dict) or part not in sub:
+            allowed = ", ".join(sub) if isinstance(sub, dict) else "none"
+            raise InputError(f"--set {key}: unknown key {part!r}; "
+                             f"{'[' + key_path(parts[:i]) + ']' if i else 'the top level'} "
+                             f"allows: {allowed}")
+        if last:
+            node[part] = _toml_value(text.strip())
+            return ".".join(parts), text.strip()
+        child = sub[part]
+        if isinstance(child, list):
+            node = node.setdefault(part, [])
+        else:
+            node = node.setdefault(part, {})
+        sub = child
+
+
+class Tables:
+    """Files named in the scene, relative to it; their texts are kept (``read``) so that a
+    run stores them, and a resumed run reads the stored texts (``stored``)."""
+
+    def __init__(self, base: Path, stored: dict):
+        self.base, self.stored, self.read, self.tmp = base, stored, {}, None
+
+    def path(self, name) -> Path:
+        if not isinstance(name, str):
+            raise InputError(f"table={name!r} must be a file name (a string)")
+        if name in self.stored:
+            p = self.tmp / f"{len(self.read)}_{Path(name).name}"
+            p.write_text(self.stored[name], encoding="utf-8")
+            self.read[name] = self.stored[name]
+            return p
+        p = Path(name) if Path(name).is_absolute() else self.base / name
+        try:
+            self.read[name] = p.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError):
+            pass    # the reader names the file and why (Table.from_csv)
+        return p
+
+
+def example(name: str) -> Path:
+    """The path of a shipped scene file (``skfem_beam/scene_files/NAME.toml``)."""
+    p = Path(__file__).resolve().parents[1] / "scene_files" / f"{Path(name).stem}.toml"
+    if not p.is_file():
+        shipped = sorted(q.stem for q in p.parent.glob("*.toml"))
+        raise InputError(f"no scene file {name!r}; shipped: {', '.join(shipped)}")
+    return p

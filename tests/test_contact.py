@@ -338,14 +338,15 @@ def test_a_python_law_with_a_force_inside_its_bounds_is_called_every_step():
     loop calls its solver on every step, in contact or not."""
     from skfem_beam.contact.daqp_solver import DAQP
     from skfem_beam.scheme import Run
+    from skfem_beam.scheme.beta import BetaScheme
     from skfem_beam.scheme.solve import drive
     from skfem_beam.scheme.stepping import Stepping
 
     class Everywhere(DAQP):
         name = "daqp-everywhere"
         free_inside = False
-    run = Run(beam_system(scenes.flat_obstacles(J=40)), Stepping(1e-3, 0.3, 0.5),
-              Everywhere())
+    run = Run(BetaScheme(beam_system(scenes.flat_obstacles(J=40)), Stepping(1e-3, 0.3, 0.5),
+              Everywhere()))
     engine, calls = run.pysolver, []
     engine_solve = engine.solve
     engine.solve = lambda *a: calls.append(1) or engine_solve(*a)

@@ -8,6 +8,7 @@ import pytest
 from skfem_beam import beam_system, scenes, solve
 from skfem_beam.bar import Bar, bar_system
 from skfem_beam.scheme import Run, Stepping
+from skfem_beam.scheme.beta import BetaScheme
 from skfem_beam.scheme.kernels import EVENT_COLUMNS
 from skfem_beam.scheme.solve import drive
 
@@ -75,7 +76,7 @@ def test_impact_events_add_up_and_survive_a_full_buffer():
     assert (ev["max_violation"] <= 1e-12).all()
     assert set(ev["x"]) <= set(system.x_contact) and (ev["x"] >= 5.0).all()
     # a loop whose event buffer fills every few impacts gives the same table
-    run = Run(system, Stepping(1e-3, 1.0), "auto")
+    run = Run(BetaScheme(system, Stepping(1e-3, 1.0), "auto"))
     run.out = run.out._replace(events=np.zeros((run.st.active.size + 3, len(EVENT_COLUMNS))))
     drive(run)
     small = run.impact_events()

@@ -17,6 +17,7 @@ from skfem_beam.contact import resolve
 from skfem_beam.output.events import COLUMNS, write_impacts
 from skfem_beam.results import read_csv, read_run
 from skfem_beam.scheme import Run, Stepping, drive
+from skfem_beam.scheme.beta import BetaScheme
 
 
 def run_case(main, tmp_path, name, argv):
@@ -83,7 +84,7 @@ def test_several_obstacles_are_grouped(tmp_path):
                                   Obstacles.span(1.05, 1.35, g1=-0.03))
     nodes = np.union1d(np.linspace(0, L, 21), [0.75, 1.05, 1.35])
     pb = BeamProblem(pipe.beam, obstacles, pipe.support, initial=pipe.initial, nodes=nodes)
-    run = Run(beam_system(pb), Stepping(1e-4, 0.4), resolve("auto", None))
+    run = Run(BetaScheme(beam_system(pb), Stepping(1e-4, 0.4), resolve("auto", None)))
     drive(run)
     stats = write_impacts(tmp_path, run, {"force": "N", "impulse": "N·s"},
                           pb.beam.rho_S, 1.0, obstacles)["impact_statistics"]
@@ -151,8 +152,8 @@ def test_impulses_are_the_contact_impulse_applied_along_the_span(tmp_path, law):
     # per node and per event, from the run's own forces (every state, every node)
     pb = scenes.flat_obstacles()
     stiffness = s["penalty_stiffness_N_per_m"]
-    run = Run(beam_system(pb), Stepping(s["dt"], s["T"], s["beta"]),
-              resolve(law, stiffness / (pb.beam.rho_S or 1.0) if stiffness else None))
+    run = Run(BetaScheme(beam_system(pb), Stepping(s["dt"], s["T"], s["beta"]),
+              resolve(law, stiffness / (pb.beam.rho_S or 1.0) if stiffness else None)))
     drive(run)
     ev, dt, lam = run.impact_events(), run.dt, run.result().contact_force   # states × nodes
     assert ev["impulse"].sum() * (pb.beam.rho_S or 1.0) == pytest.approx(applied, rel=1e-12)

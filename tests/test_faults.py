@@ -29,6 +29,7 @@ from skfem_beam.output import series
 from skfem_beam.output.folder import Folder
 from skfem_beam.results import read_run
 from skfem_beam.scheme import Run
+from skfem_beam.scheme.beta import BetaScheme
 
 CASE = [sys.executable, "-m", "skfem_beam.cases.point_stops"]
 LONG = ["--dt", "1e-5", "--T", "2", "--flush-every", "2000", "--frames", "10"]
@@ -171,7 +172,7 @@ def test_failed_solver_keeps_the_impacts_so_far(tmp_path, monkeypatch, capsys):
     ref = tmp_path / "ref"
     assert exit_code(point_stops.main, argv + ["--out", str(ref)]) == 0
     monkeypatch.setattr(PositionLevel, "build", lambda self, system, stepping:
-                        Run(system, stepping, GivesUp(430)))
+                        Run(BetaScheme(system, stepping, GivesUp(430))))
     out = tmp_path / "run"
     capsys.readouterr()
     assert exit_code(point_stops.main, argv + ["--out", str(out)]) == 3

@@ -16,7 +16,8 @@ from skfem_beam.holes import Hole, HoleAt
 from skfem_beam.problem import (Beam, BeamProblem, Damping, Load, Material, Section)
 from skfem_beam.scenefile import example, run_main
 from skfem_beam.scheme import Stepping, solve
-from skfem_beam.scheme.moreau_jean import MoreauJean
+from skfem_beam.scheme import Run
+from skfem_beam.scheme.moreau_jean import MoreauJeanScheme
 from skfem_beam.semidiscrete import beam_system
 from skfem_beam.timefunctions import Sine
 
@@ -35,7 +36,7 @@ def flow(mu, J=30, damping=Damping.ratio(0.02, 20.0, 200.0)):
 
 def test_the_cone_holds_and_slip_dissipates_at_every_step():
     mu = 0.3
-    run = MoreauJean(beam_system(flow(mu)), Stepping(1e-4, 0.3))
+    run = Run(MoreauJeanScheme(beam_system(flow(mu)), Stepping(1e-4, 0.3)))
     a = run.ops.disks
     stick = slip = 0
     for n in range(2, run.n_steps + 1):
@@ -80,7 +81,7 @@ def test_the_tube_sticks_until_the_pull_reaches_mu_times_the_static_normal_force
     assert 0 < T_star < mu * P
     # θ = 1: the quasi-static choice (θ = ½ keeps the settling's vibration of the normal
     # force at 3e-6 relative after 2 s, measured: above the threshold's 1e-6)
-    run = MoreauJean(system, Stepping(dt, t0 + 0.002 * T_star / a), theta=1.0)
+    run = Run(MoreauJeanScheme(system, Stepping(dt, t0 + 0.002 * T_star / a), theta=1.0))
     first = int(t0 / dt)
     run.advance(first)
     k = run.ops.disks[0]
@@ -256,7 +257,7 @@ def test_a_run_without_supports_prints_no_table_and_draws_no_wear_chart(tmp_path
 # ---------------------------------------------------------------- Siconos
 def recorded(count=30):
     """Moreau–Jean step problems with both holes in contact: nsgs's inputs and result."""
-    run = MoreauJean(beam_system(flow(0.3)), Stepping(1e-4, 0.5))
+    run = Run(MoreauJeanScheme(beam_system(flow(0.3)), Stepping(1e-4, 0.5)))
     ops, st = run.ops, run.st
     out = []
     for n in range(2, run.n_steps + 1):
@@ -273,7 +274,7 @@ def recorded(count=30):
 def problems(steps):
     """Re-run to each recorded step and rebuild its local problem in Siconos' form."""
     system = beam_system(flow(0.3))
-    run = MoreauJean(system, Stepping(1e-4, 0.5))
+    run = Run(MoreauJeanScheme(system, Stepping(1e-4, 0.5)))
     ops, st = run.ops, run.st
     found = []
     for n in steps:
@@ -372,7 +373,7 @@ def test_one_contact_is_solved_exactly_in_each_case():
 
 def test_a_step_that_misses_the_tolerance_stops_the_run_with_one_line():
     from skfem_beam.errors import SolverError
-    run = MoreauJean(beam_system(flow(0.3)), Stepping(1e-4, 0.3))
+    run = Run(MoreauJeanScheme(beam_system(flow(0.3)), Stepping(1e-4, 0.3)))
     run.scheme.ops = run.ops._replace(tol=-1.0)       # no sweep can meet it
     with pytest.raises(SolverError, match="did not reach .*residual"):
         run.advance(run.n_steps)
@@ -416,7 +417,7 @@ T = 0.01
 
 def test_a_restored_friction_run_goes_on_bit_for_bit():
     system = beam_system(flow(0.3))
-    a, c = resumed(lambda: MoreauJean(system, Stepping(1e-4, 0.2)), 777)
+    a, c = resumed(lambda: Run(MoreauJeanScheme(system, Stepping(1e-4, 0.2))), 777)
     assert np.array_equal(a.st.sectors, c.st.sectors)
     # the saved rows after the checkpoint (those before it are the caller's)
     assert np.array_equal(a.result().work["friction"][778:], c.result().work["friction"][778:])

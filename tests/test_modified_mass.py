@@ -85,12 +85,13 @@ def test_point_stops_with_load_and_moving_support(massless):
     mass and centre of mass kept, no nodal penetration, the energy identity closed."""
     from skfem_beam import beam_system
     from skfem_beam.scheme import Run, Stepping, drive
+    from skfem_beam.scheme.beta import BetaScheme
     s0 = beam_system(scenes.point_stops())
     s = redistributed(s0)
     R = rigid_modes(s.space)
     assert s.loads.shape[1] == 2
     assert np.allclose(moments(s.M, R), moments(s0.M, R), rtol=1e-14, atol=0)  # 2e-16
-    run = Run(s, Stepping(5e-5, 0.3, 0.5, massless=massless))
+    run = Run(BetaScheme(s, Stepping(5e-5, 0.3, 0.5, massless=massless)))
     drive(run)
     r = run.result()
     assert r.status == "success" and r.impacts > 20                  # 28 / 69 measured
@@ -125,7 +126,7 @@ def test_quasi_static_refusals(solver, massless, word):
     from skfem_beam.scheme import Run, Stepping
     s = bar_system(scenes.periodic_rod(20, mass="redistributed"))
     with pytest.raises(InputError, match=word):
-        Run(s, Stepping(0.01, 1.0, 0.25, massless=massless), solver)
+        Run(BetaScheme(s, Stepping(0.01, 1.0, 0.25, massless=massless), solver))
 
 
 def test_command_line_massless_reaches_the_run(tmp_path):
@@ -175,8 +176,9 @@ def test_quasi_static_quarter_can_gain_energy_on_the_chattering_pipe(beta, dt, g
     energy identity closes in every case, so the work columns show it."""
     from skfem_beam import beam_system
     from skfem_beam.scheme import Run, Stepping, drive
+    from skfem_beam.scheme.beta import BetaScheme
     s = redistributed(beam_system(scenes.point_stops()))
-    run = Run(s, Stepping(dt, 0.3, beta, massless="quasi-static"))
+    run = Run(BetaScheme(s, Stepping(dt, 0.3, beta, massless="quasi-static")))
     drive(run, progress=False)
     r = run.result()
     assert r.status == "success" and r.max_nodal_violation == 0.0

@@ -106,12 +106,13 @@ def test_interior_probe_adds_the_support_motion():
     # ũ(x) = u(x) + h(x)φ(t) and k²ũ'' at x = 0.8 (inside an element), from the saved
     # coefficient frames evaluated independently
     from skfem_beam.scheme import Run, Stepping, drive
+    from skfem_beam.scheme.beta import BetaScheme
     from skfem_beam.contact import resolve
     from skfem_beam.problem import lifting
     pb = scenes.point_stops()
     s = beam_system(pb)
     add_probes(s, [0.8])
-    run = Run(s, Stepping(1e-4, 0.2, 0.5, 1, 2000), resolve("auto", None))
+    run = Run(BetaScheme(s, Stepping(1e-4, 0.2, 0.5, 1, 2000), resolve("auto", None)))
     drive(run)
     cols, r = probe_columns(run, 0, run.n + 1), run.result()
     k = np.arange(0, run.n + 1, run.frame_every)

@@ -18,6 +18,7 @@ from skfem_beam.problem import (Beam, BeamProblem, Damping, Load, Material, Obst
 from skfem_beam.reference import whirl_force
 from skfem_beam.scenefile import example, run_main
 from skfem_beam.scheme import Run, Stepping, solve
+from skfem_beam.scheme.beta import BetaScheme
 from skfem_beam.semidiscrete import beam_system
 from skfem_beam.timefunctions import Sine
 
@@ -104,7 +105,7 @@ def recorded_problems(count=40):
                         holes=(HoleAt(Hole.round(R), 0.45, 0.55), HoleAt(Hole.round(R), 1.0)),
                         load=Load.distributed(1.0, Sine(900.0, 2 * np.pi * 30, np.pi / 2)),
                         load_w=Load.distributed(1.0, Sine(900.0, 2 * np.pi * 30)))
-    run = Run(beam_system(scene), Stepping(1e-4, 0.2))
+    run = Run(BetaScheme(beam_system(scene), Stepping(1e-4, 0.2)))
     kind = disk_kinds(run.st.yf.size, run.scheme.step.disks)
     out = []
     for n in range(2, 2000):
@@ -310,7 +311,7 @@ def test_bad_two_plane_scenes_are_refused_in_one_line(tmp_path, capsys, extra, w
 def test_a_restored_two_plane_run_goes_on_bit_for_bit():
     from skfem_beam.scenefile import load
     system = beam_system(load(example("tube_round_holes")).problem)
-    a, c = resumed(lambda: Run(system, Stepping(1e-4, 0.3)), 1234)
+    a, c = resumed(lambda: Run(BetaScheme(system, Stepping(1e-4, 0.3))), 1234)
     assert np.array_equal(a.st.rowwork, c.st.rowwork) and a.result().impacts > 20
 
 

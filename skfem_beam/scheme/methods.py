@@ -12,8 +12,10 @@ pairs a one-step integrator with a non-smooth law.
 
 Each owns its default β (the papers: 1/2 for exact contact, 1/4 for springs), its checks,
 its units and how it builds its run (``method.build(system, stepping)``: a :class:`.run.Run`
-or a :class:`.moreau_jean.MoreauJean`); :func:`.solve.solve` takes one as ``method=``.  They are importable from :mod:`skfem_beam.methods` too, where the command
-line's and the scene file's words name them (``methods.make``).
+of its one-step integrator, :class:`.beta.BetaScheme` or
+:class:`.moreau_jean.MoreauJeanScheme`); :func:`.solve.solve` takes one as ``method=``.
+They are importable from :mod:`skfem_beam.methods` too, where the command line's and the
+scene file's words name them (``methods.make``).
 """
 from __future__ import annotations
 
@@ -24,7 +26,9 @@ from ..checks import check_choice, check_nonnegative, check_positive, check_rest
 from ..contact import ContactLaw, resolve
 from ..contact.penalty import Penalty as PenaltyLaw
 from ..contact.restitution import Restitution
-from .moreau_jean import NAME as MOREAU_JEAN, MoreauJean as MoreauJeanRun, check_theta
+from ..errors import Deferred
+from .beta import BetaScheme
+from .moreau_jean import NAME as MOREAU_JEAN, MoreauJeanScheme, check_theta
 from .run import Run
 from .stepping import MASSLESS
 
@@ -37,6 +41,13 @@ def mass_scale(system) -> float:
     if view is not None and view.kind == "beam" and view.rho_S:
         return view.rho_S
     return 1.0
+
+
+def beta_run(system, stepping, law: ContactLaw) -> Run:
+    """A run of the β-scheme with ``law`` (PositionLevel's and Penalty's build)."""
+    with Deferred():               # signals wait while the kernels compile or load
+        scheme = BetaScheme(system, stepping, law)
+    return Run(scheme)
 
 
 @dataclass(frozen=True)
@@ -58,8 +69,8 @@ class PositionLevel:
     def law(self, system) -> ContactLaw:
         return resolve(self.solver, None, self.restitution)
 
-    def build(self, system, stepping):
-        return Run(system, replace(stepping, massless=self.massless), self.law(system))
+    def build(self, system, stepping) -> Run:
+        return beta_run(system, replace(stepping, massless=self.massless), self.law(system))
 
 
 @dataclass(frozen=True)
@@ -90,8 +101,8 @@ class Penalty:
         return PenaltyLaw(self.stiffness / scale, self.damping / scale,  # the one conversion
                           self.implicit)
 
-    def build(self, system, stepping):     # the quasi-static massless rows refuse springs
-        return Run(system, replace(stepping, massless=self.massless), self.law(system))
+    def build(self, system, stepping) -> Run:   # the quasi-static massless rows refuse springs
+        return beta_run(system, replace(stepping, massless=self.massless), self.law(system))
 
 
 @dataclass(frozen=True)
@@ -108,8 +119,10 @@ class MoreauJean:
         object.__setattr__(self, "theta", check_theta(self.theta))
         object.__setattr__(self, "restitution", check_restitution(self.restitution))
 
-    def build(self, system, stepping):
-        return MoreauJeanRun(system, stepping, self.theta, self.restitution)
+    def build(self, system, stepping) -> Run:
+        with Deferred():           # signals wait while the kernels compile or load
+            scheme = MoreauJeanScheme(system, stepping, self.theta, self.restitution)
+        return Run(scheme)
 
 
 Method = Union[PositionLevel, Penalty, MoreauJean]

@@ -45,7 +45,7 @@ from ..checks import check_finite
 from ..contact.active_set import box_qp
 from ..contact.base import ContactLaw
 from ..contact.restitution import Restitution
-from ..errors import Deferred, InputError
+from ..errors import InputError
 from ..linalg import Banded, band_solve, rows_dot, rows_matvec
 from .beta import (disk_rows, friction_of, hole_arrays, observers, penetration_samples,
                    refuse_lands, start_positions, two_plane_state)
@@ -54,7 +54,6 @@ from .kernels import (EVENT_COLUMNS, FAILED, FRICTION, IMPACT_FIELDS, ITERATIONS
                       STOPPED_AT, UNSTABLE, Inputs, Series, csr_product, hole_kinematics,
                       track_impacts)
 from .operators import csr_arrays, load_norms, step_operators
-from .run import Run
 from .stepping import Stepping
 
 MJOps = namedtuple("MJOps", [
@@ -363,13 +362,3 @@ class MoreauJeanScheme:
         return (f": friction's Gauss–Seidel did not reach {self.ops.tol:g} in "
                 f"{MAX_SWEEPS} sweeps (residual {self.st.fres[0]:.3g})")
 
-
-class MoreauJean(Run):
-    """A Moreau–Jean run of ``system`` on ``stepping`` (its β is not used), with
-    ``theta`` ∈ [1/2, 1] and Newton restitution ``restitution`` ∈ [0, 1]: the driver of
-    :class:`Run` over :class:`MoreauJeanScheme` (chunks, events, checkpoints)."""
-
-    def __init__(self, system, stepping: Stepping, theta: float = 0.5,
-                 restitution: float = 0.0):
-        with Deferred():           # signals wait while the kernels compile or load
-            self._drive(MoreauJeanScheme(system, stepping, theta, restitution))

@@ -8,13 +8,11 @@ import time
 
 import numpy as np
 
-from ..contact import ContactLaw
 from ..errors import Deferred, InputError, SolverError
 from ..stability import kappa_h, linear_limit
-from .beta import BetaScheme
 from .kernels import (EVENT_COLUMNS, EVENTS_FULL, EVENTS_WRITTEN, FAILED, ROW0, STOPPED_AT,
                       UNSTABLE, WORK_TERMS, Inputs, PythonLaw)
-from .stepping import Result, Stepping
+from .stepping import Result
 
 FIRST_ROWS = 1 << 15      # saved rows allocated at first; more as a chunk needs them
 SAVED = ("obs", "obsv", "energy", "work", "lam", "resid")   # the saved series, by row
@@ -54,9 +52,10 @@ class SavedRows:
 
 
 class Run:
-    """A run of ``system`` on the grid ``stepping``: with ``law`` (a name of
-    ``contact.LAWS``, "auto", or a law object) the β-scheme (:class:`.beta.BetaScheme`);
-    :class:`~.moreau_jean.MoreauJean` drives Moreau–Jean the same way.
+    """A run of a one-step integrator ``scheme`` (:class:`.beta.BetaScheme`,
+    :class:`.moreau_jean.MoreauJeanScheme`: each holds its system, its time grid and its
+    law) over the grid, the same for every method; ``method.build(system, stepping)``
+    (:mod:`.methods`) makes one.
 
     ``advance(n1)`` steps up to state n1; ``checkpoint()``/``restore()`` give the full
     state (the integrator's fields, warm starts, running diagnostics), so that a restored
@@ -66,13 +65,13 @@ class Run:
 
     _next = ((-1, -1), None)   # the next chunk's (n0, n1) and inputs, computed ahead (advance)
 
-    def __init__(self, system, stepping: Stepping, law: str | ContactLaw = "auto"):
+    def __init__(self, scheme):
         with Deferred():           # signals wait while the kernels compile or load
-            self._drive(BetaScheme(system, stepping, law))
+            self._drive(scheme)
 
     def _drive(self, scheme) -> None:
-        """Take ``scheme`` (a one-step integrator: BetaScheme, MoreauJeanScheme) from its
-        first state: buffers, the start, the compiled loop loaded outside the timed loop."""
+        """Take ``scheme`` from its first state: buffers, the start, the compiled loop
+        loaded outside the timed loop."""
         self.scheme, self.system, self.stepping = scheme, scheme.system, scheme.stepping
         self.dt, self.beta, self.theta = scheme.dt, scheme.beta, scheme.theta
         self.n_steps, self.save_every = scheme.n_steps, scheme.save_every

@@ -124,6 +124,7 @@ def test_quasi_static_massless_node_does_not_oscillate(courant):
     ("auto", "midpoint", "massless='midpoint' is not one of")])
 def test_quasi_static_refusals(solver, massless, word):
     from skfem_beam.scheme import Run, Stepping
+    from skfem_beam.scheme.beta import BetaScheme
     s = bar_system(scenes.periodic_rod(20, mass="redistributed"))
     with pytest.raises(InputError, match=word):
         Run(BetaScheme(s, Stepping(0.01, 1.0, 0.25, massless=massless), solver))

@@ -2,17 +2,17 @@
 contact's exact local solve (circle, cone, slip against the force, the stick/slip
 threshold), μ = 0 as the frictionless round-hole run bit for bit, the shipped friction
 scene (no penetration, the energy identity with friction work, dissipation at every
-step) and the whirl on a rough wall."""
+step), the whirl on a rough wall and the static stick/slip threshold."""
 import numpy as np
 import pytest
 
 from skfem_beam import methods
 from skfem_beam.contact.round_hole_friction import (SEPARATE, SLIP_BACKWARD, SLIP_FORWARD,
-                                                    STICK, coulomb_disk)
+                                                    STICK, RoundHoleFriction, coulomb_disk)
 from skfem_beam.holes import Hole, HoleAt
 from skfem_beam.problem import Beam, BeamProblem, Damping, Load, Material, Section
 from skfem_beam.scenefile import example, load
-from skfem_beam.scheme import solve
+from skfem_beam.scheme import Run, Stepping, solve
 from skfem_beam.semidiscrete import beam_system
 from skfem_beam.timefunctions import Sine
 
@@ -131,3 +131,41 @@ def test_a_rough_round_hole_is_never_penetrated_under_a_rotating_force():
     assert (np.hypot(p[:, 0], p[:, 1]) - R).max() <= 1e-12 * R
     w = rough.work["friction"]
     assert w[-1] < 0 and np.diff(w).max() <= 1e-15 * abs(w[-1])
+
+
+def test_the_tube_sticks_until_the_pull_reaches_mu_times_the_static_normal_force():
+    """tests/test_friction.py's static threshold at position level: P = 60 N presses the
+    node at x = 0.75 on its wall along +v, a pull along w grows from 0.999 T* (T* = μN of
+    the discrete static analysis); the node sticks (|λ_t| < μλ_n) until the pull reaches
+    T* to within the settling's vibration (β = ½ damps none of it: 2.3e-6, measured)."""
+    mu, P, t0, a, dt = 0.3, 60.0, 1.0, 0.01, 1e-4
+
+    class Pull:
+        def __call__(self, t):
+            t = np.asarray(t, dtype=float)
+            return np.where(t < t0, 0.0, 0.999 * T_star + a * (t - t0))
+
+    system = beam_system(BeamProblem(TUBE, J=10, ends=("pinned", "pinned"), planes=2,
+                                     damping=Damping(alpha=100.0),
+                                     holes=(HoleAt(Hole.round(R), 0.75, friction=mu),),
+                                     load=Load.point(0.75, P),
+                                     load_w=Load(points=((0.75, Pull()),))))
+    n = system.meta["n_plane"]
+    e = system.C[0, :n].toarray().ravel()
+    T_star = mu * (P - TUBE.rho_S * R / (e @ np.linalg.solve(system.K[:n, :n].toarray(), e)))
+    run = Run(system, Stepping(dt, t0 + 0.002 * T_star / a, 0.5), RoundHoleFriction())
+    run.advance(int(t0 / dt))
+
+    def cone_ratio():
+        y, m, c = run.st.y_cur, run.st.mu, 0.5 * (run.st.lo + run.st.hi)
+        nv = np.array([y[0] - c[0], y[1] - c[1]]) / R
+        return abs(-nv[1] * m[0] + nv[0] * m[1]) / (mu * -(nv[0] * m[0] + nv[1] * m[1]))
+
+    for step in range(int(t0 / dt) + 1, run.n_steps + 1):
+        run.advance(step)
+        if cone_ratio() >= 1 - 1e-12:        # the first slip
+            T = float(Pull()(step * dt))
+            break
+    else:
+        pytest.fail("the tube never slipped")
+    assert abs(T / T_star - 1) <= 1e-5

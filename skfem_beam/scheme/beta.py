@@ -197,8 +197,8 @@ class BetaScheme:
         self.law = law = self._law(law, m)
         if friction(system) and not law.friction:
             raise InputError(f"Coulomb friction needs law = round-hole-friction (or auto: "
-                             f"exact contact, position level) or moreau-jean (velocity "
-                             f"level), not {law.name}")
+                             f"exact contact at position level) or moreau-jean (a "
+                             f"velocity-level law), not {law.name}")
         if law.name != "round-hole":
             refuse_lands(system, f"the {law.name} law")
         if self.step.disks.size and not law.round_holes:

@@ -6,6 +6,7 @@ step), the whirl on a rough wall and the static stick/slip threshold."""
 import numpy as np
 import pytest
 
+from conftest import resumed
 from skfem_beam import methods
 from skfem_beam.contact.round_hole_friction import (SEPARATE, SLIP_BACKWARD, SLIP_FORWARD,
                                                     STICK, RoundHoleFriction, coulomb_disk)
@@ -169,3 +170,10 @@ def test_the_tube_sticks_until_the_pull_reaches_mu_times_the_static_normal_force
     else:
         pytest.fail("the tube never slipped")
     assert abs(T / T_star - 1) <= 1e-5
+
+
+def test_a_restored_position_level_friction_run_goes_on_bit_for_bit():
+    system = beam_system(whirl(0.3))
+    a, c = resumed(lambda: Run(system, Stepping(1e-4, 0.1, 0.5), RoundHoleFriction()), 555)
+    assert np.array_equal(a.st.rowwork, c.st.rowwork)
+    assert np.array_equal(a.result().work["friction"][556:], c.result().work["friction"][556:])

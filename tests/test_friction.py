@@ -382,7 +382,7 @@ def test_a_step_that_misses_the_tolerance_stops_the_run_with_one_line():
 @pytest.mark.parametrize("extra, word", [
     ("[contact]\nfriction = 0.3\n", "no tangential direction"),
     ("planes = 2\n[[obstacles]]\nx = 0.5\nhole = { radius = 4e-4 }\nfriction = 0.3\n"
-     "[contact]\nlaw = \"position\"\n", "velocity-level"),
+     "[contact]\nlaw = \"round-hole\"\n", "velocity-level"),
     ("planes = 2\n[[obstacles]]\nx = 0.5\nhole = { sides = 3, radius = 4e-4 }\nfriction = 0.3\n",
      "frictionless"),
 ])

@@ -15,6 +15,8 @@ and then x = x_free + W μ; μ/Δt² are the nodal contact forces.  Laws (regist
 - ``daqp``: exact dual active-set QP (daqp's Model).
 - ``penalty``: normal compliance, one-sided springs (needs a stiffness).
 - ``restitution``: exact contact with a Newton coefficient of restitution e (Paoli–Schatzman).
+- ``round-hole``: exact contact in round holes (second-order cones), boxes beside them.
+- ``round-hole-friction``: the same with Coulomb friction on the step's slip.
 - ``auto``: the cheapest exact one for the scene.
 
 The protocol a law follows (and how to write one) is in :mod:`.base`; ``register(name,

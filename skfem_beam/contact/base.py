@@ -118,6 +118,8 @@ class StepData:
     lands: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     #                     (q, 3) per disk: (lands, half width, angle) of a broached hole
     #                     (contact.lands), (0, 0, 0) a round one; (0, 3): all round
+    friction: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    #                     Coulomb's μ per row (a round hole's first row; none: (0,))
 
     @property
     def decoupled(self) -> bool:
@@ -138,6 +140,7 @@ class ContactLaw:
     round_holes = False  # takes StepData.disks (round holes); the others refuse them
     springs = False      # the obstacles are springs: a penetration is a support's
     #                      deflection (physics), not a numerical error
+    friction = False     # takes Coulomb friction (StepData.friction); the others refuse it
 
     def setup(self, step: StepData, first: bool = False) -> np.ndarray:
         return np.zeros(0)

@@ -3,6 +3,8 @@ user's (then named by ``--solver``, a scene file's ``[contact] law`` and
 ``PositionLevel(solver=)`` like the shipped ones, with no edit of the front end)."""
 from __future__ import annotations
 
+import numpy as np
+
 from ..errors import InputError
 from .active_set import ActiveSet
 from .base import ContactLaw, StepData
@@ -12,6 +14,7 @@ from .penalty import Penalty
 from .projection import Projection
 from .restitution import Restitution
 from .round_hole import RoundHole
+from .round_hole_friction import RoundHoleFriction
 
 LAWS = {
     "projection": Projection,
@@ -21,6 +24,7 @@ LAWS = {
     "penalty": Penalty,      # needs stiffness=
     "restitution": Restitution,   # needs restitution= (e)
     "round-hole": RoundHole,      # round holes (and boxes beside them), exact
+    "round-hole-friction": RoundHoleFriction,   # ... with Coulomb friction, exact contact
 }
 
 
@@ -93,12 +97,16 @@ def resolve(law: str | ContactLaw = "auto", stiffness: float | None = None,
 
 
 class Auto(ContactLaw):
-    """The exact round-hole law where there are round holes; else projection when the
-    constraints are decoupled, the exact active set when not."""
+    """The exact round-hole law where there are round holes (with Coulomb friction when a
+    hole has μ > 0); else projection when the constraints are decoupled, the exact active
+    set when not."""
     name = "auto"
 
     @staticmethod
     def choose(step: StepData) -> ContactLaw:
+        fric = np.asarray(step.friction, dtype=float)
+        if step.disks.size and fric.size and np.any(fric[step.disks[:, 0]] > 0):
+            return RoundHoleFriction()
         if step.disks.size:
             return RoundHole()
         return Projection() if step.decoupled else ActiveSet()

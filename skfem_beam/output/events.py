@@ -167,8 +167,12 @@ def write_impacts(folder: Path, run, units: dict, scale: float = 1.0, sign: floa
         stats["units"].update({"slip": "m, Σ|u_t|Δt over the contact",
                                "friction_impulse": i + ", Σ|p_t| over the contact"})
         from ..scheme.moreau_jean import NSGS_TOL
+        coefficients = sorted({float(m) for m in run.system.friction if m > 0})
+        if not hasattr(run.st, "fres"):    # position level: each block exact, no NSGS
+            return {"impact_statistics": stats, "friction": {"coefficients": coefficients,
+                                                             "law": run.solver}}
         return {"impact_statistics": stats, "friction": {
-            "coefficients": sorted({float(m) for m in run.system.friction if m > 0}),
+            "coefficients": coefficients,
             "nsgs_tolerance": NSGS_TOL, "nsgs_max_residual": float(run.st.fres[1])}}
     return {"impact_statistics": stats}
 

@@ -136,7 +136,7 @@ def support_statistics(table: dict, run, scale: float, duration: float, T: float
             "impact_angle_histogram": {"edges_rad": edges.tolist(), "counts": counts.tolist()},
             "impact_work_rate": -scale * float(work[rows, 0].sum()) / T,
             "normal_work_rate": _normal_work_rate(run, rows, scale, T)}
-        if run.st.fc.shape[0]:
+        if run.st.fc.shape[0] or "friction" in run.work_terms:
             entry["friction_work_rate"] = -scale * float(work[rows, 2].sum()) / T
         if wear is not None:
             entry["wear"] = support_wear(run, x, scale, T, wear)

@@ -20,9 +20,9 @@ from ..contact.registry import Auto
 from ..contact.round_hole import disk_kinds
 from ..errors import InputError, SolverError
 from ..linalg import band_solve, rows_matvec
-from .kernels import (CALLEES, EVENT_COLUMNS, IMPACT_FIELDS, NC_COLUMNS, SECTORS, Inputs, Ops,
-                      PythonLaw, Series, State, csr_product, energy_beta, move_bounds, record,
-                      run_steps, run_steps_python)
+from .kernels import (CALLEES, EVENT_COLUMNS, FRICTION_COLUMN, IMPACT_FIELDS, NC_COLUMNS,
+                      SECTORS, Inputs, Ops, PythonLaw, Series, State, csr_product, energy_beta,
+                      move_bounds, record, run_steps, run_steps_python)
 from .operators import csr_arrays, load_norms, step_operators
 from .stepping import Stepping
 
@@ -193,11 +193,12 @@ class BetaScheme:
             self.op = op = step_operators(system, s.dt, s.beta, s.massless)
         self.step = StepData(op.A, op.C, op.D, np.ascontiguousarray(system.lo, dtype=float),
                              np.ascontiguousarray(system.hi, dtype=float), s.dt, s.beta,
-                             disk_rows(system), land_rows(system))
+                             disk_rows(system), land_rows(system), friction_of(system))
         self.law = law = self._law(law, m)
-        if friction(system):
-            raise InputError("Coulomb friction is a velocity-level law: run it with law = "
-                             "moreau-jean (the β-scheme's contact is frictionless)")
+        if friction(system) and not law.friction:
+            raise InputError(f"Coulomb friction needs law = round-hole-friction (or auto: "
+                             f"exact contact at position level) or moreau-jean (a "
+                             f"velocity-level law), not {law.name}")
         if law.name != "round-hole":
             refuse_lands(system, f"the {law.name} law")
         if self.step.disks.size and not law.round_holes:
@@ -237,7 +238,16 @@ class BetaScheme:
         return Ops(s.dt, s.beta, s.save_every, s.frame_every, op.Kb.rows, op.Bb, op.Ab.chol,
                    op.Eb.rows, self.loads, *csr_arrays(op.C), step.lo, step.hi, shift, sshift,
                    op.W, op.D, *csr_arrays(self.Orows), *samples, slo, shi, params, op.Z,
-                   *csr_arrays(system.K.tocsr()[op.Z]), *hole_arrays(system))
+                   *csr_arrays(system.K.tocsr()[op.Z]), *self._holes())
+
+    def _holes(self):
+        """hole_arrays, and Nc's column FRICTION_COLUMN ← each round hole's μ when the law
+        takes friction (kernels.friction_split: its work is then split off the contact's)."""
+        arrays = hole_arrays(self.system)
+        if self.law.friction and arrays[-1].shape[0]:
+            first = arrays[1]
+            arrays[-1][first, FRICTION_COLUMN] = friction_of(self.system)[first]
+        return arrays
 
     def _state(self) -> State:
         """The loop's state (kernels.State), by field name."""

@@ -42,12 +42,14 @@ Ops = namedtuple("Ops", [
     #                                   row's index, its second row −1, other rows 0
     "disks",                          # the round holes' first rows
     "Np", "Ni", "Nx", "Nc",           # two planes: each row's node (v, w) as CSR rows 2j,
-    #                                   2j+1, and [cy, cz, sy, sz, ny, nz, n, h, a]: its hole's
-    #                                   centre at rest, the centre's motion per unit φ, the
-    #                                   row's normal ((0, 0): radial, a round hole), a
+    #                                   2j+1, and [cy, cz, sy, sz, ny, nz, n, h, a, f]: its
+    #                                   hole's centre at rest, the centre's motion per unit
+    #                                   φ, the row's normal ((0, 0): radial, a round hole), a
     #                                   broached hole's lands, half width, first land's angle
     #                                   (both rows of its pair; n = 0: not broached, see
-    #                                   contact.lands); none: 1 plane
+    #                                   contact.lands), a round hole's Coulomb μ when the
+    #                                   β-scheme's law takes friction (first row; else 0,
+    #                                   see friction_split); none: 1 plane
 ])
 State = namedtuple("State", [
     "u_prev", "u_cur",                # uⁿ⁻¹, uⁿ
@@ -80,8 +82,9 @@ Series = namedtuple("Series", ["obs", "obsv", "energy", "work", "lam", "frames_u
 # H: the load at the quasi-static massless rows, (1−2β)fⁿ + βfⁿ⁻¹ there (0 rows: none)
 Inputs = namedtuple("Inputs", ["G", "phi", "H"], defaults=(np.zeros((0, 0)),))
 WORK_TERMS = ("damping", "input", "contact")   # the columns of State.work and Series.work
-FRICTION = 3           # ... and the friction work's (Moreau–Jean with friction only)
-NC_COLUMNS = 9         # Ops.Nc's columns
+FRICTION = 3           # ... and the friction work's (runs with friction only)
+NC_COLUMNS = 10        # Ops.Nc's columns
+FRICTION_COLUMN = 9    # ... the one of a round hole's μ (the β-scheme's friction law)
 SECTORS = 12           # the hole's angular sectors of the normal work (State.sectors)
 EVENT_COLUMNS = ("value", "start_step", "end_step", "velocity", "peak_force", "impulse",
                  "max_violation", "angle", "normal_velocity", "tangential_velocity", "slip",
@@ -387,6 +390,32 @@ def normal_of(ops, j, px, py):
     return nx, ny
 
 
+@njit(cache=True, inline="always")
+def friction_split(mu, dy, at, work, rowwork, ev, a, b, dt):
+    """The β-scheme with Coulomb friction (contact.round_hole_friction), after the step:
+    the round hole (a, b)'s tangential work ½ λ_t s/Δt² (t the wall's tangent at y^{n+1},
+    μ_t = t·μ_p, s = t·(y^{n+1} − y^{n−1}) = t·dy) moves from the contact's column to the
+    friction's (FRICTION, rowwork's column 2); the event under way gets the slip |s|/2
+    (= |u_t|Δt, u_t = s/(2Δt)) and the impulse |μ_t|/Δt.  ``at``: (y^{n+1}, lo, hi)."""
+    y, lo, hi = at
+    pa = y[a] - 0.5 * (lo[a] + hi[a])
+    pb = y[b] - 0.5 * (lo[b] + hi[b])
+    rho = np.hypot(pa, pb)
+    if rho == 0.0 or (mu[a] == 0.0 and mu[b] == 0.0):
+        return
+    ta, tb = -pb / rho, pa / rho
+    mt, s = ta * mu[a] + tb * mu[b], ta * dy[a] + tb * dy[b]
+    w = 0.5 * mt * s / (dt * dt)
+    work[2] -= w
+    work[FRICTION] += w
+    if rowwork.shape[0]:
+        rowwork[a, 0] -= w
+        rowwork[a, 2] += w
+    if ev[0] >= 0.0:
+        ev[9] += 0.5 * abs(s)
+        ev[10] += abs(mt) / dt
+
+
 @internal
 def hole_kinematics(ops, st, step, dt, p):
     """Two planes, after state step+1: every row's node position, its impact angle and
@@ -396,6 +425,9 @@ def hole_kinematics(ops, st, step, dt, p):
     for j in range(st.active.size):
         if ops.pair[j] < 0:
             continue
+        if ops.pair[j] > 0 and ops.Nc[j, FRICTION_COLUMN] > 0.0:
+            friction_split(st.mu, st.dy, (st.y_cur, st.lo, st.hi), st.work, st.rowwork,
+                           st.impact[j], j, ops.pair[j], dt)
         node_position(ops, st, j, p)
         ev = st.impact[j]
         nx, ny = normal_of(ops, j, p[2], p[3])

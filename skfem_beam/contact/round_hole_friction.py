@@ -1,0 +1,248 @@
+"""Coulomb friction in round holes at position level: the β-scheme's step with exact
+contact at the nodes (|y_p − c| ≤ r to round-off) and Coulomb's law on the step's slip.
+
+At a round hole the node's pair y_p = (v, w) at t_{n+1} satisfies |y_p − c| ≤ r.  The
+step's multiplier μ_p (Δt² × the contact force) is split along the wall's outward normal
+n = (y_p − c)/r at y_p^{n+1} and its tangent t = (−n_w, n_v):
+
+    μ_p = −λ_n n + λ_t t,   λ_n ≥ 0,  λ_n (|y_p − c| − r) = 0,
+    |λ_t| ≤ μ_f λ_n;  |λ_t| < μ_f λ_n ⇒ s = 0;  s ≠ 0 ⇒ λ_t = −μ_f λ_n sign(s),
+
+with the slip s = t·(y_p^{n+1} − y_p^{n−1}), i.e. 2Δt × the β-scheme's consistent
+tangential velocity.  Why that one: the scheme's energy identity is its equation times
+(u^{n+1} − u^{n−1}) (kernels.finish_step), so a step's friction work is exactly
+½ λ_t s/Δt² = −½ μ_f |λ_n| |s|/Δt² ≤ 0: dissipative at every step, not only on average
+(the backward increment y^{n+1} − y^n would stick without the two-step memory but
+leaves the sign of the step's friction work open).
+
+**One contact** (its block with the other multipliers fixed): z = ỹ_p − c the block's
+free offset, q = y_p^{n−1} − c the slip's reference, D = D_pp; p = y_p − c = z + Dμ_p.
+
+- separation: |z| ≤ r, μ_p = 0;
+- stick (s = 0 ⇔ p ∥ q): p = r q/|q|, μ_p = D⁻¹(p − z), kept if it lies in the cone;
+- slip with sign σ = sign(s): λ_t = −σμ_f λ_n makes μ_p = −τ G_σ p, G_σ = I + σμ_f R
+  (R the rotation by +90°, R n = t), τ = λ_n/r ≥ 0, so p = (I + τ D G_σ)⁻¹ z with
+  |p| = r: a 1-D root in τ (`slip_root`; det(I + τDG_σ) = 1 + τ tr D + τ² det D(1 + μ_f²)
+  > 0, so p(τ) is smooth; safeguarded Newton on 1/|p| − 1/r), kept if σ s ≥ 0.
+
+The normal is that of the unknown y^{n+1}: the closed forms above solve for it (no
+fixed point).  **Several contacts** (and frictionless box rows beside them): block
+Gauss–Seidel, each block exact with the others fixed, until a sweep moves no value by
+more than round-off (as round_hole.land_cone_solve, without its Newton polish).
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from ..errors import InputError
+from .active_set import data_scale
+from .base import ContactLaw, compiled_law
+from .round_hole import (MAX_SWEEPS, SWEEP_TOL, disk_params, disk_root, land_cone_solve,
+                         radial)
+
+internal = njit(cache=True)
+
+SEPARATE, STICK, SLIP_FORWARD, SLIP_BACKWARD, FRICTIONLESS, FALLBACK = range(6)
+
+
+@njit(cache=True)
+def _slip_point(M, za, zb, t, out):
+    """out[0:2] ← p = (I + tM)⁻¹z, out[2] ← d|p|/dt (M = (M00, M01, M10, M11))."""
+    n00, n01, n10, n11 = 1.0 + t * M[0], t * M[1], t * M[2], 1.0 + t * M[3]
+    det = n00 * n11 - n01 * n10
+    pa, pb = (n11 * za - n01 * zb) / det, (-n10 * za + n00 * zb) / det
+    ma, mb = M[0] * pa + M[1] * pb, M[2] * pa + M[3] * pb       # dp/dt = −N⁻¹ M p
+    da, db = -(n11 * ma - n01 * mb) / det, -(-n10 * ma + n00 * mb) / det
+    norm = np.hypot(pa, pb)
+    out[0], out[1], out[2] = pa, pb, (pa * da + pb * db) / norm
+    return norm
+
+
+@njit(cache=True)
+def slip_root(a, b, d, za, zb, r, g, out):
+    """τ ≥ 0 with |p(τ)| = r, p(τ) = (I + τ D G)⁻¹z, D = [[a, b], [b, d]], G = [[1, −g],
+    [g, 1]] (|z| > r): out[0:2] ← p; returns τ.  Safeguarded Newton on ψ = 1/|p| − 1/r
+    (< 0 at τ = 0, > 0 for τ large) inside a bracket found by doubling."""
+    M = np.array([a + b * g, b - a * g, b + d * g, d - b * g])
+    w = np.empty(3)
+    lo, hi = 0.0, (np.hypot(za, zb) / r - 1.0) / (0.5 * (a + d))
+    for _ in range(200):
+        if _slip_point(M, za, zb, hi, w) < r:
+            break
+        lo, hi = hi, 2.0 * hi
+    t = lo
+    for _ in range(200):
+        norm = _slip_point(M, za, zb, t, w)
+        psi = 1.0 / norm - 1.0 / r
+        if psi == 0.0:
+            break
+        if psi < 0.0:
+            lo = max(lo, t)
+        else:
+            hi = min(hi, t)
+        dpsi = -w[2] / (norm * norm)
+        t_new = t - psi / dpsi if dpsi > 0.0 else 0.5 * (lo + hi)
+        if not lo < t_new < hi:
+            t_new = 0.5 * (lo + hi)
+        if abs(t_new - t) <= 1e-16 * t_new or hi - lo <= 1e-16 * hi:
+            t = t_new
+            break
+        t = t_new
+    _slip_point(M, za, zb, t, w)
+    out[0], out[1] = w[0], w[1]
+    return t
+
+
+@njit(cache=True)
+def coulomb_disk(D2, z, q, r, f, out):
+    """One contact's μ_p into out[0:2] and p = y_p − c into out[2:4] (module docstring);
+    ``D2`` = (a, b, d) the block D_pp, ``z``, ``q`` = (free offset, slip reference), r the
+    radius, f Coulomb's μ.  Returns the case (SEPARATE, STICK, SLIP_FORWARD: s > 0,
+    SLIP_BACKWARD, FRICTIONLESS: f = 0 or q = 0, FALLBACK: no case held)."""
+    a, b, d = D2
+    za, zb = z
+    qa, qb = q
+    if za * za + zb * zb <= r * r:
+        out[0], out[1], out[2], out[3] = 0.0, 0.0, za, zb
+        return SEPARATE
+    nq = np.hypot(qa, qb)
+    root = np.empty(3)
+    if f > 0.0 and nq > 0.0:
+        pa, pb = r * qa / nq, r * qb / nq                   # stick: p ∥ q
+        det = a * d - b * b
+        ma = (d * (pa - za) - b * (pb - zb)) / det
+        mb = (-b * (pa - za) + a * (pb - zb)) / det
+        ln = -(pa * ma + pb * mb) / r
+        lt = (-pb * ma + pa * mb) / r
+        if ln >= 0.0 and abs(lt) <= f * ln:
+            out[0], out[1], out[2], out[3] = ma, mb, pa, pb
+            return STICK
+        for sigma in (1.0, -1.0):                           # slip with s of sign σ
+            g = sigma * f
+            tau = slip_root(a, b, d, za, zb, r, g, root)
+            pa, pb = root[0], root[1]
+            s = (pb * qa - pa * qb) / r                     # t·(p − q) = −t·q
+            if sigma * s >= 0.0:
+                out[0], out[1] = -tau * (pa - g * pb), -tau * (pb + g * pa)
+                out[2], out[3] = pa, pb
+                return SLIP_FORWARD if sigma > 0.0 else SLIP_BACKWARD
+    disk_root(a, b, d, za, zb, r, root)                     # frictionless
+    out[0], out[1], out[2], out[3] = -root[2] * root[0], -root[2] * root[1], root[0], root[1]
+    return FRICTIONLESS if f == 0.0 or nq == 0.0 else FALLBACK
+
+
+@internal
+def _box_row(D, y, lo, hi, mu, j):
+    """Box row j's projection (Lemma 4.1) with the others fixed; returns its change."""
+    yt = y[j] - D[j, j] * mu[j]
+    new_j = (min(max(yt, lo[j]), hi[j]) - yt) / D[j, j]
+    dj = new_j - mu[j]
+    if dj != 0.0:
+        for i in range(y.size):
+            y[i] += D[i, j] * dj
+        mu[j] = new_j
+    return abs(D[j, j] * dj)
+
+
+@internal
+def _disk_block(D, y, y_prev, bounds, fric, mu, a, b, local):
+    """Disk (a, b)'s exact Coulomb block with the others fixed; returns its change."""
+    lo, hi = bounds
+    ya = y[a] - D[a, a] * mu[a] - D[a, b] * mu[b]
+    yb = y[b] - D[b, a] * mu[a] - D[b, b] * mu[b]
+    za, zb, _, r = radial(ya, yb, lo[a], hi[a], lo[b], hi[b])
+    qa, qb, _, _ = radial(y_prev[a], y_prev[b], lo[a], hi[a], lo[b], hi[b])
+    coulomb_disk((D[a, a], D[a, b], D[b, b]), (za, zb), (qa, qb), r, fric[a], local)
+    da, db = local[0] - mu[a], local[1] - mu[b]
+    if da != 0.0 or db != 0.0:
+        for i in range(y.size):
+            y[i] += D[i, a] * da + D[i, b] * db
+        mu[a], mu[b] = local[0], local[1]
+    return max(abs(D[a, a] * da + D[a, b] * db), abs(D[b, a] * da + D[b, b] * db))
+
+
+@internal
+def friction_cone_solve(D, yf, y_prev, lo, hi, kind, fric, mu, active):
+    """The step's μ for boxes and round disks with Coulomb friction ``fric`` (per disk
+    first row; ``kind`` as round_hole.cone_solve's; ``y_prev`` = C u^{n−1}, the slip's
+    reference).  Returns the sweeps (< 0: no convergence)."""
+    m = yf.size
+    y = yf.copy()
+    for j in range(m):
+        mu[j] = 0.0
+    local = np.empty(4)
+    scale = data_scale(yf, lo, hi)
+    blocks = 0
+    for j in range(m):
+        if kind[j] >= 0:
+            blocks += 1
+    for sweeps in range(1, MAX_SWEEPS + 1):
+        change = 0.0
+        for j in range(m):
+            if kind[j] == 0:
+                change = max(change, _box_row(D, y, lo, hi, mu, j))
+            elif kind[j] > 0:
+                change = max(change, _disk_block(D, y, y_prev, (lo, hi), fric, mu, j,
+                                                 kind[j], local))
+        if blocks == 1 or change <= SWEEP_TOL * scale:
+            break
+    else:
+        return -1
+    for j in range(m):
+        if kind[j] > 0:
+            active[j] = mu[j] != 0.0 or mu[kind[j]] != 0.0
+        elif kind[j] < 0:
+            active[j] = False
+        else:
+            active[j] = mu[j] != 0.0
+    return sweeps
+
+
+@internal
+def friction_rows(params, m):
+    """(kind, fric) from the law's params: [q, a0, b0, ..., μ_0, μ_1, ...] (μ per disk)."""
+    kind = np.zeros(m, np.int64)
+    fric = np.zeros(m)
+    q = int(params[0])
+    for p in range(q):
+        a, b = int(params[1 + 2 * p]), int(params[2 + 2 * p])
+        kind[a], kind[b] = b, -1
+        fric[a] = params[1 + 2 * q + p]
+    return kind, fric
+
+
+@compiled_law
+def round_hole_friction_kernel(D, yf, y_cur, y_prev, lo, hi, params, state, mu, active):
+    m = yf.size
+    kind, fric = friction_rows(params, m)
+    for j in range(m):
+        if fric[j] > 0.0:
+            return friction_cone_solve(D, yf, y_prev, lo, hi, kind, fric, mu, active)
+    # no friction anywhere: the frictionless law's own solve (the same numbers)
+    return land_cone_solve(D, yf, lo, hi, kind, np.zeros((m, 3)), mu, active)
+
+
+class RoundHoleFriction(ContactLaw):
+    """Exact contact in round holes with Coulomb friction at position level (module
+    docstring); with μ = 0 everywhere it is the round-hole law, bit for bit."""
+    name = "round-hole-friction"
+    kernel = round_hole_friction_kernel
+    round_holes = True
+    friction = True
+
+    def setup(self, step, first=False):
+        width = step.hi - step.lo
+        if step.disks.size and np.any(np.abs(width[step.disks[:, 0]] - width[step.disks[:, 1]])
+                                      > 1e-12 * width[step.disks[:, 0]]):
+            raise InputError("a round hole's two rows must have the same radius")
+        if step.lands.size and np.any(step.lands[:, 0] > 0):
+            raise InputError("the round-hole-friction law takes round holes and flat faces; "
+                             "broached holes (lands) need the round-hole law (frictionless)")
+        fric = np.asarray(step.friction, dtype=float)
+        if fric.size == 0:
+            fric = np.zeros(step.lo.size)
+        if np.any(np.delete(fric, step.disks[:, 0]) > 0):
+            raise InputError("Coulomb friction acts at round holes only (the position-level "
+                             "law); flat faces are frictionless")
+        return np.concatenate([disk_params(step.disks), fric[step.disks[:, 0]]])

@@ -14,6 +14,7 @@ from skfem_beam.holes import Hole, HoleAt
 from skfem_beam.problem import Beam, BeamProblem, Damping, Load, Material, Section
 from skfem_beam.scenefile import example, load
 from skfem_beam.scheme import Run, Stepping, solve
+from skfem_beam.scheme.beta import BetaScheme
 from skfem_beam.semidiscrete import beam_system
 from skfem_beam.timefunctions import Sine
 
@@ -154,7 +155,7 @@ def test_the_tube_sticks_until_the_pull_reaches_mu_times_the_static_normal_force
     n = system.meta["n_plane"]
     e = system.C[0, :n].toarray().ravel()
     T_star = mu * (P - TUBE.rho_S * R / (e @ np.linalg.solve(system.K[:n, :n].toarray(), e)))
-    run = Run(system, Stepping(dt, t0 + 0.002 * T_star / a, 0.5), RoundHoleFriction())
+    run = Run(BetaScheme(system, Stepping(dt, t0 + 0.002 * T_star / a, 0.5), RoundHoleFriction()))
     run.advance(int(t0 / dt))
 
     def cone_ratio():
@@ -174,6 +175,6 @@ def test_the_tube_sticks_until_the_pull_reaches_mu_times_the_static_normal_force
 
 def test_a_restored_position_level_friction_run_goes_on_bit_for_bit():
     system = beam_system(whirl(0.3))
-    a, c = resumed(lambda: Run(system, Stepping(1e-4, 0.1, 0.5), RoundHoleFriction()), 555)
+    a, c = resumed(lambda: Run(BetaScheme(system, Stepping(1e-4, 0.1, 0.5), RoundHoleFriction())), 555)
     assert np.array_equal(a.st.rowwork, c.st.rowwork)
     assert np.array_equal(a.result().work["friction"][556:], c.result().work["friction"][556:])

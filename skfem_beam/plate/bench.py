@@ -19,6 +19,7 @@ import numpy as np
 
 from ..linalg import Banded, band_solve
 from ..scheme import solve
+from ..scheme.methods import PositionLevel
 from ..scheme.operators import step_operators
 from .model import Plate
 from .space import plate_space
@@ -67,8 +68,8 @@ def step_ms(system, solver: str, steps: int) -> tuple[float, float]:
     """(the scheme's mean wall time per step in ms, the fraction of steps in contact),
     from a first short run (compiles, builds the operators) and the timed run's own
     loop time."""
-    solve(system, DT, 2 * DT, solver=solver, progress=False)
-    r = solve(system, DT, steps * DT, solver=solver, progress=False)
+    solve(system, DT, 2 * DT, method=PositionLevel(solver), progress=False)
+    r = solve(system, DT, steps * DT, method=PositionLevel(solver), progress=False)
     return 1e3 * r.wall_time_s / r.steps, r.contact_fraction
 
 

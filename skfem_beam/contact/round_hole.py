@@ -182,7 +182,7 @@ def _still_holds(D, yf, lo, hi, kind, lands, piece, mu, mu_new, tol):
         elif kind[j] > 0:
             a, b = j, kind[j]
             pa, pb, rho, r = radial(y[a], y[b], lo[a], hi[a], lo[b], hi[b])
-            if lands[j, 0] > 0.0:
+            if lands is not None and lands[j, 0] > 0.0:
                 if piece[j] > 0:
                     if not piece_holds(piece[j], pa, pb, mu_new[a], mu_new[b], r,
                                        lands[j, 0], lands[j, 1], lands[j, 2], tol):
@@ -225,9 +225,9 @@ def _polish(D, yf, lo, hi, kind, lands, piece, mu, tol):
             else:
                 a, b = j, kind[j]
                 pa, pb, _, r = radial(y[a], y[b], lo[a], hi[a], lo[b], hi[b])
-                if piece[a] > 0 and _piece_rows(D, act, k, i, (a, b), (pa, pb, r),
-                                                (mu_new[a], mu_new[b]), piece[a], lands[a],
-                                                F, J):
+                if lands is not None and piece[a] > 0 and _piece_rows(
+                        D, act, k, i, (a, b), (pa, pb, r), (mu_new[a], mu_new[b]), piece[a],
+                        lands[a], F, J):
                     i += 2
                     continue
                 F[i] = 0.5 * (pa * pa + pb * pb - r * r) / r
@@ -260,7 +260,7 @@ def _block(D, y, lo, hi, kind, lands, piece, mu, a, root, out):
     ya = y[a] - D[a, a] * mu[a] - D[a, b] * mu[b]
     yb = y[b] - D[b, a] * mu[a] - D[b, b] * mu[b]
     za, zb, _, r = radial(ya, yb, lo[a], hi[a], lo[b], hi[b])
-    if lands[a, 0] > 0.0:
+    if lands is not None and lands[a, 0] > 0.0:
         piece[a] = land_project(D[a, a], D[a, b], D[b, b], za, zb, r, lands[a, 0],
                                 lands[a, 1], lands[a, 2], root, out)
     elif za * za + zb * zb <= r * r:
@@ -273,7 +273,7 @@ def _block(D, y, lo, hi, kind, lands, piece, mu, a, root, out):
 @internal
 def cone_solve(D, yf, lo, hi, kind, mu, active):
     """The step's μ for boxes and round disks: land_cone_solve without broached holes."""
-    return land_cone_solve(D, yf, lo, hi, kind, np.zeros((yf.size, 3)), mu, active)
+    return land_cone_solve(D, yf, lo, hi, kind, None, mu, active)
 
 
 @internal
@@ -281,7 +281,9 @@ def land_cone_solve(D, yf, lo, hi, kind, lands, mu, active):
     """The step's μ for boxes, disks and broached holes (module docstring).  ``kind[j]``:
     0 a box row, b > 0 the first row of a disk whose second row is b, −1 a disk's second
     row; ``lands[j]`` of a disk's first row: (lands, half width, angle) of a broached hole
-    (lands 0: round).  Returns the sweeps (< 0: no convergence)."""
+    (lands 0: round); ``lands`` None: every disk round, and then numba compiles none of
+    the broached holes' code (it prunes a None argument's branches: a round-hole scene's
+    first run compiles less).  Returns the sweeps (< 0: no convergence)."""
     m = yf.size
     y = yf.copy()
     for j in range(m):
@@ -370,6 +372,11 @@ def lands_of(params, m):
 
 @compiled_law
 def round_hole_kernel(D, yf, y_cur, y_prev, lo, hi, params, state, mu, active):
+    return land_cone_solve(D, yf, lo, hi, kinds_of(params, yf.size), None, mu, active)
+
+
+@compiled_law
+def broached_hole_kernel(D, yf, y_cur, y_prev, lo, hi, params, state, mu, active):
     m = yf.size
     return land_cone_solve(D, yf, lo, hi, kinds_of(params, m), lands_of(params, m), mu,
                            active)
@@ -399,5 +406,7 @@ class RoundHole(ContactLaw):
                                       > 1e-12 * (step.hi - step.lo)[step.disks[:, 0]]):
             raise InputError("a round hole's two rows must have the same radius")
         if step.lands.size and np.any(step.lands[:, 0] > 0):
+            self.kernel = broached_hole_kernel    # round holes only: no lands' code
             return np.concatenate([disk_params(step.disks), land_params(step.lands)])
+        self.kernel = round_hole_kernel
         return disk_params(step.disks)

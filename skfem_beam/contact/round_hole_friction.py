@@ -220,7 +220,7 @@ def round_hole_friction_kernel(D, yf, y_cur, y_prev, lo, hi, params, state, mu, 
         if fric[j] > 0.0:
             return friction_cone_solve(D, yf, y_prev, lo, hi, kind, fric, mu, active)
     # no friction anywhere: the frictionless law's own solve (the same numbers)
-    return land_cone_solve(D, yf, lo, hi, kind, np.zeros((m, 3)), mu, active)
+    return land_cone_solve(D, yf, lo, hi, kind, None, mu, active)
 
 
 class RoundHoleFriction(ContactLaw):

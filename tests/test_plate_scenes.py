@@ -160,3 +160,17 @@ def test_resume_extends_a_plate_run_bit_for_bit(tmp_path):
     assert exit_code(run_main, ["--resume", str(short), "--T", "0.1"]) == 0
     assert exit_code(run_main, [scene, "--T", "0.1", "--out", str(whole)]) == 0
     assert (short / "timeseries.csv").read_bytes() == (whole / "timeseries.csv").read_bytes()
+
+
+def test_every_plate_key_is_in_docs_plate_md():
+    from pathlib import Path
+    from skfem_beam.scenefile.schema import PLATE_KEYS
+    text = (Path(__file__).parents[1] / "docs" / "plate.md").read_text()
+    text = text[text.index("## Scene files"):]
+    for section, sub in PLATE_KEYS.items():
+        sub = sub[0] if isinstance(sub, list) else sub
+        keys = [k for k in sub if k not in ("amplitude", "omega", "phase", "value", "sines",
+                                            "table", "random", "psd")] \
+            if isinstance(sub, dict) else [section]
+        for key in keys:
+            assert f"`{key}`" in text, f"[{section}] {key}"

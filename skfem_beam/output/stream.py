@@ -51,7 +51,8 @@ class Series:
     of ``run.frame_every`` (0: every frame the run keeps); ``field_until``: the last step
     with a frame (None: the run's end); ``events(folder, run, last)``: writes impacts.csv
     and returns its summary entries (``last``: the last state the loop computed), on every
-    way a run ends: finished, unstable, interrupted, failed.
+    way a run ends: finished, unstable, interrupted, failed; ``writer``: the field
+    writer's class, as :class:`~.fields.FieldWriter` is called (the plate's: .plate).
     """
     columns: Callable
     ready: Callable | None = None
@@ -59,6 +60,7 @@ class Series:
     field_until: int | None = None
     keep_all: bool = False      # finish needs every row (not only what a chart shows)
     events: Callable | None = None
+    writer: Callable | None = None   # the field writer's class (None: FieldWriter, a line)
 
     def rows_ready(self, run: Run) -> int:
         return self.ready(run) if self.ready is not None else run.n // run.save_every + 1
@@ -76,11 +78,12 @@ class _Fields:
             raise InputError(f"field frames every {every} steps are not kept by the run "
                              f"(it keeps every {run.frame_every}-th)")
         self.every, self.until, self.written = every, series.field_until, 0
+        self.make = series.writer or FieldWriter
 
     @property
     def writer(self) -> FieldWriter:
         if self._writer is None:
-            self._writer = FieldWriter(self.folder, self.run.system, self.fmt)
+            self._writer = self.make(self.folder, self.run.system, self.fmt)
         return self._writer
 
     def update(self) -> None:

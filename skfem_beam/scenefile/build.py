@@ -17,14 +17,13 @@ from .bar import bar_problem
 from .beam import beam_problem
 from .parts import need, plane_count
 from .read import Parsed, Tables, read
+from .schema import OUTPUT_DEFAULTS
 
 
 BEAM_MASSES = ("consistent", "redistributed")        # [mesh] mass of a beam
 SCENE_WORDS = methods.Words(solver="[contact] law = ", massless="[mesh] massless = ",
                             law="[contact] law = ", restitution="[contact] restitution = ",
                             theta="[contact] theta = ")
-OUTPUT_DEFAULTS = {"format": "both", "save_every": 1, "frames": 200, "flush_every": 20000,
-                   "checkpoint_every": None}
 
 
 @dataclass(frozen=True)
@@ -81,6 +80,9 @@ def build(parsed: Parsed, dynamic: bool = True) -> Scene:
     try:    # every error line names the file
         with tempfile.TemporaryDirectory() as tmp:
             tables.tmp = Path(tmp)
+            if parsed.kind == "plate":
+                from .plate import plate_scene
+                return plate_scene(parsed, tables, dynamic)
             problem = (beam_problem if parsed.kind == "beam" else bar_problem)(parsed.data,
                                                                               tables)
         if not dynamic:

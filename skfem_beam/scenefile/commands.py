@@ -46,8 +46,12 @@ def run_main(argv) -> int:
     p = _run_parser()
     args = stored_args(p.parse_args(argv), p, argv)
     scene = _scene_of(args.scene, args.set, args.resume)
-    spec = _spec(scene, {k: v for k, v in vars(args).items() if k != "resume"}, args.resume)
     name = f"scene {Path(args.scene).stem}" if args.scene else "scene"
+    if scene.kind == "plate":
+        from ..cases.plate import run_plate_case
+        flags = {k: v for k, v in vars(args).items() if k != "resume"}
+        return run_plate_case(name, scene.problem, _plate_spec(scene, flags, args.resume))
+    spec = _spec(scene, {k: v for k, v in vars(args).items() if k != "resume"}, args.resume)
     if scene.kind == "bar":
         from ..cases.impacting_bar import run_bar_case
         return run_bar_case(scene.problem, spec)
@@ -99,6 +103,28 @@ def _spec(scene: Scene, flags: dict, resume) -> RunSpec:
                    wear(scene) if scene.kind == "beam" else None)
 
 
+def _plate_spec(scene, flags: dict, resume) -> RunSpec:
+    """A plate scene and the command line's flags as one RunSpec (as :func:`_spec`; the
+    probes are the file's [output] probes, vertices (x, y): --probe X is a beam's)."""
+    if flags.pop("probe", None):
+        raise InputError("--probe X is a beam's abscissa; a plate's probes are [output] "
+                         "probes = [[x, y], ...] in the scene file")
+    for key, value in scene.output.items():
+        if key != "probes" and flags[key] is None:
+            flags[key] = value
+    flags["T"] = scene.stepping.T if flags["T"] is None else flags["T"]
+    flags["out"] = flags["out"] or f"out/{Path(flags['scene']).stem}"
+    options = OutputOptions(flags["out"], flags["overwrite"], resume, flags["format"],
+                            flags["frames"], flags["save_every"], flags["flush_every"],
+                            flags["checkpoint_every"])
+    stepping = replace(scene.stepping, T=flags["T"], save_every=options.save_every,
+                       frames=options.frames)
+    config = {"command": "python -m skfem_beam run", "scene_text": scene.text,
+              "scene_files": scene.files, **flags, "probe": None, "dt": stepping.dt,
+              "beta": stepping.beta, "law": scene.method.name}
+    return RunSpec(stepping, scene.method, options, config)
+
+
 def _chart_stops(problem: BeamProblem) -> tuple:
     """The obstacle at the tip, for the tip chart (none when it has none)."""
     lo, hi = problem.obstacles.bounds([problem.beam.L])
@@ -125,6 +151,8 @@ def modes_main(argv) -> int:
     from ..two_planes import plane_problems
     args = _modes_parser().parse_args(argv)
     scene = load(args.scene, args.set or (), dynamic=False)
+    if scene.kind == "plate":
+        return _plate_modes(scene, args)
     if scene.kind != "beam":
         raise InputError(f"modes: {args.scene} is a {scene.kind}; modes are computed for "
                          "beams")
@@ -158,3 +186,30 @@ def _write_modes(out: Path, rows: list, x, two: bool) -> None:
             w.writerow([i] + ([p] if two else []) + [f"{f:.17g}", f"{om:.17g}"]
                        + [f"{u:.17g}" for u in shape])
     print(f"written: {out / 'modes.csv'}", file=sys.stderr)
+
+
+def _plate_modes(scene, args) -> int:
+    """The plate's lowest natural frequencies (its edges' supports; obstacles ignored),
+    printed, and with --out DIR/modes.csv: mode, f, ω and w at every vertex."""
+    from ..plate.modes import natural_frequencies
+    out = None
+    if args.out is not None:
+        from ..output.folder import check_output_dir
+        out = check_output_dir(args.out, args.overwrite)
+    space = scene.problem.space
+    omega, shapes = natural_frequencies(space, args.n)
+    print(f"{'mode':>4s} {'f (Hz)':>14s} {'ω (rad/s)':>14s}")
+    for i, w in enumerate(omega, 1):
+        print(f"{i:4d} {w / (2 * np.pi):14.6g} {w:14.6g}")
+    if out is not None:
+        out.mkdir(parents=True, exist_ok=True)
+        x, y = space.vertices
+        with open(out / "modes.csv", "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(["mode", "f_Hz", "omega_rad_s"]
+                       + [f"w({xi:.12g};{yi:.12g})" for xi, yi in zip(x, y)])
+            for i, om in enumerate(omega):
+                w.writerow([i + 1, f"{om / (2 * np.pi):.17g}", f"{om:.17g}"]
+                           + [f"{v:.17g}" for v in shapes[space.w_dofs, i]])
+        print(f"written: {out / 'modes.csv'}", file=sys.stderr)
+    return 0

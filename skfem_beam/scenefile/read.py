@@ -126,9 +126,11 @@ class Tables:
 
 
 def example(name: str) -> Path:
-    """The path of a shipped scene file (``skfem_beam/scene_files/NAME.toml``)."""
-    p = Path(__file__).resolve().parents[1] / "scene_files" / f"{Path(name).stem}.toml"
-    if not p.is_file():
-        shipped = sorted(q.stem for q in p.parent.glob("*.toml"))
-        raise InputError(f"no scene file {name!r}; shipped: {', '.join(shipped)}")
-    return p
+    """The path of a shipped scene file (``skfem_beam/scene_files/NAME.toml``, a plate's
+    in ``skfem_beam/scene_files/plates/NAME.toml``)."""
+    folder = Path(__file__).resolve().parents[1] / "scene_files"
+    for p in (folder / f"{Path(name).stem}.toml", folder / "plates" / f"{Path(name).stem}.toml"):
+        if p.is_file():
+            return p
+    shipped = sorted(q.stem for q in [*folder.glob("*.toml"), *folder.glob("plates/*.toml")])
+    raise InputError(f"no scene file {name!r}; shipped: {', '.join(shipped)}")

@@ -1,4 +1,5 @@
-"""The scene file's schema: its key tables (:data:`BEAM_KEYS`, :data:`BAR_KEYS`) and the
+"""The scene file's schema: its key tables (:data:`BEAM_KEYS`, :data:`BAR_KEYS`,
+:data:`PLATE_KEYS`) and the
 check of a parsed file against them.
 
 Every value is checked by the object it builds; this module checks only the file's shape:
@@ -70,6 +71,8 @@ U0, V0 = {"x": NUMBERS, "u": NUMBERS}, {"x": NUMBERS, "v": NUMBERS}
 TIME_KEYS = {"dt": N, "T": N, "beta": N, "load_window": V}
 OUTPUT = {"format": V, "save_every": N, "frames": N, "flush_every": N, "checkpoint_every": N,
           "probes": NUMBERS}
+OUTPUT_DEFAULTS = {"format": "both", "save_every": 1, "frames": 200, "flush_every": 20000,
+                   "checkpoint_every": None}      # [output] when the file leaves them out
 CONTACT = {"law": V, "stiffness": N, "restitution": N, "friction": N, "theta": N}
 G = NumberOr({"poly": NUMBERS, "about": N, "x": NUMBERS, "g": NUMBERS},   # the rest: obstacles._g
              "{ poly = [...] } or { x = [...], g = [...] }")
@@ -108,7 +111,19 @@ BAR_KEYS = {
     "mesh": {"J": N, "mass": V, "massless": V},
     "time": TIME_KEYS, "contact": CONTACT, "output": OUTPUT,
 }
-KINDS = {"beam": BEAM_KEYS, "bar": BAR_KEYS}
+PLATE_KEYS = {
+    "kind": V, "geometry": {"a": N, "b": N}, "section": {"thickness": N},
+    "material": {"E": N, "rho": N, "nu": N},
+    "edges": {"left": V, "right": V, "bottom": V, "top": V},
+    "mesh": {"nx": N, "ny": N, "element": V},
+    "obstacles": [{"g1": N, "g2": N, "region": NUMBERS, "points": ListOf(NUMBERS)}],
+    "loads": [{"pressure": N, "region": NUMBERS, **TIME}],
+    "initial": {"static_pressure": N, "velocity": N},
+    "time": {"dt": N, "T": N, "beta": N},
+    "contact": {"law": V, "solver": V, "stiffness": N, "restitution": N, "theta": N},
+    "output": {**OUTPUT, "probes": ListOf(NUMBERS)},
+}
+KINDS = {"beam": BEAM_KEYS, "bar": BAR_KEYS, "plate": PLATE_KEYS}
 
 
 def key_path(path: tuple) -> str:

@@ -1,0 +1,80 @@
+"""A plate scene's run (``python -m skfem_beam run`` on a ``kind = "plate"`` file): the
+beams' streaming pipeline (:func:`~skfem_beam.output.stream.execute`: rows and frames as
+they come, checkpoints, ``--resume``) with the plate's own columns, field writer and
+charts (:mod:`skfem_beam.output.plate`)."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..chart_process import draw
+from ..output.charts import energy_chart, trajectory_chart
+from ..output.plate import (UNITS, PlateFieldWriter, deflection_chart, plate_cells,
+                            plate_columns, probe_name, vertex_fields)
+from ..output.stream import Series, execute, prepare
+from ..spec import RunSpec
+
+
+def smallest_gap(system) -> float | None:
+    """The smallest |g1|, |g2| at the constrained vertices (m; None: no finite one)."""
+    g = np.abs(np.concatenate([system.lo, system.hi]))
+    g = g[np.isfinite(g)]
+    return float(g.min()) if g.size else None
+
+
+def run_plate_case(case: str, setup, spec: RunSpec) -> int:
+    """Run the plate ``setup`` (scenefile.plate.PlateSetup) as ``spec`` says, write its
+    folder, return the exit code."""
+    prepare(spec.options)                         # fail before the run, not after it
+    system = setup.system
+    run = spec.method.build(system, spec.stepping)
+    plate = system.meta["plate"]
+    summary = {
+        "case": case, "kind": "plate", "element": plate.element, "nx": plate.nx,
+        "ny": plate.ny, "a": plate.a, "b": plate.b, "thickness": plate.h,
+        "edges": {e: plate.support(e) for e in ("left", "right", "bottom", "top")},
+        "dt": run.dt, "T": run.n_steps * run.dt, "beta": run.beta, "theta": run.theta,
+        "method": spec.method.name, "unknowns": system.n,
+        "constrained_vertices": int(system.C.shape[0]),
+        "smallest_gap_m": smallest_gap(system),
+        "probes": [list(p) for p in setup.probes],
+        "units": {**UNITS, "max_penetration": "m, at the constrained vertices",
+                  "smallest_gap_m": "m, the smallest |g1|, |g2| at the constrained "
+                                    "vertices"},
+        "config": spec.config,
+    }
+    series = Series(plate_columns(setup.probes), writer=PlateFieldWriter)
+    return execute(run, spec.options, summary, series, plate_charts(case, system, setup))
+
+
+def plate_charts(case: str, system, setup):
+    """The charts of a plate run: w at the probes, the energy and its balance, the total
+    contact force, and the deflection over the plate at the frame of the largest contact
+    force (the last frame when there is none); summary entries of the contact."""
+    def finish(folder: Path, data: dict, run) -> dict:
+        t, plate = data["t"], system.meta["plate"]
+        about = (f"{run.label}, Δt={run.dt:g} s, {plate.element} {plate.nx}×{plate.ny}")
+        draw(trajectory_chart, folder / "probes.png", t,
+             {f"w({x:g}, {y:g})": data[probe_name(x, y)] for x, y in setup.probes},
+             title=f"{case}: deflection at the probes ({about})")
+        draw(energy_chart, folder / "energy.png", t, data["energy_J"],
+             title=f"{case}: discrete energy ½E_β ({about})",
+             work={k: data[f"work_{k}_J"] for k in run.work_terms}, joules=True)
+        if np.any(data["contact_force_N"]):
+            draw(trajectory_chart, folder / "contact_force.png", t,
+                 {"total contact force": data["contact_force_N"]},
+                 title=f"{case}: total contact force on the plate ({about})",
+                 ylabel="force (N)")
+        r = run.result()
+        force = np.abs(r.frames_force).sum(axis=1) if r.frames_force.size else np.zeros(1)
+        k = int(np.argmax(force)) if np.any(force) else r.frames_t.size - 1
+        w = vertex_fields(system, r.frames_u[k], r.frames_v[k], r.frames_force[k])["w"]
+        points, ((_, cells),) = plate_cells(system)
+        draw(deflection_chart, folder / "deflection.png", points, cells, w,
+             title=f"{case}: w at t = {r.frames_t[k]:.4g} s\n({about})")
+        return {"energy_final_J": float(data["energy_J"][-1]),
+                "max_contact_force_N": float(np.max(data["contact_force_N"], initial=0.0)),
+                "max_contact_area_fraction":
+                    float(np.max(data["contact_area_fraction"], initial=0.0))}
+    return finish

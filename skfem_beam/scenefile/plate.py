@@ -1,0 +1,221 @@
+"""A plate's scene file (``kind = "plate"``) → the plate's objects (:mod:`skfem_beam.plate`):
+the :class:`~skfem_beam.plate.Plate` from [geometry], [section], [material], [edges] and
+[mesh]; its :class:`~skfem_beam.plate.PlateObstacle` from [[obstacles]], its
+:class:`~skfem_beam.plate.Pressure` from [[loads]] (each with a time function of the
+beam's, :mod:`.forcing`), its start from [initial], the probes from [output] and the
+method from [contact] (the one vocabulary, :func:`skfem_beam.methods.make`).  Every value
+is checked here or by the object it builds, in one line naming its key."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import methods
+from ..checks import check_choice, check_count, check_positive
+from ..contact import SOLVERS
+from ..errors import InputError
+from ..plate.model import EDGES, ELEMENTS, SUPPORTS, Plate
+from ..scheme import Stepping
+from .forcing import _time_function
+from .parts import need
+from .read import Parsed, Tables
+from .schema import OUTPUT_DEFAULTS
+
+PLATE_WORDS = methods.Words(solver="[contact] solver = ", massless="[mesh] massless = ",
+                            law="[contact] law = ", restitution="[contact] restitution = ",
+                            theta="[contact] theta = ")
+TIME_FORMS = ("amplitude", "omega", "phase", "value", "sines", "table", "random", "psd")
+
+
+@dataclass(frozen=True)
+class PlateSetup:
+    """What a plate scene builds: its finite element ``space``, the ``system`` the scheme
+    steps (None for ``modes``), the ``probes`` (x, y) whose w is written."""
+    space: object
+    system: object = None
+    probes: tuple = ()
+
+
+@dataclass(frozen=True)
+class PlateScene:
+    """A plate scene file read into the plate's objects (as :class:`.build.Scene` for a
+    beam): ``problem`` a :class:`PlateSetup`, ``method`` the run's method, ``stepping``
+    the time grid, ``output`` the [output] keys with their defaults, ``text``/``files``/
+    ``data`` as a beam scene's."""
+    kind: str
+    problem: PlateSetup
+    stepping: Stepping | None
+    method: object = None
+    output: dict = field(default_factory=dict)
+    text: str = ""
+    files: dict = field(default_factory=dict)
+    data: dict = field(default_factory=dict)
+
+
+def plate_of(data: dict) -> Plate:
+    """[geometry] a, b, [section] thickness, [material] E, rho, nu, [edges], [mesh]."""
+    g = need(data.get("geometry", {}), ("a", "b"), "geometry")
+    for key, value in g.items():
+        check_positive(f"[geometry] {key}", value)
+    h = need(data.get("section", {}), ("thickness",), "section")["thickness"]
+    check_positive("[section] thickness", h)
+    m = need(data.get("material", {}), ("E", "rho", "nu"), "material")
+    check_positive("[material] E", m["E"])
+    check_positive("[material] rho", m["rho"])
+    if not -1.0 < m["nu"] < 0.5:
+        raise InputError(f"[material] nu={m['nu']!r} must lie in (-1, 0.5)")
+    edges = data.get("edges", {})
+    for edge, support in edges.items():
+        check_choice(f"[edges] {edge}", support, SUPPORTS)
+    mesh = data.get("mesh", {})
+    element = check_choice("[mesh] element", mesh.get("element", "bfs"), ELEMENTS)
+    nx, ny = (check_count(f"[mesh] {k}", mesh.get(k, 8)) for k in ("nx", "ny"))
+    return Plate(a=g["a"], b=g["b"], h=h, E=m["E"], rho=m["rho"], nu=m["nu"],
+                 edges={e: edges.get(e, "free") for e in EDGES}, element=element,
+                 nx=nx, ny=ny)
+
+
+def _region(value, plate: Plate, where: str) -> tuple:
+    """region = [x0, y0, x1, y1] (m) on the plate, as (x0, x1, y0, y1)."""
+    if len(value) != 4:
+        raise InputError(f"{where} = {value!r} must be [x0, y0, x1, y1] (m)")
+    x0, y0, x1, y1 = value
+    tol = 1e-9 * max(plate.a, plate.b)
+    if not (x0 < x1 and y0 < y1):
+        raise InputError(f"{where} = {value!r} needs x0 < x1 and y0 < y1")
+    if x0 < -tol or y0 < -tol or x1 > plate.a + tol or y1 > plate.b + tol:
+        raise InputError(f"{where} = {value!r} is off the plate [0, {plate.a:g}] × "
+                         f"[0, {plate.b:g}] (m)")
+    return (x0, x1, y0, y1)
+
+
+def _point(value, plate: Plate, where: str) -> tuple[float, float]:
+    """A point [x, y] (m) on the plate."""
+    if len(value) != 2:
+        raise InputError(f"{where} = {value!r} must be a point [x, y] (m)")
+    x, y = value
+    tol = 1e-9 * max(plate.a, plate.b)
+    if not (-tol <= x <= plate.a + tol and -tol <= y <= plate.b + tol):
+        raise InputError(f"{where} = {value!r} is off the plate [0, {plate.a:g}] × "
+                         f"[0, {plate.b:g}] (m)")
+    return float(x), float(y)
+
+
+def obstacles_of(data: dict, space) -> list:
+    """[[obstacles]] g1, g2 (m, at least one) over region or at points (a point must be
+    a vertex of the mesh)."""
+    from ..plate.system import PlateObstacle, vertex_index
+    out = []
+    for i, d in enumerate(data.get("obstacles", [])):
+        where = f"obstacles.{i}"
+        if "g1" not in d and "g2" not in d:
+            raise InputError(f"[{where}] needs g1 and/or g2 (m)")
+        if "region" in d and "points" in d:
+            raise InputError(f"[{where}] give region or points, not both")
+        region = _region(d["region"], space.plate, f"{where}.region") if "region" in d \
+            else None
+        points = tuple(_point(p, space.plate, f"{where}.points[{k}]")
+                       for k, p in enumerate(d.get("points", [])))
+        for k, (x, y) in enumerate(points):
+            _vertex(space, x, y, f"{where}.points[{k}]", vertex_index)
+        if "points" in d and not points:
+            raise InputError(f"[{where}] points = [] names no vertex")
+        out.append(PlateObstacle(d.get("g1", -np.inf), d.get("g2", np.inf), region, points))
+    return out
+
+
+def _vertex(space, x: float, y: float, where: str, vertex_index) -> int:
+    try:
+        return vertex_index(space, x, y)
+    except InputError as e:
+        raise InputError(f"{where} = [{x:g}, {y:g}]: {e}") from None
+
+
+def loads_of(data: dict, plate: Plate, tables: Tables) -> list:
+    """[[loads]] pressure (Pa) × a(t) (a time function of the beam's; none: a = 1),
+    over region (none: the whole plate)."""
+    from ..plate.system import Pressure, one
+    out = []
+    for i, d in enumerate(data.get("loads", [])):
+        where = f"loads.{i}"
+        p = need(d, ("pressure",), where)["pressure"]
+        region = _region(d["region"], plate, f"{where}.region") if "region" in d else None
+        time = {k: d[k] for k in TIME_FORMS if k in d}
+        if "omega" in time and "amplitude" not in time:
+            time["amplitude"] = 1.0          # the pressure is the amplitude
+        a = _time_function(time, where, tables)
+        out.append(Pressure(float(p), one if a is None else a, region))
+    return out
+
+
+def initial_of(data: dict):
+    """[initial] static_pressure (Pa: w⁰ the static deflection under it), velocity
+    (m/s, uniform)."""
+    from ..plate.system import PlateInitial, Pressure
+    d = data.get("initial", {})
+    static = Pressure(float(d["static_pressure"])) if "static_pressure" in d else None
+    return PlateInitial(static, float(d.get("velocity", 0.0)))
+
+
+def probes_of(data: dict, space) -> tuple:
+    """[output] probes = [[x, y], ...]: vertices of the mesh (none: the nearest the
+    centre)."""
+    from ..plate.system import vertex_index
+    given = data.get("output", {}).get("probes")
+    if given is None:
+        x, y = space.vertices
+        c = int(np.argmin(np.hypot(x - space.plate.a / 2, y - space.plate.b / 2)))
+        return ((float(x[c]), float(y[c])),)
+    points = tuple(_point(p, space.plate, f"output.probes[{k}]") for k, p in enumerate(given))
+    for k, (x, y) in enumerate(points):
+        _vertex(space, x, y, f"output.probes[{k}]", vertex_index)
+    return points
+
+
+def method_of(data: dict) -> methods.Method:
+    """[contact] law (position | moreau-jean | penalty, or a position-level solver's
+    name as a beam scene's), solver, stiffness (N/m: the penalty law), restitution,
+    theta (Moreau–Jean)."""
+    c = data.get("contact", {})
+    law = c.get("law", "penalty" if "stiffness" in c else "position")
+    solver = c.get("solver", "auto")
+    if law in SOLVERS and law not in methods.LAWS:
+        if "solver" in c:
+            raise InputError(f"[contact] law = {law!r} names a solver: give it as law or "
+                             "as solver, not both")
+        law, solver = "position", law
+    check_choice("[contact] law", law, (*methods.LAWS, *SOLVERS))
+    if law == "penalty" and "stiffness" not in c:
+        raise InputError("[contact] law = 'penalty' needs stiffness (N/m)")
+    if "stiffness" in c and law != "penalty":
+        raise InputError(f"[contact] stiffness is the penalty spring: law = {law!r} does not "
+                         "take it")
+    if solver != "auto":
+        check_choice("[contact] solver", solver, SOLVERS)
+    return methods.make(law, solver, c.get("restitution", 0.0), c.get("stiffness"),
+                        words=PLATE_WORDS, theta=c.get("theta"))
+
+
+def plate_scene(parsed: Parsed, tables: Tables, dynamic: bool = True) -> PlateScene:
+    """The plate scene ``parsed`` (``dynamic=False``: the plate's space alone, for
+    ``modes``)."""
+    from ..plate.space import plate_space
+    from ..plate.system import plate_system
+    data = parsed.data
+    space = plate_space(plate_of(data))
+    if not dynamic:
+        return PlateScene("plate", PlateSetup(space), None, text=parsed.text,
+                          files=tables.read, data=data)
+    t = data.get("time", {})
+    if "dt" not in t or "T" not in t:
+        raise InputError("[time] needs dt and T (s)")
+    method = method_of(data)
+    probes = probes_of(data, space)
+    system = plate_system(space, obstacles_of(data, space), loads_of(data, space.plate, tables),
+                          initial_of(data), probes)
+    out = {**OUTPUT_DEFAULTS, **data.get("output", {})}
+    stepping = Stepping(t["dt"], t["T"], t.get("beta", method.default_beta),
+                        out["save_every"], out["frames"])
+    return PlateScene("plate", PlateSetup(space, system, probes), stepping, method, out,
+                      parsed.text, tables.read, data)

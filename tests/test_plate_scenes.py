@@ -1,0 +1,176 @@
+"""Plate scene files (kind = "plate", docs/plate.md "Scene files"): the shipped scenes
+run from the command line and write their folder; exact contact at every vertex and the
+energy identity, read from the files; the fields read back with meshio; the bad values
+refused in one line with nothing written; modes; --resume."""
+import csv
+import json
+import subprocess
+import sys
+
+import meshio
+import numpy as np
+import pytest
+
+from conftest import assert_refused, exit_code
+from skfem_beam.output.plate import vertex_fields
+from skfem_beam.scenefile import example, load, modes_main, run_main
+from skfem_beam.scheme import drive
+
+SHIPPED = ("plate_on_stops", "plate_rattling")
+FILES = ("timeseries.csv", "summary.json", "fields.xdmf", "fields.h5", "fields.pvd",
+         "probes.png", "energy.png", "deflection.png", "checkpoint.npz")
+
+
+def columns(folder) -> dict:
+    with open(folder / "timeseries.csv", newline="") as fh:
+        rows = list(csv.reader(fh))
+    return {name: np.array([float(r[i]) for r in rows[1:]]) for i, name in enumerate(rows[0])}
+
+
+@pytest.fixture(scope="module", params=SHIPPED)
+def shipped(request, tmp_path_factory):
+    """(name, output folder) of a shipped scene run by ``python -m skfem_beam run``."""
+    out = tmp_path_factory.mktemp(request.param) / "run"
+    done = subprocess.run([sys.executable, "-m", "skfem_beam", "run",
+                           str(example(request.param)), "--out", str(out)],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    return request.param, out
+
+
+def test_shipped_plate_scene_writes_its_folder(shipped):
+    name, out = shipped
+    for f in FILES:
+        assert (out / f).is_file(), f
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "success" and summary["kind"] == "plate"
+    assert summary["solver"] == "active-set" and summary["impacts"] > 0
+    assert summary["wall_time_s"] > 0 and summary["steps"] == round(summary["T"] /
+                                                                    summary["dt"])
+    assert summary["max_contact_force_N"] > 0
+
+
+def test_exact_contact_at_every_vertex(shipped):
+    _, out = shipped
+    summary = json.loads((out / "summary.json").read_text())
+    gap = summary["smallest_gap_m"]
+    assert summary["max_nodal_violation"] <= 1e-12 * gap          # measured ≈ 1e-19 m
+    assert summary["max_penetration"] <= 1e-12 * gap
+
+
+def test_energy_identity_from_the_timeseries(shipped):
+    _, out = shipped
+    c = columns(out)
+    closure = c["energy_J"] - c["energy_J"][0] + c["work_damping_J"] - c["work_input_J"] \
+        - c["work_contact_J"]
+    assert np.abs(closure).max() <= 1e-9 * np.abs(c["energy_J"]).max()
+    assert c["work_contact_J"][-1] < 0                             # impacts lose energy
+    assert 0 < c["contact_area_fraction"].max() <= 1
+    assert c["contact_force_N"].max() > 0
+
+
+def test_fields_read_back_with_the_run_s_deflection(shipped):
+    """meshio reads fields.xdmf and the VTU frames; w at every vertex at every frame is
+    the run's own (the same run again through the API), bit for bit; the probe
+    column of timeseries.csv is w at its vertex."""
+    name, out = shipped
+    scene = load(example(name))
+    system = scene.problem.system
+    run = scene.method.build(system, scene.stepping)
+    drive(run)
+    r = run.result()
+    expected = [vertex_fields(system, r.frames_u[k], r.frames_v[k], r.frames_force[k])
+                for k in range(r.frames_t.size)]
+    with meshio.xdmf.TimeSeriesReader(str(out / "fields.xdmf")) as reader:
+        points, cells = reader.read_points_cells()
+        assert reader.num_steps == len(expected)
+        for k in range(reader.num_steps):
+            t, data, _ = reader.read_data(k)
+            assert t == r.frames_t[k]
+            np.testing.assert_array_equal(data["w"], expected[k]["w"])
+            np.testing.assert_array_equal(data["contact_force"], expected[k]["contact_force"])
+    assert points.shape[0] == system.meta["space"].vertices.shape[1]
+    assert cells[0].type == "quad"
+    last = meshio.read(out / "fields_vtu" / f"fields_{len(expected) - 1:06d}.vtu")
+    np.testing.assert_array_equal(last.point_data["w"], expected[-1]["w"])
+    c = columns(out)
+    x, y = scene.problem.probes[0]
+    i = int(np.argmin(np.hypot(points[:, 0] - x, points[:, 1] - y)))
+    step = round(r.frames_t[-1] / scene.stepping.dt)
+    assert c[f"w_x{x:g}_y{y:g}"][step] == expected[-1]["w"][i]
+
+
+GOOD = example("plate_on_stops").read_text()
+
+
+@pytest.mark.parametrize("old, new, word", [
+    ("nu = 0.3", "nu = 0.6", "nu"),
+    ("nu = 0.3", "nu = -1.0", "nu"),
+    ("thickness = 0.01 ", "thickness = 0.0 ", "thickness"),
+    ("thickness = 0.01 ", "thickness = -0.01 ", "thickness"),
+    ('left = "clamped"', 'left = "welded"', "left"),
+    ('left = "clamped"', 'middle = "clamped"', "middle"),
+    ("g1 = -1.75e-4 ", "g1 = -1.75e-4\nregion = [0.0, 0.0, 0.5, 1.2] ", "region"),
+    ("g1 = -1.75e-4 ", "g1 = -1.75e-4\npoints = [[0.2, 1.3]] ", "points"),
+    ("g1 = -1.75e-4 ", "g1 = -1.75e-4\npoints = [[0.21, 0.6]] ", "points"),
+    ("g1 = -1.75e-4 ", "g1 = \"0.175mm\" ", "g1"),
+    ('element = "bfs"', 'element = "hermite"', "element"),
+    ("nx = 6", "nx = 0", "nx"),
+    ("probes = [[0.2, 0.6], [0.2, 0.2]]", "probes = [[0.2, 0.61]]", "probes"),
+    ('law = "position"', 'law = "springs"', "law"),
+    ('law = "position"', 'law = "penalty"', "stiffness"),
+    ("static_pressure = 1.0e5 ", "static_pressure = -1.0e5 ", "initial deflection"),
+])
+def test_bad_plate_scene_one_line_exit_2_nothing_written(tmp_path, capsys, old, new, word):
+    assert old in GOOD
+    src = tmp_path / "src"
+    src.mkdir()
+    (src / "plate.toml").write_text(GOOD.replace(old, new))
+    out = tmp_path / "out"
+    out.mkdir()
+    assert_refused(run_main, [str(src / "plate.toml"), "--out", str(out / "run")], word,
+                   capsys, out)
+
+
+def test_bad_value_line_names_the_file(tmp_path, capsys):
+    (tmp_path / "plate.toml").write_text(GOOD.replace("nu = 0.3", "nu = 0.6"))
+    assert exit_code(run_main, [str(tmp_path / "plate.toml"), "--out",
+                                str(tmp_path / "run")]) == 2
+    err = capsys.readouterr().err
+    assert "plate.toml" in err and "[material] nu=0.6" in err and "(-1, 0.5)" in err
+    assert not (tmp_path / "run").exists()
+
+
+def test_modes_lists_the_plate_frequencies(tmp_path, capsys):
+    assert exit_code(modes_main, [str(example("plate_rattling")), "--n", "3", "--out",
+                                  str(tmp_path / "m")]) == 0
+    text = capsys.readouterr().out
+    # simply supported 1 × 1 m, h = 5 mm: ω₁₁ = 2π² √(D/(ρh)) = 154.5 rad/s (BFS 8 × 8)
+    assert "154.4" in text or "154.5" in text
+    rows = list(csv.reader(open(tmp_path / "m" / "modes.csv")))
+    assert len(rows) == 4 and rows[1][0] == "1"
+
+
+def test_resume_extends_a_plate_run_bit_for_bit(tmp_path):
+    """A finished run keeps its last checkpoint: --resume DIR --T longer continues it, and
+    its timeseries.csv is the uninterrupted longer run's, byte for byte."""
+    scene = str(example("plate_rattling"))
+    short, whole = tmp_path / "short", tmp_path / "whole"
+    assert exit_code(run_main, [scene, "--T", "0.05", "--out", str(short)]) == 0
+    assert exit_code(run_main, ["--resume", str(short), "--T", "0.1"]) == 0
+    assert exit_code(run_main, [scene, "--T", "0.1", "--out", str(whole)]) == 0
+    assert (short / "timeseries.csv").read_bytes() == (whole / "timeseries.csv").read_bytes()
+
+
+def test_every_plate_key_is_in_docs_plate_md():
+    from pathlib import Path
+    from skfem_beam.scenefile.schema import PLATE_KEYS
+    text = (Path(__file__).parents[1] / "docs" / "plate.md").read_text()
+    text = text[text.index("## Scene files"):]
+    for section, sub in PLATE_KEYS.items():
+        sub = sub[0] if isinstance(sub, list) else sub
+        keys = [k for k in sub if k not in ("amplitude", "omega", "phase", "value", "sines",
+                                            "table", "random", "psd")] \
+            if isinstance(sub, dict) else [section]
+        for key in keys:
+            assert f"`{key}`" in text, f"[{section}] {key}"

@@ -752,3 +752,20 @@ def test_damped_supports_dissipate_what_their_dashpots_do(tmp_path):
         assert np.abs(balance).max() < 1e-11 * np.abs(s["energy_J"]).max()
     assert errors[1] < 0.02 and errors[0] / errors[1] > 3, errors
     assert abs(peaks[1] / peaks[0] - 1) < 0.01
+
+
+def test_a_shipped_scene_runs_by_its_name_from_any_folder(tmp_path, monkeypatch, capsys):
+    """`run point_stops.toml` (as the scene-file page writes it) finds the shipped file when
+    the folder has none of that name, and runs what `example` gives; a --set of the kind is
+    one line (it used to end in a KeyError)."""
+    monkeypatch.chdir(tmp_path)
+    a, b = tmp_path / "a", tmp_path / "b"
+    argv = ["--T", "0.01", "--format", "none"]
+    assert exit_code(run_main, ["point_stops.toml", "--out", str(a), *argv]) == 0
+    assert exit_code(run_main, [str(example("point_stops")), "--out", str(b), *argv]) == 0
+    assert (a / "timeseries.csv").read_bytes() == (b / "timeseries.csv").read_bytes()
+    out = tmp_path / "refused"
+    out.mkdir()
+    capsys.readouterr()
+    assert_refused(run_main, ["point_stops.toml", "--set", "kind=foo", "--out",
+                              str(out / "x")], "a scene's kind is its file's", capsys, out)

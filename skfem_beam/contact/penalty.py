@@ -301,7 +301,8 @@ class Penalty(ContactLaw):
                 pick(c, owner[:, 1]))
 
     def __repr__(self) -> str:
-        fmt = lambda v: f"{v[0]:g}" if v.size == 1 else f"[{', '.join(f'{x:g}' for x in v)}]"  # noqa: E731
+        def fmt(v):
+            return f"{v[0]:g}" if v.size == 1 else f"[{', '.join(f'{x:g}' for x in v)}]"
         return f"Penalty(stiffness={fmt(self.stiffness)}, damping={fmt(self.damping)})"
 
 

@@ -363,6 +363,22 @@ class Obstacles:
             return np.where(np.isclose(z, x, rtol=0, atol=1e-12 * max(1.0, abs(x))), g, np.inf)
         return cls(lower, upper, (float(x),), carried)
 
+    def owners(self, x: np.ndarray) -> np.ndarray:
+        """(len(x), 2): per x the index in ``parts`` of the obstacle whose g1 is the bound
+        g1(x) (the highest; ties: the first listed) and of the one whose g2 is g2(x) (the
+        lowest), −1 where the bound is infinite; one obstacle (no parts): 0."""
+        x = np.asarray(x, dtype=float).ravel()
+        parts = self.parts or (self,)
+        out = np.full((x.size, 2), -1, np.int64)
+        if not x.size:
+            return out
+        bounds = [o.bounds(x) for o in parts]
+        for side, best in ((0, np.argmax), (1, np.argmin)):
+            g = np.array([b[side] for b in bounds])
+            i = best(g, axis=0)              # the first of equal bounds
+            out[:, side] = np.where(np.isfinite(g[i, np.arange(x.size)]), i, -1)
+        return out
+
     def bounds(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(g1(x), g2(x)) as float arrays, checked: no NaN, g1 < g2 everywhere."""
         x = np.asarray(x, dtype=float)

@@ -50,8 +50,10 @@ SECTION_DOCS = {
         '`x` (point stops) or `x_from`, `x_to` (a span) or neither (the whole beam); `g1`, '
         '`g2`: numbers, `{ poly = [c0, c1, ...], about = x0 }` (Σ c_k (x − x0)^k) or `{ x = '
         '[...], g = [...] }` (linear between points); `carried = true` moves with the '
-        'support; `stiffness` (N/m) and `damping` (N·s/m, optional), the same on every '
-        "obstacle: elastic supports, the penalty law's springs with Kelvin–Voigt dashpots. "
+        'support; `stiffness` (N/m) and `damping` (N·s/m, optional): elastic supports, the '
+        "penalty law's springs with Kelvin–Voigt dashpots, each obstacle its own (one plane; "
+        'two planes: the same on every obstacle), on every obstacle or none (rigid); '
+        "summary.json `spring_supports` gives each one's largest deflection and force. "
         'Two planes: g1, g2 bound v; `hole = {...}` at `x` or over `x_from`, `x_to` bounds '
         '(v, w): `{ radius = r }` (drilled, `centre = [cy, cz]` optional), `{ sides = n, '
         'radius = r, angle = a }` (a regular polygon, r to its faces, a in rad), `{ lands = '

@@ -181,7 +181,8 @@ def beam_system(problem: BeamProblem, samples_per_element: int = 20) -> SemiDisc
               "element": problem.element, "J": problem.J, "problem": problem},
         view=SceneView("beam", L, k2, sup if problem.lifting == "paper" else None,
                        problem.obstacles, beam.rho_S, beam.EI, lift, x_obs),
-        bound_motion=motion, bound_shift=shift, sample_shift=s_shift)
+        bound_motion=motion, bound_shift=shift, sample_shift=s_shift,
+        row_obstacle=problem.obstacles.owners(x_c))
 
 
 def modal_damping(M, K, zeta: float) -> sp.csr_matrix:

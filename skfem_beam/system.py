@@ -100,6 +100,10 @@ class SemiDiscrete:
     friction: np.ndarray | None = None       # Coulomb's μ per row (a round hole's first)
     row_nodes: sp.csr_matrix | None = None
     row_centres: np.ndarray | None = None
+    # per constrained row, the obstacle (Obstacles.parts index; one obstacle: 0) whose g1
+    # and whose g2 is its lo and its hi (m, 2), −1 none (an infinite bound); None: unknown
+    # (two planes, a bar): the penalty law then takes one stiffness for all
+    row_obstacle: np.ndarray | None = None
 
     @property
     def n(self) -> int:

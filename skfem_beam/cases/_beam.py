@@ -52,8 +52,11 @@ def run_beam_case(case: str, problem, spec: RunSpec, stops=(), extra=None) -> in
         "config": spec.config,
     }
 
+    springs = (spec.method.stiffness, spec.method.damping) \
+        if penalty and system.planes == 1 else None
+
     def events(folder: Path, run, last: int) -> dict:
-        return beam_impacts(folder, run, problem, last, spec.wear)
+        return beam_impacts(folder, run, problem, last, spec.wear, springs)
 
     two = system.planes == 2
     if two:
@@ -65,6 +68,7 @@ def run_beam_case(case: str, problem, spec: RunSpec, stops=(), extra=None) -> in
                                spec.wear))
     if code == 0:
         print_supports(Path(spec.options.out), spec.wear)
+        print_springs(Path(spec.options.out))
         warn_no_contact(run, system)
     return code
 
@@ -78,6 +82,30 @@ def print_supports(folder: Path, wear) -> None:
     text = support_table(stats.get("supports") or [], newtons, wear)
     if text:
         print(text)
+
+
+def print_springs(folder: Path) -> None:
+    """Under the run's end line, the spring supports' table (summary.json's
+    ``spring_supports``, output.events.spring_supports): per obstacle its stiffness,
+    impacts, largest deflection and force; nothing for rigid supports."""
+    table = spring_table(read_summary(folder).get("spring_supports") or [])
+    if table:
+        print(table)
+
+
+def spring_table(springs: list[dict]) -> str:
+    """``spring_supports`` as plain text, one row per obstacle ("" without)."""
+    if not springs:
+        return ""
+    head = ["obstacle", "where", "k (N/m)", "c (N·s/m)", "impacts", "deflection mm",
+            "force N"]
+    rows = [[str(s["obstacle"]), s["where"], f"{s['stiffness']:.4g}", f"{s['damping']:.4g}",
+             str(s["impacts"]), f"{1e3 * s['max_deflection']:.4g}", f"{s['max_force']:.4g}"]
+            for s in springs]
+    widths = [max(len(r[i]) for r in [head] + rows) for i in range(len(head))]
+    lines = ["spring supports (largest deflection and force per obstacle):"]
+    lines += ["  ".join(c.rjust(w) for c, w in zip(r, widths)) for r in [head] + rows]
+    return "\n".join(lines)
 
 
 def warn_no_contact(run, system) -> None:

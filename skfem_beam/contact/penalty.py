@@ -23,6 +23,13 @@ implicit step is the minimiser of a strictly convex function and Newton solves i
 
 The start step weights the spring at u⁰ by ½(1−2β) instead (see scheme.run).
 
+Each obstacle may have its own stiffness and damping (``stiffness``, ``damping``: one
+number, or one per obstacle, in the order of ``Obstacles.parts``): a row's lower bound g1
+then has the stiffness of the obstacle that gives it and its upper bound g2 that of its
+own (StepData.obstacle), so κ and c in r(y) are per row and side.  The kernels read them
+per row and side always (params[rows_at(params):], see ``row_params``): with one number
+every row holds it, the same arithmetic as a scalar.  Round holes take one number.
+
 ``implicit=True`` takes the whole spring force at t_{n+1} instead (weights 1, 0, 0): the
 step is then min ½|x − x_free|²_A + ½Δt²κ·dist²(Cx, K), the Moreau–Yosida regularisation
 of the exact step, which it approaches at rate 1/κ as κ → ∞ (at the same Δt and mesh);
@@ -50,21 +57,38 @@ def spring(y, lo, hi, stiffness):
 
 
 @njit(cache=True)
+def sided_spring(y, lo, hi, k_lo, k_hi):
+    """r(y) = −(κ_hi (y − hi)⁺ − κ_lo (lo − y)⁺): each bound its own obstacle's stiffness
+    (with κ_lo = κ_hi = κ the bits of `spring`: at most one term is nonzero)."""
+    return -(k_hi * max(y - hi, 0.0) - k_lo * max(lo - y, 0.0))
+
+
+@njit(cache=True)
+def rows_at(params):
+    """Where the per-row constants start: after [κ, c, w_cur, w_prev, d, q, pairs (2q)]."""
+    return DISKS_AT + 1 + 2 * int(params[DISKS_AT])
+
+
+@njit(cache=True)
 def damped(y, lo, hi):
     """The dashpot acts: the spring is compressed (y beyond its bound) at tₙ."""
     return y > hi or y < lo
 
 
 @njit(cache=True)
-def compliance_solve(D, yf, lo, hi, c, state, mu, d, y_cur, y_prev):
-    """Solve y = yf − c·D·[(y − hi)⁺ − (lo − y)⁺] − d·D·δ(y − y_prev) (c = Δt²βκ ≥ 0; the
-    dashpot d = cΔt/2 on the values compressed at tₙ, δ their indicator: `damped`) for
-    μ = (y − yf) in D-scaled form; ``state`` (−1/0/+1) is the warm start.  Returns
-    iterations (< 0: failed)."""
+def compliance_solve(D, yf, lo, hi, c, state, mu, d, y_cur, y_prev, rows):
+    """Solve y = yf − D·[c_hi (y − hi)⁺ − c_lo (lo − y)⁺] − D·d δ(y − y_prev) (c = Δt²βκ ≥ 0
+    per row and side; the dashpot d = cΔt/2 on the values compressed at tₙ, δ their
+    indicator: `damped`, d that of the side compressed) for μ = (y − yf) in D-scaled form;
+    ``rows`` = [κ_lo, κ_hi, c_lo, c_hi, d_lo, d_hi] (m each; row_params), ``c``, ``d``
+    their largest (c = 0: no spring, d = 0: no dashpot); ``state`` (−1/0/+1) is the warm
+    start.  Returns iterations (< 0: failed)."""
     m = yf.size
     if c == 0.0:
         mu[:] = 0.0
         return 0
+    c_lo, c_hi = rows[2 * m:3 * m], rows[3 * m:4 * m]
+    d_lo, d_hi = rows[4 * m:5 * m], rows[5 * m:6 * m]
     y = yf.copy()
     for it in range(1, 60 + 4 * m):
         # Newton system on the current pattern: y + c D P (y − b) + d D δ (y − y_prev) = yf
@@ -72,14 +96,15 @@ def compliance_solve(D, yf, lo, hi, c, state, mu, d, y_cur, y_prev):
         rhs = yf.copy()
         for j in range(m):
             if state[j] != 0:
-                b = hi[j] if state[j] > 0 else lo[j]
+                b, cj = (hi[j], c_hi[j]) if state[j] > 0 else (lo[j], c_lo[j])
                 for i in range(m):
-                    Amat[i, j] += c * D[i, j]
-                    rhs[i] += c * D[i, j] * b
+                    Amat[i, j] += cj * D[i, j]
+                    rhs[i] += cj * D[i, j] * b
             if d != 0.0 and damped(y_cur[j], lo[j], hi[j]):
+                dj = d_hi[j] if y_cur[j] > hi[j] else d_lo[j]
                 for i in range(m):
-                    Amat[i, j] += d * D[i, j]
-                    rhs[i] += d * D[i, j] * y_prev[j]
+                    Amat[i, j] += dj * D[i, j]
+                    rhs[i] += dj * D[i, j] * y_prev[j]
         y = np.linalg.solve(Amat, rhs)
         changed = False
         for j in range(m):
@@ -91,11 +116,11 @@ def compliance_solve(D, yf, lo, hi, c, state, mu, d, y_cur, y_prev):
             break
     else:
         return -1
-    # μ with y = yf + D μ: μ = −c·[(y − hi)⁺ − (lo − y)⁺] − d·δ(y − y_prev)
+    # μ with y = yf + D μ: μ = −[c_hi (y − hi)⁺ − c_lo (lo − y)⁺] − d·δ(y − y_prev)
     for j in range(m):
-        mu[j] = -c * (max(y[j] - hi[j], 0.0) - max(lo[j] - y[j], 0.0))
+        mu[j] = sided_spring(y[j], lo[j], hi[j], c_lo[j], c_hi[j])
         if d != 0.0 and damped(y_cur[j], lo[j], hi[j]):
-            mu[j] -= d * (y[j] - y_prev[j])
+            mu[j] -= (d_hi[j] if y_cur[j] > hi[j] else d_lo[j]) * (y[j] - y_prev[j])
     return it
 
 
@@ -113,10 +138,13 @@ def disk_spring(ya, yb, lo_a, hi_a, lo_b, hi_b, stiffness):
 def penalty_explicit(y_cur, y_prev, lo, hi, params, r):
     """r = w_cur r(yⁿ) + w_prev r(yⁿ⁻¹): (1−2β) and β in a step, ½(1−2β) and 0 at the start."""
     stiffness, w_cur, w_prev = params[0], params[2], params[3]
-    for j in range(r.size):
-        r[j] = w_cur * spring(y_cur[j], lo[j], hi[j], stiffness) \
-            + w_prev * spring(y_prev[j], lo[j], hi[j], stiffness)
-    for p in range(int(params[DISKS_AT]) if params.size > DISKS_AT else 0):
+    m = r.size
+    rows = params[rows_at(params):]
+    k_lo, k_hi = rows[:m], rows[m:2 * m]
+    for j in range(m):
+        r[j] = w_cur * sided_spring(y_cur[j], lo[j], hi[j], k_lo[j], k_hi[j]) \
+            + w_prev * sided_spring(y_prev[j], lo[j], hi[j], k_lo[j], k_hi[j])
+    for p in range(int(params[DISKS_AT])):
         a, b = int(params[DISKS_AT + 1 + 2 * p]), int(params[DISKS_AT + 2 + 2 * p])
         fa, fb = disk_spring(y_cur[a], y_cur[b], lo[a], hi[a], lo[b], hi[b], stiffness)
         ga, gb = disk_spring(y_prev[a], y_prev[b], lo[a], hi[a], lo[b], hi[b], stiffness)
@@ -196,7 +224,7 @@ def penalty_kernel(D, yf, y_cur, y_prev, lo, hi, params, state, mu, active):
     """The implicit springs (params[1] = Δt²βκ) and dashpots (params[4] = cΔt/2, on the
     values compressed at tₙ): y = yf + Dμ."""
     m = yf.size
-    if params.size > DISKS_AT and params[DISKS_AT] > 0:
+    if params[DISKS_AT] > 0:
         kind = kinds_of(params[DISKS_AT:], m)
         its = disk_compliance_solve(D, yf, lo, hi, params[1], kind, mu)
         for i in range(m):   # in contact: the spring is compressed at y^{n+1}
@@ -205,7 +233,8 @@ def penalty_kernel(D, yf, y_cur, y_prev, lo, hi, params, state, mu, active):
             else:
                 active[i] = kind[i] > 0 and (mu[i] != 0.0 or mu[kind[i]] != 0.0)
         return its
-    its = compliance_solve(D, yf, lo, hi, params[1], state, mu, params[4], y_cur, y_prev)
+    its = compliance_solve(D, yf, lo, hi, params[1], state, mu, params[4], y_cur, y_prev,
+                           params[rows_at(params):])
     for i in range(m):   # in contact: the spring is compressed at y^{n+1}
         y = yf[i]
         for j in range(m):
@@ -216,31 +245,71 @@ def penalty_kernel(D, yf, y_cur, y_prev, lo, hi, params, state, mu, active):
 
 class Penalty(ContactLaw):
     """Normal compliance: the obstacles are one-sided springs of stiffness ``stiffness``
-    (in the units of the semi-discrete equation: per unit mass for the beam)."""
+    (in the units of the semi-discrete equation: per unit mass for the beam): one number,
+    or one per obstacle (``Obstacles.parts`` in order; the system's rows then need
+    StepData.obstacle), and so ``damping``."""
     name = "penalty"
     kernel = penalty_kernel
     explicit = penalty_explicit
     round_holes = True
     springs = True
 
-    def __init__(self, stiffness: float, damping: float = 0.0, implicit: bool = False):
-        self.stiffness = check_positive("stiffness", stiffness)
-        self.damping = check_nonnegative("damping", damping)
+    def __init__(self, stiffness, damping=0.0, implicit: bool = False):
+        self.stiffness = _per_obstacle("stiffness", stiffness, check_positive)
+        self.damping = _per_obstacle("damping", damping, check_nonnegative)
         self.implicit = bool(implicit)
 
     def setup(self, step, first=False):
-        beta, k = step.beta, self.stiffness
+        beta, k = step.beta, np.max(self.stiffness)
         w_cur, w_prev = (0.5 * (1 - 2 * beta), 0.0) if first else (1 - 2 * beta, beta)
         if self.implicit:           # the whole force at t_{n+1} (module docstring)
             beta, w_cur, w_prev = 1.0, 0.0, 0.0
+        k_lo, k_hi, c_lo, c_hi = self.row_params(step)
         params = np.array([k, step.dt ** 2 * beta * k, w_cur, w_prev,
-                           0.5 * step.dt * self.damping])
+                           0.5 * step.dt * np.max(self.damping)])
+        rows = [k_lo, k_hi, step.dt ** 2 * beta * k_lo, step.dt ** 2 * beta * k_hi,
+                0.5 * step.dt * c_lo, 0.5 * step.dt * c_hi]
         if not step.disks.size:
-            return params
-        if self.damping:
+            return np.concatenate([params, [0.0], *rows])
+        if np.any(self.damping):
             raise InputError("a support's damping (a dashpot) in a round hole is not "
                              "modelled: leave out [[obstacles]] damping")
-        return np.concatenate([params, disk_params(step.disks)])
+        if self.stiffness.size > 1:
+            raise InputError("round holes take one stiffness for all the obstacles")
+        return np.concatenate([params, disk_params(step.disks), *rows])
+
+    def row_params(self, step):
+        """(κ_lo, κ_hi, c_lo, c_hi) per constrained row: the stiffness and damping of the
+        obstacle giving its g1 and its g2 (StepData.obstacle; one number: every row)."""
+        m = step.lo.size
+        if self.stiffness.size == 1 and self.damping.size == 1:
+            k, c = np.full(m, self.stiffness[0]), np.full(m, self.damping[0])
+            return k, k, c, c
+        owner = np.asarray(step.obstacle, dtype=np.int64).reshape(-1, 2)
+        n = max(self.stiffness.size, self.damping.size)
+        if owner.shape[0] != m:
+            raise InputError("a stiffness per obstacle needs the system's obstacle of each "
+                             "constrained row (one-plane beams' flat obstacles); give one "
+                             "stiffness for all")
+        if owner.max(initial=-1) >= n:
+            raise InputError(f"{n} stiffnesses for {owner.max() + 1} obstacles: give one per "
+                             "obstacle (or one for all)")
+        k = np.broadcast_to(self.stiffness, (n,))
+        c = np.broadcast_to(self.damping, (n,))
+        pick = lambda v, i: np.where(i >= 0, v[np.maximum(i, 0)], v[0])  # noqa: E731
+        return (pick(k, owner[:, 0]), pick(k, owner[:, 1]), pick(c, owner[:, 0]),
+                pick(c, owner[:, 1]))
 
     def __repr__(self) -> str:
-        return f"Penalty(stiffness={self.stiffness:g}, damping={self.damping:g})"
+        def fmt(v):
+            return f"{v[0]:g}" if v.size == 1 else f"[{', '.join(f'{x:g}' for x in v)}]"
+        return f"Penalty(stiffness={fmt(self.stiffness)}, damping={fmt(self.damping)})"
+
+
+def _per_obstacle(name: str, value, check) -> np.ndarray:
+    """One number or one per obstacle, each checked (``check``), as a 1-d float array."""
+    values = np.atleast_1d(np.asarray(value, dtype=float)).ravel()
+    if values.size == 0:
+        raise InputError(f"{name}: give one number or one per obstacle")
+    return np.array([check(f"{name}[{i}]" if values.size > 1 else name, v)
+                     for i, v in enumerate(values.tolist())])

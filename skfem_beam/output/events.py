@@ -119,13 +119,52 @@ def impact_statistics(table: dict, duration: float, obstacles=None) -> dict:
     return out
 
 
+def spring_supports(table: dict, obstacles, stiffness, damping) -> list[dict]:
+    """Spring supports (the penalty law): per obstacle (``obstacles.parts`` in order, a
+    scene file's [[obstacles]]; one obstacle: itself) its ``stiffness`` and ``damping``
+    (one number, or one per obstacle, as given: N/m, N·s/m), its impacts, its largest
+    deflection (m: the largest compression of its spring at a node, impacts.csv's
+    max_violation) and its largest force (impacts.csv's peak_force, in its units), 0 for
+    an obstacle never touched.  An impact is the obstacle's whose g1 (bound 1) or g2 (2)
+    is the node's bound (Obstacles.owners: the law's own choice of spring)."""
+    parts = getattr(obstacles, "parts", ()) or (obstacles,)
+    k = np.broadcast_to(np.asarray(stiffness, dtype=float), (len(parts),))
+    c = np.broadcast_to(np.asarray(damping, dtype=float), (len(parts),))
+    x, bound = np.asarray(table["x"], dtype=float), np.asarray(table["bound"], dtype=int)
+    owner = obstacles.owners(x)[np.arange(x.size), bound - 1] if x.size else \
+        np.zeros(0, int)
+    out = []
+    for i, part in enumerate(parts):
+        rows = np.flatnonzero(owner == i)
+        out.append({"obstacle": i, "where": _describe(part), "stiffness": float(k[i]),
+                    "damping": float(c[i]), "impacts": int(rows.size),
+                    "max_deflection": float(table["max_violation"][rows].max(initial=0.0)),
+                    "max_force": float(table["peak_force"][rows].max(initial=0.0))})
+    return out
+
+
 def write_impacts(folder: Path, run, units: dict, scale: float = 1.0, sign: float = 1.0,
-                  obstacles=None, last: int | None = None, wear=None) -> dict:
+                  obstacles=None, last: int | None = None, wear=None,
+                  springs: tuple | None = None) -> dict:
     """Write ``folder/impacts.csv`` from ``run`` (a :class:`~skfem_beam.scheme.Run`) and
     return the summary entry ``{"impact_statistics": ...}``; ``units``: the force and
     impulse units (``{"force": "N", "impulse": "N·s"}``), see :func:`impact_table`.
     ``last``: the last state the loop computed when it is not ``run.n`` (a failed step
-    stops the loop inside a chunk)."""
+    stops the loop inside a chunk).  ``springs``: (stiffness, damping) of the
+    supports' springs in N/m and N·s/m (a penalty run on ``obstacles``): the entry
+    ``spring_supports`` too (:func:`spring_supports`)."""
+    out = _write_impacts(folder, run, units, scale, sign, obstacles, last, wear)
+    table = out.pop("_table", None)
+    if springs is not None and obstacles is not None and table is not None:
+        out["spring_supports"] = spring_supports(table, obstacles, *springs)
+        out["impact_statistics"]["units"]["spring_supports"] = (
+            "per obstacle: stiffness N/m, damping N·s/m (as given), max_deflection m (the "
+            f"largest compression of its spring), max_force {units['force']} (its largest "
+            "peak_force)")
+    return out
+
+
+def _write_impacts(folder, run, units, scale, sign, obstacles, last, wear) -> dict:
     s = run.system
     last = run.n if last is None else int(last)
     events = run.impact_events(last)
@@ -174,16 +213,19 @@ def write_impacts(folder: Path, run, units: dict, scale: float = 1.0, sign: floa
         return {"impact_statistics": stats, "friction": {
             "coefficients": coefficients,
             "nsgs_tolerance": NSGS_TOL, "nsgs_max_residual": float(run.st.fres[1])}}
-    return {"impact_statistics": stats}
+    return {"impact_statistics": stats, "_table": table}
 
 
-def beam_impacts(folder: Path, run, problem, last: int | None = None, wear=None) -> dict:
+def beam_impacts(folder: Path, run, problem, last: int | None = None, wear=None,
+                 springs: tuple | None = None) -> dict:
     """:func:`write_impacts` for a beam scene, in N and N·s when ρS is known (``wear``:
-    output.supports.Wear, two planes)."""
+    output.supports.Wear, two planes; ``springs``: the supports' (stiffness, damping),
+    N/m and N·s/m, of a penalty run)."""
     rho_S = problem.beam.rho_S
     units = {"force": "N", "impulse": "N·s"} if rho_S else \
         {"force": "m²/s² (N per kg/m)", "impulse": "m²/s (N·s per kg/m)"}
-    return write_impacts(folder, run, units, rho_S or 1.0, 1.0, problem.obstacles, last, wear)
+    return write_impacts(folder, run, units, rho_S or 1.0, 1.0, problem.obstacles, last, wear,
+                         springs)
 
 
 def bar_impacts(folder: Path, run, bar, last: int | None = None) -> dict:

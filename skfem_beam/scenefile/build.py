@@ -9,7 +9,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from .. import methods
-from ..checks import check_choice
+from ..checks import check_choice, check_nonnegative, check_positive
 from ..contact import SOLVERS
 from ..errors import InputError
 from ..scheme import Stepping
@@ -33,7 +33,8 @@ class Scene:
     ``problem``: a BeamProblem or a Bar; ``stepping``: the time grid; ``law``,
     ``stiffness`` (N/m), ``restitution``: the [contact] keys, ``damping`` (N·s/m): the
     supports' dashpots ([[obstacles]] damping) (``method`` builds the run's method from
-    them);
+    them); ``stiffness`` and ``damping`` are tuples (one per obstacle) when the
+    [[obstacles]] stiffness or damping differ;
     ``output``: format, save_every, frames, flush_every, checkpoint_every; ``text``: the
     file as read and ``files`` the tables it read (path as written → text), so that a run
     can be rebuilt from its summary.json; ``data``: the parsed TOML with the overrides.
@@ -42,13 +43,13 @@ class Scene:
     problem: object
     stepping: Stepping
     law: str = "auto"
-    stiffness: float | None = None
+    stiffness: float | tuple[float, ...] | None = None
     restitution: float = 0.0
     output: dict = field(default_factory=dict)
     text: str = ""
     files: dict = field(default_factory=dict)
     data: dict = field(default_factory=dict)
-    damping: float = 0.0
+    damping: float | tuple[float, ...] = 0.0
 
     @property
     def method(self) -> methods.Method:
@@ -93,25 +94,44 @@ def build(parsed: Parsed, dynamic: bool = True) -> Scene:
         raise InputError(f"{path.name}: {e}") from None
 
 
-def _supports(data: dict) -> tuple[float, float] | None:
+def _supports(data: dict) -> tuple | None:
     """A beam's [[obstacles]] stiffness (N/m) and damping (N·s/m, default 0): the supports'
-    own compliance, one pair for all of them (the penalty law's springs and dashpots;
-    their deflection is the support's).  None: rigid supports."""
+    own compliance (the penalty law's springs and dashpots; their deflection is the
+    support's), one number each when every obstacle has the same, else a tuple of one per
+    obstacle (one plane only: its rows know their obstacle).  Every obstacle has a
+    stiffness or none does (rigid supports: None); a damping needs a stiffness."""
     if data.get("kind", "beam") != "beam":
         return None
     obstacles = data.get("obstacles", [])
-    pairs = {(o.get("stiffness"), o.get("damping")) for o in obstacles}
-    if pairs <= {(None, None)}:
+    given = [(o.get("stiffness"), o.get("damping")) for o in obstacles]
+    if all(k is None and c is None for k, c in given):
         return None
-    if len(pairs) > 1 or None in {k for k, _ in pairs}:
-        raise InputError("[[obstacles]] stiffness, damping: give every obstacle the same "
-                         f"(got {', '.join(f'{k}, {c}' for k, c in sorted(pairs, key=str))})")
+    springs = [i for i, (k, _) in enumerate(given) if k is not None]
+    for i, (k, c) in enumerate(given):
+        where = f"[obstacles.{i}]"
+        if k is None and c is not None:
+            raise InputError(f"{where} damping is a dashpot beside the support's spring: "
+                             "give its stiffness (N/m) too")
+        if k is None:
+            raise InputError(f"{where} has no stiffness while [obstacles.{springs[0]}] has "
+                             "one: give every obstacle a stiffness (springs, N/m) or none "
+                             "(rigid); rigid and spring supports together are not modelled")
+        check_positive(f"{where} stiffness", k)
+        if c is not None:
+            check_nonnegative(f"{where} damping", c)
     if "stiffness" in data.get("contact", {}) or \
             data.get("contact", {}).get("law", "penalty") not in ("penalty", "auto"):
         raise InputError("[[obstacles]] stiffness makes the supports springs (the penalty "
                          "law): leave out [contact] law and stiffness")
-    (k, c), = pairs
-    return k, 0.0 if c is None else c
+    ks = tuple(float(k) for k, _ in given)
+    cs = tuple(0.0 if c is None else float(c) for _, c in given)
+    if len(set(ks)) == 1 and len(set(cs)) == 1:
+        return ks[0], cs[0]
+    if plane_count(data) == 2:
+        raise InputError("[[obstacles]] stiffness, damping may differ per obstacle in one "
+                         f"plane only; with planes = 2 give every obstacle the same (got "
+                         f"{', '.join(f'{k:g}, {c:g}' for k, c in zip(ks, cs))})")
+    return ks, cs
 
 
 def _scene(kind, problem, data, text, files) -> Scene:

@@ -98,6 +98,14 @@ def friction(system) -> bool:
     return bool(np.any(friction_of(system) > 0))
 
 
+def obstacle_rows(system) -> np.ndarray:
+    """Per constrained row the obstacle giving its lo and its hi (SemiDiscrete.row_obstacle;
+    unknown: (0, 2))."""
+    rows = getattr(system, "row_obstacle", None)
+    return np.zeros((0, 2), np.int64) if rows is None else \
+        np.ascontiguousarray(rows, dtype=np.int64).reshape(-1, 2)
+
+
 def disk_rows(system) -> np.ndarray:
     """The (q, 2) row pairs of the system's round holes (none: (0, 2))."""
     disks = getattr(system, "disks", None)
@@ -193,7 +201,8 @@ class BetaScheme:
             self.op = op = step_operators(system, s.dt, s.beta, s.massless)
         self.step = StepData(op.A, op.C, op.D, np.ascontiguousarray(system.lo, dtype=float),
                              np.ascontiguousarray(system.hi, dtype=float), s.dt, s.beta,
-                             disk_rows(system), land_rows(system), friction_of(system))
+                             disk_rows(system), land_rows(system), friction_of(system),
+                             obstacle_rows(system))
         self.law = law = self._law(law, m)
         if friction(system) and not law.friction:
             raise InputError(f"Coulomb friction needs law = round-hole-friction (or auto: "

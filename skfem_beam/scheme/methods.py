@@ -22,11 +22,13 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 from typing import ClassVar, Union
 
+import numpy as np
+
 from ..checks import check_choice, check_nonnegative, check_positive, check_restitution
 from ..contact import ContactLaw, resolve
 from ..contact.penalty import Penalty as PenaltyLaw
 from ..contact.restitution import Restitution
-from ..errors import Deferred
+from ..errors import Deferred, InputError
 from .beta import BetaScheme
 from .moreau_jean import NAME as MOREAU_JEAN, MoreauJeanScheme, check_theta
 from .run import Run
@@ -81,28 +83,42 @@ class Penalty:
     semi-discrete equation (per unit mass for a beam).
     ``damping``: a dashpot beside each spring (Kelvin–Voigt, N·s/m in the same units as
     ``stiffness``), the supports' own damping; ``implicit``: the whole spring force at
-    t_{n+1} (contact.penalty: the regularisation whose limit is the exact step)."""
-    stiffness: float
+    t_{n+1} (contact.penalty: the regularisation whose limit is the exact step).
+    ``stiffness`` and ``damping`` are one number, or a tuple of one per obstacle (in the
+    order of ``Obstacles.parts``: a scene file's [[obstacles]]) for a one-plane beam."""
+    stiffness: float | tuple[float, ...]
     equation_units: bool = False
     massless: str = "beta"
-    damping: float = 0.0
+    damping: float | tuple[float, ...] = 0.0
     implicit: bool = False
     name: ClassVar[str] = "penalty"
     default_beta: ClassVar[float] = 0.25
     theta: ClassVar[None] = None
 
     def __post_init__(self):
-        object.__setattr__(self, "stiffness", check_positive("stiffness", self.stiffness))
-        object.__setattr__(self, "damping", check_nonnegative("damping", self.damping))
+        object.__setattr__(self, "stiffness", _one_or_each("stiffness", self.stiffness,
+                                                           check_positive))
+        object.__setattr__(self, "damping", _one_or_each("damping", self.damping,
+                                                         check_nonnegative))
         check_choice("massless", self.massless, MASSLESS)
 
     def law(self, system) -> ContactLaw:
         scale = 1.0 if self.equation_units or system is None else mass_scale(system)
-        return PenaltyLaw(self.stiffness / scale, self.damping / scale,  # the one conversion
-                          self.implicit)
+        k, c = np.asarray(self.stiffness), np.asarray(self.damping)
+        return PenaltyLaw(k / scale, c / scale, self.implicit)     # the one conversion
 
     def build(self, system, stepping) -> Run:   # the quasi-static massless rows refuse springs
         return beta_run(system, replace(stepping, massless=self.massless), self.law(system))
+
+
+def _one_or_each(name: str, value, check):
+    """A number (checked by ``check``), or a tuple of one per obstacle, each checked."""
+    if np.ndim(value) == 0:
+        return check(name, value)
+    values = tuple(np.asarray(value, dtype=float).ravel().tolist())
+    if not values:
+        raise InputError(f"{name}: give one number or one per obstacle")
+    return tuple(check(f"{name}[{i}]", v) for i, v in enumerate(values))
 
 
 @dataclass(frozen=True)

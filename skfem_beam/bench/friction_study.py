@@ -276,6 +276,8 @@ def chart(rows: list[dict], dt_scene: float, path: Path) -> None:
                         label=LABEL[law])
             ax.set_xscale("log")
         ax.axvline(dt_scene, color="0.6", ls=":", lw=1)
+        ax.set_xticks(dts, [f"{d:g}" for d in dts], fontsize=7)
+        ax.minorticks_off()
         ax.set_xlabel("Δt (s)  (dotted: the scene's)")
         ax.set_title(title, fontsize=10)
         ax.grid(True, which="both", alpha=0.3)

@@ -12,6 +12,7 @@ from .penalty import Penalty
 from .projection import Projection
 from .restitution import Restitution
 from .round_hole import RoundHole
+from .sparse_qp import ClarabelSparseLaw, OSQPSparseLaw, PDASSparse
 
 LAWS = {
     "projection": Projection,
@@ -21,6 +22,10 @@ LAWS = {
     "penalty": Penalty,      # needs stiffness=
     "restitution": Restitution,   # needs restitution= (e)
     "round-hole": RoundHole,      # round holes (and boxes beside them), exact
+    # x-space engines for many contacts, C a selector (the plate): no W, no D
+    "pdas-sparse": PDASSparse,
+    "osqp-sparse": OSQPSparseLaw,
+    "clarabel-sparse": ClarabelSparseLaw,
 }
 
 

@@ -209,7 +209,7 @@ class OSQPSparse(XSpaceSolver):
             lo_s, hi_s = self.scaled_bounds()
             self.prob.update(l=lo_s, u=hi_s)
         self.prob.update(q=self.qmat @ x)
-        r = self.prob.solve()
+        r = self.prob.solve(raise_error=False)
         if r.info.status_val != self._solved:
             raise SolverError(f"OSQP returned status '{r.info.status}' after {r.info.iter} "
                               f"iterations")

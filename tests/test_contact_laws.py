@@ -33,7 +33,8 @@ def test_the_documented_law_runs_and_agrees_with_projection(tmp_path):
 
 def test_registry_names_and_auto():
     assert set(LAWS) == {"projection", "active-set", "osqp", "daqp", "penalty", "restitution",
-                         "round-hole"}
+                         "round-hole", "round-hole-friction", "pdas-sparse", "osqp-sparse",
+                         "clarabel-sparse"}
     for name in ("projection", "active-set", "osqp", "daqp"):
         assert resolve(name).name == name
     assert isinstance(resolve("auto", stiffness=1e3), Penalty)

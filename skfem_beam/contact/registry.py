@@ -15,6 +15,7 @@ from .projection import Projection
 from .restitution import Restitution
 from .round_hole import RoundHole
 from .round_hole_friction import RoundHoleFriction
+from .sparse_qp import ClarabelSparseLaw, OSQPSparseLaw, PDASSparse
 
 LAWS = {
     "projection": Projection,
@@ -25,6 +26,10 @@ LAWS = {
     "restitution": Restitution,   # needs restitution= (e)
     "round-hole": RoundHole,      # round holes (and boxes beside them), exact
     "round-hole-friction": RoundHoleFriction,   # ... with Coulomb friction, exact contact
+    # x-space engines for many contacts, C a selector (the plate): no W, no D
+    "pdas-sparse": PDASSparse,
+    "osqp-sparse": OSQPSparseLaw,
+    "clarabel-sparse": ClarabelSparseLaw,
 }
 
 

@@ -1,23 +1,28 @@
-"""What a plate step costs: ``python -m skfem_beam.plate.bench [--meshes 20 40]``.
+"""What a plate step costs: ``python -m skfem_beam.plate.bench [--meshes 20 40 80]``.
 
 A simply supported 1 × 1 m steel plate (h = 1 cm, BFS on n × n), a flat obstacle under
 the whole plate at w ≥ −0.2 w_s (w_s: the static centre deflection under the load), the
 plate starting flat at rest under a uniform −10 kPa: it falls onto the obstacle within a
 quarter period and stays pressed on it.  Printed per mesh: the half bandwidth, the setup
 (the banded Cholesky of A = M + βΔt²K alone, and the whole of scheme.operators:
-step_operators, with W = A⁻¹Cᵀ and D = C W) and the bytes of W and D; per step, one
-banded solve with A's factor, the scheme's step without obstacles, and the step pressed
-on the obstacle with each exact law (its mean over the run, with the fraction of steps
-in contact).  Only measured, nothing tuned (docs/plate.md, Dynamics).
+step_operators, with W = A⁻¹Cᵀ and D = C W, when W fits in W_LIMIT bytes) and the bytes
+of W and D; per step, one banded solve with A's factor, the scheme's step without
+obstacles, and the step pressed on the obstacle with each exact law (its mean over the
+run, with the fraction of steps in contact, and its ratio to the banded solve); the
+process's peak memory after each mesh.  The laws that need W and D (active-set, daqp,
+osqp) run only where W fits; the x-space laws (contact.sparse_qp) build neither.  Only
+measured, nothing tuned (docs/plate.md, "Which engine at which size").
 """
 from __future__ import annotations
 
 import argparse
+import resource
 import time
 
 import numpy as np
 
 from ..linalg import Banded, band_solve
+from ..methods import PositionLevel
 from ..scheme import solve
 from ..scheme.methods import PositionLevel
 from ..scheme.operators import step_operators
@@ -27,7 +32,10 @@ from .system import PlateInitial, PlateObstacle, Pressure, half_bandwidth, plate
 
 LOAD = -1e4                  # Pa
 DT = 2e-4                    # s (the first period is 20 ms)
-LAWS = {"active-set": 200, "daqp": 200, "osqp": 40}     # steps of each law's run
+STEPS = 100                  # steps of each law's run
+DELASSUS_LAWS = ("active-set", "daqp", "osqp")               # need W and D
+X_SPACE_LAWS = ("pdas-sparse", "osqp-sparse", "clarabel-sparse")   # neither
+W_LIMIT = 200e6              # bytes: W = A⁻¹Cᵀ (dense n × m) is built below this only
 
 
 def timed(f, repeat: int = 1) -> float:
@@ -51,17 +59,20 @@ def systems(n: int):
 
 
 def setup_row(system) -> dict:
-    """The band, the factor's and step_operators' times, and W's and D's bytes."""
+    """The band, the factor's and step_operators' times (with W and D if W fits in
+    W_LIMIT, else without), and W's and D's bytes."""
     A = system.M + 0.5 * DT**2 * system.K
     factor = timed(lambda: Banded(A, factor=True), 3)
+    delassus = 8.0 * system.n * system.C.shape[0] <= W_LIMIT
     t0 = time.perf_counter()
-    ops = step_operators(system, DT, 0.5)
+    ops = step_operators(system, DT, 0.5, delassus=delassus)
     total = time.perf_counter() - t0
     b = np.ones(system.n)
     solve_s = timed(lambda: band_solve(ops.Ab.chol, b), 50)
     return {"n": system.n, "m": system.C.shape[0], "kd": half_bandwidth(A),
             "factor_s": factor, "operators_s": total, "W_MB": ops.W.nbytes / 1e6,
-            "D_MB": ops.D.nbytes / 1e6, "band_solve_ms": 1e3 * solve_s}
+            "D_MB": ops.D.nbytes / 1e6, "band_solve_ms": 1e3 * solve_s,
+            "delassus": delassus}
 
 
 def step_ms(system, solver: str, steps: int) -> tuple[float, float]:
@@ -73,28 +84,43 @@ def step_ms(system, solver: str, steps: int) -> tuple[float, float]:
     return 1e3 * r.wall_time_s / r.steps, r.contact_fraction
 
 
+def peak_mb() -> float:
+    """The process's peak resident memory so far (MB; Linux reports kB)."""
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e3
+
+
+def law_rows(pressed, laws, solve_ms: float) -> None:
+    """One line per law: its mean step, the fraction in contact, the ratio to a solve."""
+    for law in laws:
+        try:
+            ms, fraction = step_ms(pressed, law, STEPS)
+        except Exception as e:          # a law that does not run here says why
+            print(f"  step with {law}: not run ({type(e).__name__}: {e})", flush=True)
+            continue
+        print(f"  step with {law}: {ms:.2f} ms = {ms / solve_ms:.1f} solves ({STEPS} steps, "
+              f"{100 * fraction:.0f} % in contact)", flush=True)
+
+
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--meshes", type=int, nargs="+", default=[20, 40])
+    parser.add_argument("--laws", nargs="+", default=DELASSUS_LAWS + X_SPACE_LAWS)
     args = parser.parse_args(argv)
     for n in args.meshes:
         free, pressed = systems(n)
         row = setup_row(pressed)
         print(f"BFS {n} x {n}: {row['n']} unknowns, {row['m']} constrained vertices, half "
               f"bandwidth {row['kd']}")
-        print(f"  setup: Cholesky of A {row['factor_s']:.3f} s, step_operators (A, W, D) "
+        what = "(A, W, D)" if row["delassus"] else "(A; W would be " \
+            f"{8e-6 * row['n'] * row['m']:.0f} MB: not built)"
+        print(f"  setup: Cholesky of A {row['factor_s']:.3f} s, step_operators {what} "
               f"{row['operators_s']:.2f} s; W {row['W_MB']:.1f} MB, D {row['D_MB']:.1f} MB")
-        print(f"  one banded solve: {row['band_solve_ms']:.3f} ms")
-        ms, _ = step_ms(free, "auto", 200)
-        print(f"  step without obstacles: {ms:.3f} ms")
-        for law, steps in LAWS.items():
-            try:
-                ms, fraction = step_ms(pressed, law, steps)
-            except Exception as e:          # a law that does not run here says why
-                print(f"  step with {law}: not run ({type(e).__name__}: {e})")
-                continue
-            print(f"  step with {law}: {ms:.3f} ms ({steps} steps, {100 * fraction:.0f} % "
-                  f"in contact)")
+        print(f"  one banded solve: {row['band_solve_ms']:.3f} ms", flush=True)
+        ms, _ = step_ms(free, "auto", STEPS)
+        print(f"  step without obstacles: {ms:.2f} ms", flush=True)
+        laws = [law for law in args.laws if row["delassus"] or law not in DELASSUS_LAWS]
+        law_rows(pressed, laws, row["band_solve_ms"])
+        print(f"  peak memory of the process so far: {peak_mb():.0f} MB", flush=True)
 
 
 if __name__ == "__main__":

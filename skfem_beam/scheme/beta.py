@@ -197,8 +197,11 @@ class BetaScheme:
         self.dt, self.beta, self.theta, self.n_steps = s.dt, s.beta, None, s.steps
         self.save_every, self.frame_every = s.save_every, s.frame_every
         self.shift = 0.5 * s.dt if s.load_window == "centered" else 0.0
+        law = resolve(law) if not isinstance(law, ContactLaw) else law
+        x_space = bool(getattr(law, "x_space", False)) and m > 0   # no W, no D
         with _callees_aside():
-            self.op = op = step_operators(system, s.dt, s.beta, s.massless)
+            self.op = op = step_operators(system, s.dt, s.beta, s.massless,
+                                          delassus=not x_space)
         self.step = StepData(op.A, op.C, op.D, np.ascontiguousarray(system.lo, dtype=float),
                              np.ascontiguousarray(system.hi, dtype=float), s.dt, s.beta,
                              disk_rows(system), land_rows(system), friction_of(system),
@@ -372,7 +375,8 @@ class BetaScheme:
                     raise SolverError("the first step's contact problem could not be solved")
                 st.law_state[:] = 0
                 st.active[:] = False
-            u1 = u1 + op.W @ st.mu
+            if op.W.shape[1] == st.mu.size:     # else an x-space law wrote u¹ into u1
+                u1 = u1 + op.W @ st.mu
         st.u_cur[:] = u1
         csr_product(self.ops.Cp, self.ops.Ci, self.ops.Cx, u1, st.y_cur)
         st.mu[:] = 0.0

@@ -186,10 +186,11 @@ def finish_step(ops, st, Gn, massless):
     Zr, beta = ops.Zr, ops.beta
     x, mu, d, u_prev, u_cur, work = st.x, st.mu, st.d, st.u_prev, st.u_cur, st.work
     dy, y_prev, y_cur, r_e, rowwork = st.dy, st.y_prev, st.y_cur, st.r_e, st.rowwork
-    for j in range(mu.size):
-        if mu[j] != 0.0:
-            for i in range(x.size):
-                x[i] += W[i, j] * mu[j]
+    if W.shape[1] == mu.size:   # else an x-space law wrote uⁿ⁺¹ into x (no W)
+        for j in range(mu.size):
+            if mu[j] != 0.0:
+                for i in range(x.size):
+                    x[i] += W[i, j] * mu[j]
     for i in range(x.size):
         d[i] = x[i] - u_prev[i]
     if Bb.shape[0]:

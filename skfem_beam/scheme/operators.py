@@ -20,6 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
@@ -62,7 +63,11 @@ def load_norms(system, dt: float, beta: float) -> np.ndarray:
     return np.sqrt(np.array([lv @ spla.spsolve(N, lv) for lv in system.loads.T]))
 
 
-def step_operators(system, dt: float, beta: float, massless: str = "beta") -> StepOperators:
+def step_operators(system, dt: float, beta: float, massless: str = "beta",
+                   delassus: bool = True) -> StepOperators:
+    """The step's operators; ``delassus=False`` (an x-space law, contact.sparse_qp): W
+    and D are not built (W (n, 0), D (0, 0)); a plate builds W with one banded solve of
+    all its columns (`multi_rhs_W`), the beam column by column as it always has."""
     M, K, B = system.M, system.K, system.B
     Z = massless_rows(M)
     quasi_static, massless = massless == "quasi-static", Z.size
@@ -85,11 +90,16 @@ def step_operators(system, dt: float, beta: float, massless: str = "beta") -> St
                          f"floating-point range ({e}): check the scales of k2, L, dt") from None
     C = system.C.tocsr()
     m = C.shape[0]
-    W = np.zeros((system.n, m))
-    for j in range(m):
-        col = C[j].toarray().ravel()
-        band_solve(Ab.chol, col)
-        W[:, j] = col
+    if not delassus:
+        W = np.zeros((system.n, 0))
+    elif getattr(system, "meta", {}).get("kind") == "plate":
+        W = multi_rhs_W(Ab, C)
+    else:
+        W = np.zeros((system.n, m))
+        for j in range(m):
+            col = C[j].toarray().ravel()
+            band_solve(Ab.chol, col)
+            W[:, j] = col
     if quasi_static and Z.size:
         if B is not None:
             raise InputError("massless='quasi-static' with damping is not supported (the "
@@ -101,10 +111,19 @@ def step_operators(system, dt: float, beta: float, massless: str = "beta") -> St
         W *= beta       # the contact term of the rows times β (see the module docstring)
     else:
         Z = np.zeros(0, dtype=np.int64)
-    D = np.ascontiguousarray((C @ W).reshape(m, m))
+    D = np.ascontiguousarray((C @ W).reshape(m, m)) if delassus else np.zeros((0, 0))
     return StepOperators(A=sp.csr_matrix(A), Ab=Ab, Eb=Banded(E), Kb=Banded(K),
                          Bb=Banded(B).rows if B is not None else np.zeros((0, 1)),
                          C=C, W=W, D=D, Z=Z.astype(np.int64))
+
+
+def multi_rhs_W(Ab: Banded, C) -> np.ndarray:
+    """W = A⁻¹Cᵀ by LAPACK's banded solve of all m columns at once (one call, no CSR slice
+    per column: 40 × 40 plate, 1,521 columns: 25 s column by column before)."""
+    W = np.asfortranarray(C.T.toarray())
+    return np.ascontiguousarray(
+        scipy.linalg.cho_solve_banded((Ab.lapack_band("chol"), False), W, overwrite_b=True,
+                                      check_finite=False))
 
 
 def csr_arrays(a):

@@ -1,0 +1,78 @@
+"""The x-space contact engines (skfem_beam/contact/sparse_qp.py) on the plate: the same run
+as the compiled active set (which uses W = A⁻¹Cᵀ and D = C W) before the second impact,
+contact exact at the vertices, the scheme's energy identity closed; and the beam's C
+(not a selector) refused."""
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from skfem_beam import InputError
+from skfem_beam.contact.sparse_qp import SelectorQP, selected_unknowns
+from skfem_beam.methods import PositionLevel
+from skfem_beam.plate import Plate, plate_space
+from skfem_beam.plate.system import PlateInitial, PlateObstacle, Pressure, plate_system
+from skfem_beam.scheme import solve
+
+DT, T = 1e-4, 0.03
+
+
+def closure(r):
+    """energy − energy[0] + damping work − input work − contact work (0 by the identity)."""
+    w = r.work
+    return r.energy - r.energy[0] + w["damping"] - w["input"] - w["contact"]
+
+
+@pytest.fixture(scope="module")
+def plate():
+    """A simply supported 1 × 1 m steel plate (12 × 12 BFS, 121 contact vertices)
+    deflected upwards by 10 kPa, released at rest onto a flat obstacle under the whole
+    plate at half its static centre deflection; and the compiled active set's run."""
+    space = plate_space(Plate(nx=12, ny=12))
+    start = PlateInitial(static=Pressure(1e4))
+    free = plate_system(space, initial=start)
+    w_max = float(free.observe["w(0.5,0.5)"] @ free.u0)
+    system = plate_system(space, obstacles=[PlateObstacle(g1=-0.5 * w_max)], initial=start)
+    return system, w_max, solve(system, DT, T, method=PositionLevel("active-set"))
+
+
+@pytest.mark.parametrize("law", ["osqp-sparse", "pdas-sparse", "clarabel-sparse"])
+def test_an_x_space_engine_runs_the_active_sets_plate(plate, law):
+    system, w_max, ref = plate
+    r = solve(system, DT, T, method=PositionLevel(law))
+    assert r.success and r.solver == law and r.impacts > 0
+    starts = np.sort(ref.impact_events["t_start"])
+    second = starts[starts > starts[0] + 5 * DT]
+    before = ref.t < (second[0] if second.size else np.inf)
+    scale = np.abs(ref.frames_u).max()
+    frames = ref.frames_t < (second[0] if second.size else np.inf)
+    assert np.abs(r.frames_u[frames] - ref.frames_u[frames]).max() <= 1e-10 * scale
+    w, w_ref = r.observed["w(0.5,0.5)"], ref.observed["w(0.5,0.5)"]
+    assert np.abs(w[before] - w_ref[before]).max() <= 1e-10 * w_max
+    y = r.frames_u @ system.C.T
+    assert (y - system.lo).min() >= -1e-12 * w_max
+    assert r.max_nodal_violation <= 1e-12 * w_max
+    assert np.abs(closure(r)).max() <= 1e-9 * np.abs(r.energy).max()
+
+
+def test_the_engines_need_a_selector_and_the_exact_finish_is_exact():
+    with pytest.raises(InputError, match="select one unknown"):
+        selected_unknowns(sp.csr_matrix([[1.0, -1.0, 0.0]]))
+    rng = np.random.default_rng(0)
+    n = 30
+    B = sp.random(n, n, density=0.1, random_state=1)
+    A = sp.csr_matrix(B @ B.T + n * sp.eye(n))
+    A = sp.csr_matrix(A.multiply(abs(sp.eye(n, k=0) + sum(sp.eye(n, k=k) + sp.eye(n, k=-k)
+                                                         for k in range(1, 4))) > 0))
+    C = sp.csr_matrix((np.ones(10), (np.arange(10), np.arange(0, 30, 3))), shape=(10, n))
+    qp = SelectorQP(A, C)
+    x = rng.normal(size=n)
+    lo, hi = np.full(10, -0.1), np.full(10, 0.1)
+    state = np.zeros(10, np.int8)
+    u = x.copy()
+    mu, sweeps = qp.finish(u, lo, hi, state)
+    y = u[qp.dof]
+    assert np.all(y >= lo) and np.all(y <= hi)
+    assert np.allclose(A @ u, A @ x + C.T @ mu, rtol=0, atol=1e-12 * np.abs(A @ x).max())
+    assert np.all(mu[state < 0] > 0) and np.all(mu[state > 0] < 0) and np.all(mu[state == 0] == 0)
+    assert np.array_equal(y[state < 0], lo[state < 0]) and np.array_equal(y[state > 0],
+                                                                          hi[state > 0])

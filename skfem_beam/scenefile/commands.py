@@ -73,10 +73,9 @@ def _scene_of(path, sets, resume) -> Scene:
     return load(path or "scene.toml", sets or (), **stored)
 
 
-def _spec(scene: Scene, flags: dict, resume) -> RunSpec:
-    """The scene and the command line's flags (which override its [output] and [time] T)
-    as one RunSpec; summary.json's config records both, in the flags' names."""
-    given = flags.pop("probe", None) or []
+def _grid(scene, flags: dict, resume) -> tuple[OutputOptions, object]:
+    """The output options and the time grid: the flags (completed in place from the
+    scene's [output] and [time] T where not given) over the scene's."""
     for key, value in scene.output.items():
         if key != "probes" and flags[key] is None:
             flags[key] = value
@@ -85,8 +84,15 @@ def _spec(scene: Scene, flags: dict, resume) -> RunSpec:
     options = OutputOptions(flags["out"], flags["overwrite"], resume, flags["format"],
                             flags["frames"], flags["save_every"], flags["flush_every"],
                             flags["checkpoint_every"])
-    stepping = replace(scene.stepping, T=flags["T"], save_every=options.save_every,
-                       frames=options.frames)
+    return options, replace(scene.stepping, T=flags["T"], save_every=options.save_every,
+                            frames=options.frames)
+
+
+def _spec(scene: Scene, flags: dict, resume) -> RunSpec:
+    """The scene and the command line's flags (which override its [output] and [time] T)
+    as one RunSpec; summary.json's config records both, in the flags' names."""
+    given = flags.pop("probe", None) or []
+    options, stepping = _grid(scene, flags, resume)
     law, restitution = scene.law, scene.restitution
     mass = scene.data.get("mesh", {}).get("mass", "consistent") if scene.kind == "beam" \
         else scene.problem.mass
@@ -109,16 +115,7 @@ def _plate_spec(scene, flags: dict, resume) -> RunSpec:
     if flags.pop("probe", None):
         raise InputError("--probe X is a beam's abscissa; a plate's probes are [output] "
                          "probes = [[x, y], ...] in the scene file")
-    for key, value in scene.output.items():
-        if key != "probes" and flags[key] is None:
-            flags[key] = value
-    flags["T"] = scene.stepping.T if flags["T"] is None else flags["T"]
-    flags["out"] = flags["out"] or f"out/{Path(flags['scene']).stem}"
-    options = OutputOptions(flags["out"], flags["overwrite"], resume, flags["format"],
-                            flags["frames"], flags["save_every"], flags["flush_every"],
-                            flags["checkpoint_every"])
-    stepping = replace(scene.stepping, T=flags["T"], save_every=options.save_every,
-                       frames=options.frames)
+    options, stepping = _grid(scene, flags, resume)
     config = {"command": "python -m skfem_beam run", "scene_text": scene.text,
               "scene_files": scene.files, **flags, "probe": None, "dt": stepping.dt,
               "beta": stepping.beta, "law": scene.method.name}

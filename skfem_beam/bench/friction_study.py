@@ -41,14 +41,15 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import SolverError
+from ..methods import MOREAU_JEAN
 from ..output.supports import support_rows, union_length
 from ..scenefile import example, load
 from ..scenefile.build import wear
 from ..semidiscrete import beam_system
 
 SCENE = "tube_round_holes_friction"
-LAWS = ("moreau-jean", "round-hole-friction")
-LABEL = {"moreau-jean": "Moreau–Jean (θ = ½)", "round-hole-friction": "position level (β = ½)"}
+LAWS = (MOREAU_JEAN, "round-hole-friction")
+LABEL = {MOREAU_JEAN: "Moreau–Jean (θ = ½)", "round-hole-friction": "position level (β = ½)"}
 FACTORS = (4, 2, 1, 0.5, 0.25, 0.125)       # × the scene's Δt
 STATS = ("friction_W", "normal_W", "wear_m3_s")
 COLUMNS = ("law", "dt", "T", "t0", "x", "penetration_m", "penetration_pct", "friction_W",
@@ -203,7 +204,7 @@ def verdict(rows: list[dict], dt: float) -> tuple[bool, str]:
     lines, ok = [], True
     for name in ("friction_W", "wear_m3_s"):
         e = errors_at(rows, dt, name)
-        mj, pl = e["moreau-jean"], e["round-hole-friction"]
+        mj, pl = e[MOREAU_JEAN], e["round-hole-friction"]
         excess = pl["error_common"] - mj["error_common"]
         ok &= excess <= e["noise"]
         lines.append(
@@ -216,7 +217,7 @@ def verdict(rows: list[dict], dt: float) -> tuple[bool, str]:
             f"{mj['finest']:.4g} differ by "
             f"{100 * abs(pl['finest'] - mj['finest']) / e['common_limit']:.1f} %; noise "
             f"(2 standard errors) {100 * e['noise']:.1f} %")
-    dts, pen = per_run(rows, "moreau-jean", "penetration_m")
+    dts, pen = per_run(rows, MOREAU_JEAN, "penetration_m")
     lines.append(f"penetration: Moreau–Jean {pen[0]:.3g} … {pen[-1]:.3g} m, order "
                  f"{np.polyfit(np.log(dts), np.log(pen), 1)[0]:.2f}; position level at most "
                  f"{max(r['penetration_m'] for r in rows if r['law'] != 'moreau-jean'):.2g} m")

@@ -243,7 +243,7 @@ def main(argv=None) -> int:
     if args.child:
         _child(*args.child)
         return 0
-    scenes = sorted(p.name for p in (PACKAGE / "scene_files").glob("*.toml")) \
+    scenes = sorted(str(p) for p in (PACKAGE / "scene_files").glob("**/*.toml")) \
         if args.scenes else args.scene
     if scenes:
         return _scenes(args, [_scene_path(s) for s in scenes])

@@ -144,6 +144,8 @@ class ContactLaw:
     springs = False      # the obstacles are springs: a penetration is a support's
     #                      deflection (physics), not a numerical error
     friction = False     # takes Coulomb friction (StepData.friction); the others refuse it
+    x_space = False      # solves for uⁿ⁺¹ itself (contact.sparse_qp): the scheme builds
+    #                      neither W nor D for it
 
     def setup(self, step: StepData, first: bool = False) -> np.ndarray:
         return np.zeros(0)

@@ -198,7 +198,7 @@ class BetaScheme:
         self.save_every, self.frame_every = s.save_every, s.frame_every
         self.shift = 0.5 * s.dt if s.load_window == "centered" else 0.0
         law = resolve(law) if not isinstance(law, ContactLaw) else law
-        x_space = bool(getattr(law, "x_space", False)) and m > 0   # no W, no D
+        x_space = law.x_space and m > 0   # no W, no D
         with _callees_aside():
             self.op = op = step_operators(system, s.dt, s.beta, s.massless,
                                           delassus=not x_space)
@@ -232,9 +232,8 @@ class BetaScheme:
         self.holes = self.st.hk if self.ops.Nc.shape[0] else None
         self.massless = self.st.ez if self.ops.Zr.size else None
 
-    def _law(self, law, m: int) -> ContactLaw:
-        """The law object: none without constraints; "auto" decided for this step."""
-        law = resolve(law) if not isinstance(law, ContactLaw) else law
+    def _law(self, law: ContactLaw, m: int) -> ContactLaw:
+        """The law to run: none without constraints; "auto" decided for this step."""
         if m == 0:
             return NoContact()
         return law.choose(self.step) if isinstance(law, Auto) else law

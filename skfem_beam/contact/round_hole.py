@@ -285,30 +285,15 @@ def land_cone_solve(D, yf, lo, hi, kind, lands, mu, active):
     the broached holes' code (it prunes a None argument's branches: a round-hole scene's
     first run compiles less).  Returns the sweeps (< 0: no convergence)."""
     m = yf.size
-    y = yf.copy()
-    for j in range(m):
-        mu[j] = 0.0
+    y, scale, blocks = sweep_start(yf, lo, hi, kind, mu)
     root, new = np.empty(3), np.empty(2)
     piece = np.zeros(m, np.int64)
-    scale = data_scale(yf, lo, hi)
     tol = 1e-13 * scale
-    blocks = 0
-    for j in range(m):
-        if kind[j] >= 0:
-            blocks += 1
     for sweeps in range(1, MAX_SWEEPS + 1):
         change = 0.0
         for j in range(m):
             if kind[j] == 0:
-                yt = y[j] - D[j, j] * mu[j]
-                target = min(max(yt, lo[j]), hi[j])
-                new_j = (target - yt) / D[j, j]
-                dj = new_j - mu[j]
-                if dj != 0.0:
-                    for i in range(m):
-                        y[i] += D[i, j] * dj
-                    mu[j] = new_j
-                change = max(change, abs(D[j, j] * dj))
+                change = max(change, box_row(D, y, lo, hi, mu, j))
             elif kind[j] > 0:
                 a, b = j, kind[j]
                 _block(D, y, lo, hi, kind, lands, piece, mu, a, root, new)
@@ -325,14 +310,55 @@ def land_cone_solve(D, yf, lo, hi, kind, lands, mu, active):
         return -1
     if blocks > 1:
         _polish(D, yf, lo, hi, kind, lands, piece, mu, tol)
-    for j in range(m):
+    contact_flags(kind, mu, active)
+    return sweeps
+
+
+@internal
+def sweep_start(yf, lo, hi, kind, mu):
+    """A Gauss–Seidel's start: (y = y_f, the data's scale, the number of blocks: box
+    rows and disks), μ ← 0."""
+    for j in range(yf.size):
+        mu[j] = 0.0
+    blocks = 0
+    for j in range(yf.size):
+        if kind[j] >= 0:
+            blocks += 1
+    return yf.copy(), data_scale(yf, lo, hi), blocks
+
+
+@internal
+def box_row(D, y, lo, hi, mu, j):
+    """Box row j's projection (Lemma 4.1) with the others fixed; returns its change."""
+    yt = y[j] - D[j, j] * mu[j]
+    new_j = (min(max(yt, lo[j]), hi[j]) - yt) / D[j, j]
+    dj = new_j - mu[j]
+    if dj != 0.0:
+        for i in range(y.size):
+            y[i] += D[i, j] * dj
+        mu[j] = new_j
+    return abs(D[j, j] * dj)
+
+
+@internal
+def contact_flags(kind, mu, active):
+    """The values in contact: a disk's first row when its μ_p ≠ 0, never its second row,
+    a box row when its μ ≠ 0."""
+    for j in range(mu.size):
         if kind[j] > 0:
             active[j] = mu[j] != 0.0 or mu[kind[j]] != 0.0
         elif kind[j] < 0:
             active[j] = False
         else:
             active[j] = mu[j] != 0.0
-    return sweeps
+
+
+def check_radii(step) -> None:
+    """A round hole's two rows (its box [lo, hi]) must have the same radius."""
+    width = step.hi - step.lo
+    first, second = step.disks[:, 0], step.disks[:, 1]
+    if step.disks.size and np.any(np.abs(width[first] - width[second]) > 1e-12 * width[first]):
+        raise InputError("a round hole's two rows must have the same radius")
 
 
 def disk_kinds(m: int, disks) -> np.ndarray:
@@ -401,10 +427,7 @@ class RoundHole(ContactLaw):
     round_holes = True
 
     def setup(self, step, first=False):
-        if step.disks.size and np.any(np.abs((step.hi - step.lo)[step.disks[:, 0]]
-                                             - (step.hi - step.lo)[step.disks[:, 1]])
-                                      > 1e-12 * (step.hi - step.lo)[step.disks[:, 0]]):
-            raise InputError("a round hole's two rows must have the same radius")
+        check_radii(step)
         if step.lands.size and np.any(step.lands[:, 0] > 0):
             self.kernel = broached_hole_kernel    # round holes only: no lands' code
             return np.concatenate([disk_params(step.disks), land_params(step.lands)])

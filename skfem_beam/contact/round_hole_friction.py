@@ -36,10 +36,9 @@ import numpy as np
 from numba import njit
 
 from ..errors import InputError
-from .active_set import data_scale
 from .base import ContactLaw, compiled_law
-from .round_hole import (MAX_SWEEPS, SWEEP_TOL, disk_params, disk_root, land_cone_solve,
-                         radial)
+from .round_hole import (MAX_SWEEPS, SWEEP_TOL, box_row, check_radii, contact_flags,
+                         disk_params, disk_root, kinds_of, land_cone_solve, radial, sweep_start)
 
 internal = njit(cache=True)
 
@@ -133,19 +132,6 @@ def coulomb_disk(D2, z, q, r, f, out):
 
 
 @internal
-def _box_row(D, y, lo, hi, mu, j):
-    """Box row j's projection (Lemma 4.1) with the others fixed; returns its change."""
-    yt = y[j] - D[j, j] * mu[j]
-    new_j = (min(max(yt, lo[j]), hi[j]) - yt) / D[j, j]
-    dj = new_j - mu[j]
-    if dj != 0.0:
-        for i in range(y.size):
-            y[i] += D[i, j] * dj
-        mu[j] = new_j
-    return abs(D[j, j] * dj)
-
-
-@internal
 def _disk_block(D, y, y_prev, bounds, fric, mu, a, b, local):
     """Disk (a, b)'s exact Coulomb block with the others fixed; returns its change."""
     lo, hi = bounds
@@ -168,20 +154,13 @@ def friction_cone_solve(D, yf, y_prev, lo, hi, kind, fric, mu, active):
     first row; ``kind`` as round_hole.cone_solve's; ``y_prev`` = C u^{n−1}, the slip's
     reference).  Returns the sweeps (< 0: no convergence)."""
     m = yf.size
-    y = yf.copy()
-    for j in range(m):
-        mu[j] = 0.0
+    y, scale, blocks = sweep_start(yf, lo, hi, kind, mu)
     local = np.empty(4)
-    scale = data_scale(yf, lo, hi)
-    blocks = 0
-    for j in range(m):
-        if kind[j] >= 0:
-            blocks += 1
     for sweeps in range(1, MAX_SWEEPS + 1):
         change = 0.0
         for j in range(m):
             if kind[j] == 0:
-                change = max(change, _box_row(D, y, lo, hi, mu, j))
+                change = max(change, box_row(D, y, lo, hi, mu, j))
             elif kind[j] > 0:
                 change = max(change, _disk_block(D, y, y_prev, (lo, hi), fric, mu, j,
                                                  kind[j], local))
@@ -189,27 +168,18 @@ def friction_cone_solve(D, yf, y_prev, lo, hi, kind, fric, mu, active):
             break
     else:
         return -1
-    for j in range(m):
-        if kind[j] > 0:
-            active[j] = mu[j] != 0.0 or mu[kind[j]] != 0.0
-        elif kind[j] < 0:
-            active[j] = False
-        else:
-            active[j] = mu[j] != 0.0
+    contact_flags(kind, mu, active)
     return sweeps
 
 
 @internal
 def friction_rows(params, m):
     """(kind, fric) from the law's params: [q, a0, b0, ..., μ_0, μ_1, ...] (μ per disk)."""
-    kind = np.zeros(m, np.int64)
     fric = np.zeros(m)
     q = int(params[0])
     for p in range(q):
-        a, b = int(params[1 + 2 * p]), int(params[2 + 2 * p])
-        kind[a], kind[b] = b, -1
-        fric[a] = params[1 + 2 * q + p]
-    return kind, fric
+        fric[int(params[1 + 2 * p])] = params[1 + 2 * q + p]
+    return kinds_of(params, m), fric
 
 
 @compiled_law
@@ -232,10 +202,7 @@ class RoundHoleFriction(ContactLaw):
     friction = True
 
     def setup(self, step, first=False):
-        width = step.hi - step.lo
-        if step.disks.size and np.any(np.abs(width[step.disks[:, 0]] - width[step.disks[:, 1]])
-                                      > 1e-12 * width[step.disks[:, 0]]):
-            raise InputError("a round hole's two rows must have the same radius")
+        check_radii(step)
         if step.lands.size and np.any(step.lands[:, 0] > 0):
             raise InputError("the round-hole-friction law takes round holes and flat faces; "
                              "broached holes (lands) need the round-hole law (frictionless)")

@@ -67,6 +67,12 @@ def make(law: str = "position", solver: str = "auto", restitution: float = 0.0,
     return PositionLevel(solver, e, massless or "beta")
 
 
+def split_law(word: str) -> tuple[str, str]:
+    """A scene file's ``[contact] law`` names a method (one of LAWS) or a position-level
+    solver (SOLVERS): the (law, solver) words of :func:`make` it stands for."""
+    return (word, "auto") if word in LAWS else ("position", word)
+
+
 def check_massless(massless: str | None, mass: str, name: str = "--massless") -> None:
     """``massless`` (None: not given) is one of MASSLESS, and only for a redistributed
     mass: the others have no massless rows.  ``name``: the flag or key as the user wrote
@@ -86,4 +92,4 @@ def default_beta(method: Method, kind: str = "beam") -> float:
 
 
 __all__ = ["LAWS", "Method", "MoreauJean", "Penalty", "PositionLevel", "Words", "check_massless",
-           "default_beta", "make", "mass_scale"]
+           "default_beta", "make", "mass_scale", "split_law"]

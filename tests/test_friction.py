@@ -111,10 +111,13 @@ def test_mu_zero_is_the_frictionless_run_bit_for_bit():
     assert np.array_equal(zero.contact_force, ref.contact_force)
 
 
-def test_energy_identity_closes_with_friction_over_one_second_of_random_flow(tmp_path):
+@pytest.mark.parametrize("law", ["auto", "moreau-jean"])
+def test_energy_identity_closes_with_friction_over_one_second_of_random_flow(tmp_path, law):
+    """The shipped friction scene under its default (friction makes "auto" the exact
+    position-level law round-hole-friction) and under Moreau–Jean."""
     out = tmp_path / "run"
     assert exit_code(run_main, [str(example("tube_round_holes_friction")), "--out", str(out),
-                                "--format", "none"]) == 0
+                                "--set", f"contact.law={law}", "--format", "none"]) == 0
     import csv
     with open(out / "timeseries.csv") as fh:
         rows = list(csv.DictReader(fh))
@@ -127,7 +130,9 @@ def test_energy_identity_closes_with_friction_over_one_second_of_random_flow(tmp
     assert np.abs(gap).max() <= 1e-9 * np.abs(col["energy"]).max()
     assert col["work_friction"][-1] < 0 and (col["friction_residual"] <= 1e-12).all()
     summary = json.loads((out / "summary.json").read_text())
-    assert summary["solver"] == "moreau-jean" and summary["friction"]["coefficients"] == [0.3]
+    solver = "round-hole-friction" if law == "auto" else law
+    assert summary["solver"] == solver and summary["friction"]["coefficients"] == [0.3]
+    assert summary["max_penetration"] <= (1e-12 * 4e-4 if law == "auto" else 2e-5)
 
 
 def test_wear_is_archards_law_linear_in_the_coefficient(tmp_path):

@@ -55,7 +55,7 @@ class Scene:
     def method(self) -> methods.Method:
         """The run's method (:mod:`skfem_beam.methods`): ``law`` names a class
         (methods.LAWS) or a position-level solver."""
-        law, solver = (self.law, "auto") if self.law in methods.LAWS else ("position", self.law)
+        law, solver = methods.split_law(self.law)
         if law == "penalty" and self.stiffness is None:
             raise InputError("[contact] law='penalty' needs stiffness (N/m)")
         massless = self.data.get("mesh", {}).get("massless")    # as written: None if not
@@ -137,8 +137,6 @@ def _supports(data: dict) -> tuple | None:
 def _scene(kind, problem, data, text, files) -> Scene:
     contact = data.get("contact", {})
     law, k, c = contact.get("law", "auto"), contact.get("stiffness"), 0.0
-    if any(h.friction > 0 for h in getattr(problem, "holes", ())) and "law" not in contact:
-        law = methods.MoreauJean.name    # Coulomb friction is a velocity-level law
     supports = _supports(data)
     if supports is not None:
         law, (k, c) = "penalty", supports

@@ -93,7 +93,7 @@ def _spec(scene: Scene, flags: dict, resume) -> RunSpec:
     as one RunSpec; summary.json's config records both, in the flags' names."""
     given = flags.pop("probe", None) or []
     options, stepping = _grid(scene, flags, resume)
-    law, restitution = scene.law, scene.restitution
+    (law, solver), restitution = methods.split_law(scene.law), scene.restitution
     mass = scene.data.get("mesh", {}).get("mass", "consistent") if scene.kind == "beam" \
         else scene.problem.mass
     probes = [float(x) for x in np.atleast_1d(scene.output.get("probes", []))] + \
@@ -101,8 +101,7 @@ def _spec(scene: Scene, flags: dict, resume) -> RunSpec:
     config = {"command": "python -m skfem_beam run", "scene_text": scene.text,
               "scene_files": scene.files, **flags, "dt": stepping.dt, "beta": stepping.beta,
               "method": "penalty" if law == "penalty" else "contact",
-              "law": law if law in methods.LAWS else "position",
-              "solver": "auto" if law in methods.LAWS or restitution else law,
+              "law": law, "solver": "auto" if restitution else solver,
               "stiffness": scene.stiffness, "restitution": restitution, "mass": mass,
               "massless": stepping.massless, "probe": probes}
     return RunSpec(stepping, scene.method, options, config, mass, tuple(probes),

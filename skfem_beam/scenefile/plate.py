@@ -184,7 +184,7 @@ def method_of(data: dict) -> methods.Method:
         if "solver" in c:
             raise InputError(f"[contact] law = {law!r} names a solver: give it as law or "
                              "as solver, not both")
-        law, solver = "position", law
+        law, solver = methods.split_law(law)
     check_choice("[contact] law", law, (*methods.LAWS, *SOLVERS))
     if law == "penalty" and "stiffness" not in c:
         raise InputError("[contact] law = 'penalty' needs stiffness (N/m)")

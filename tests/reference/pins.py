@@ -69,6 +69,8 @@ RUNS = {
        for p in sorted(SCENES.glob("*.toml"))},
     "toml_heat_mj": ["skfem_beam", "run", str(SCENES / "heat_exchanger_tube.toml"),
                      "--set", "time.T=0.05", "--set", "contact.law=moreau-jean"],
+    "toml_friction_mj": ["skfem_beam", "run", str(SCENES / "tube_round_holes_friction.toml"),
+                         "--set", "time.T=0.05", "--set", "contact.law=moreau-jean"],
 }
 NUMBERS = ("steps", "impacts", "max_nodal_violation", "max_penetration", "energy_final",
            "qp_iterations")

@@ -137,8 +137,10 @@ def _supports(data: dict) -> tuple | None:
 def _scene(kind, problem, data, text, files) -> Scene:
     contact = data.get("contact", {})
     law, k, c = contact.get("law", "auto"), contact.get("stiffness"), 0.0
-    if any(h.friction > 0 for h in getattr(problem, "holes", ())) and "law" not in contact:
-        law = methods.MoreauJean.name    # Coulomb friction is a velocity-level law
+    rough = [h for h in getattr(problem, "holes", ()) if h.friction > 0]
+    if rough and "law" not in contact:   # Coulomb friction: Moreau–Jean in round holes,
+        #                                  the position-level law where a face has it
+        law = methods.MoreauJean.name if all(h.hole.is_round for h in rough) else "auto"
     supports = _supports(data)
     if supports is not None:
         law, (k, c) = "penalty", supports

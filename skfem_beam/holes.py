@@ -292,7 +292,8 @@ def _broached_from_table(d: dict, where: str, centre) -> Hole:
 class HoleAt:
     """A hole acting at the node x (``x_to`` None) or at every node of [x, x_to];
     ``carried``: it moves with the moving support (else fixed to the ground);
-    ``friction``: Coulomb's μ at its wall (round holes; Moreau–Jean)."""
+    ``friction``: Coulomb's μ at its wall (round holes: round-hole-friction or
+    Moreau–Jean; flat faces: round-hole-friction; broached holes: none)."""
     hole: Hole
     x: float
     x_to: float | None = None
@@ -311,9 +312,10 @@ class HoleAt:
         mu = check_finite("friction", self.friction)
         if mu < 0:
             raise InputError(f"friction={mu:g} must be ≥ 0 (Coulomb's μ)")
-        if mu > 0 and not self.hole.is_round:
+        if mu > 0 and self.hole.is_broached:
             raise InputError(f"friction={mu:g} at the {self.hole.shape} hole: friction acts "
-                             "in round holes here (faces and flat bars are frictionless)")
+                             "in round holes and on flat faces (polygons, bars) here; "
+                             "broached holes (lands) are frictionless")
         object.__setattr__(self, "friction", mu)
 
     @property

@@ -104,7 +104,8 @@ SECTION_DOCS = {
         '(radial springs); `stiffness` (N/m, the penalty spring), `restitution` (e in [0, 1],'
         ' position and moreau-jean), `theta` (θ in [1/2, 1] of moreau-jean, default 1/2; '
         "as `--theta`), `friction` (Coulomb's μ at the holes' walls, two planes: runs "
-        'Moreau–Jean)'
+        'Moreau–Jean in round holes, `auto` (round-hole-friction) when a polygon or flat '
+        'bars have it)'
     ),
     'output': (
         '`format`, `save_every`, `frames`, `flush_every`, `checkpoint_every`, `probes` (x in '

@@ -97,7 +97,10 @@ class SemiDiscrete:
     disks: np.ndarray | None = None
     lands: np.ndarray | None = None          # per disk (lands, half width, angle): a
     #                                          broached hole's; (0, 0, 0) round (None: all)
-    friction: np.ndarray | None = None       # Coulomb's μ per row (a round hole's first)
+    friction: np.ndarray | None = None       # Coulomb's μ per row (a round hole's first,
+    #                                          a face's own)
+    tangents: np.ndarray | None = None       # (k, 2) a face with friction's row and its
+    #                                          tangent row t·(v, w), t = R n (bounds ±∞)
     row_nodes: sp.csr_matrix | None = None
     row_centres: np.ndarray | None = None
     # per constrained row, the obstacle (Obstacles.parts index; one obstacle: 0) whose g1

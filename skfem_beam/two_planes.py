@@ -11,7 +11,9 @@ The constraints couple the planes only at the nodes: a row is lo ≤ n·(v, w)(x
 (the first plane's flat obstacles: n = (1, 0); a hole's faces, antiparallel ones in one
 row: holes.Hole.rows), and a round hole adds the pair of rows v(x_i), w(x_i) whose box
 [c − r, c + r] carries the disk (``disks``; contact.round_hole); a broached hole is such
-a pair too, with its lands (``lands``; contact.lands).  Obstacles that move with
+a pair too, with its lands (``lands``; contact.lands).  A face of a hole with Coulomb
+friction adds its tangent row t·(v, w) right after its own (t = (−n_z, n_y), bounds ±∞;
+``tangents``: the pairs; contact.round_hole_friction).  Obstacles that move with
 the support move along d: a row's bound moves by (carried − h(x_i))·(n·d)·φ(t).
 """
 from __future__ import annotations
@@ -93,6 +95,7 @@ def two_plane_system(problem, sv: SemiDiscrete, sw: SemiDiscrete) -> SemiDiscret
                                          for x, c in zip(sv.x_contact, carried_v)])
                                .reshape(-1, 2)])]
     disks, mu, lands, m = [], [], [], sv.C.shape[0]
+    faces = []      # (face row, its tangent row, μ): faces with Coulomb friction
     free = set(space.value_nodes.tolist())
     for k, h in enumerate(problem.holes):
         at = np.flatnonzero(h.acts_at(nodes, problem.beam.L))
@@ -130,6 +133,15 @@ def two_plane_system(problem, sv: SemiDiscrete, sw: SemiDiscrete) -> SemiDiscret
                 xs.append(np.array([x]))
                 centre.append(c)
                 m += 1
+                if h.friction > 0:       # the face's tangent row t·(v, w), t = (−nz, ny)
+                    rows.append(sp.hstack([-nz * ev, ny * ev], format="csr"))
+                    lo.append(np.array([-np.inf]))
+                    hi.append(np.array([np.inf]))
+                    shift.append(np.zeros(1))
+                    xs.append(np.array([x]))
+                    centre.append(c)
+                    faces.append((m - 1, m, h.friction))
+                    m += 1
     C = sp.vstack(rows, format="csr") if m else sp.csr_matrix((0, 2 * n))
     lo, hi, x_c = (np.concatenate(a) for a in (lo, hi, xs))
     shift, centre = np.concatenate(shift), np.concatenate(centre).reshape(-1, 4)
@@ -173,17 +185,21 @@ def two_plane_system(problem, sv: SemiDiscrete, sw: SemiDiscrete) -> SemiDiscret
         planes=2, disks=np.array([d[:2] for d in disks], dtype=np.int64).reshape(-1, 2),
         lands=np.array(lands, dtype=float).reshape(-1, 3)
         if any(row[0] > 0 for row in lands) else None,
-        friction=_friction(m, disks, mu),
+        friction=_friction(m, disks, mu, faces),
+        tangents=np.array([f[:2] for f in faces], dtype=np.int64).reshape(-1, 2),
         row_nodes=node_rows, row_centres=centre)
 
 
-def _friction(m: int, disks, mu) -> np.ndarray | None:
-    """μ per row: a round hole's at its first row (None: no friction anywhere)."""
-    if not any(mu):
+def _friction(m: int, disks, mu, faces=()) -> np.ndarray | None:
+    """μ per row: a round hole's at its first row, a face's at its row (its tangent row:
+    0); None: no friction anywhere."""
+    if not any(mu) and not faces:
         return None
     out = np.zeros(m)
     for (a, _, _), value in zip(disks, mu):
         out[a] = value
+    for j, _, value in faces:
+        out[j] = value
     return out
 
 

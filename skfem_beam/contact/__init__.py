@@ -16,7 +16,8 @@ and then x = x_free + W μ; μ/Δt² are the nodal contact forces.  Laws (regist
 - ``penalty``: normal compliance, one-sided springs (needs a stiffness).
 - ``restitution``: exact contact with a Newton coefficient of restitution e (Paoli–Schatzman).
 - ``round-hole``: exact contact in round holes (second-order cones), boxes beside them.
-- ``round-hole-friction``: the same with Coulomb friction on the step's slip.
+- ``round-hole-friction``: the same with Coulomb friction on the step's slip (round holes
+  and flat faces).
 - ``auto``: the cheapest exact one for the scene.
 
 The protocol a law follows (and how to write one) is in :mod:`.base`; ``register(name,

@@ -119,10 +119,13 @@ class StepData:
     #                     (q, 3) per disk: (lands, half width, angle) of a broached hole
     #                     (contact.lands), (0, 0, 0) a round one; (0, 3): all round
     friction: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    #                     Coulomb's μ per row (a round hole's first row; none: (0,))
+    #                     Coulomb's μ per row (a round hole's first row, a face's row;
+    #                     none: (0,))
     obstacle: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
     #                     (m, 2) per row the obstacle (Obstacles.parts index; one
     #                     obstacle: 0) giving its lo and its hi, −1 none; (0, 2): unknown
+    tangents: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
+    #                     (k, 2) a face with friction's row and its tangent row (bounds ±∞)
 
     @property
     def decoupled(self) -> bool:

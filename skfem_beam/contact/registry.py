@@ -102,15 +102,15 @@ def resolve(law: str | ContactLaw = "auto", stiffness: float | None = None,
 
 
 class Auto(ContactLaw):
-    """The exact round-hole law where there are round holes (with Coulomb friction when a
-    hole has μ > 0); else projection when the constraints are decoupled, the exact active
-    set when not."""
+    """The exact law with Coulomb friction at position level when a round hole or a face
+    has μ > 0; else the exact round-hole law where there are round holes, projection when
+    the constraints are decoupled, the exact active set when not."""
     name = "auto"
 
     @staticmethod
     def choose(step: StepData) -> ContactLaw:
         fric = np.asarray(step.friction, dtype=float)
-        if step.disks.size and fric.size and np.any(fric[step.disks[:, 0]] > 0):
+        if fric.size and np.any(fric > 0):
             return RoundHoleFriction()
         if step.disks.size:
             return RoundHole()

@@ -26,9 +26,24 @@ free offset, q = y_p^{n−1} − c the slip's reference, D = D_pp; p = y_p − c
   > 0, so p(τ) is smooth; safeguarded Newton on 1/|p| − 1/r), kept if σ s ≥ 0.
 
 The normal is that of the unknown y^{n+1}: the closed forms above solve for it (no
-fixed point).  **Several contacts** (and frictionless box rows beside them): block
-Gauss–Seidel, each block exact with the others fixed, until a sweep moves no value by
-more than round-off (as round_hole.land_cone_solve, without its Newton polish).
+fixed point).
+
+**A flat face with friction** (a polygonal hole's, Hole.faces/regular/polygon): its row
+y_j = n·y_p (lo ≤ y_j ≤ hi, antiparallel faces in one row) comes with its tangent row
+y_T = t·y_p, t = R n, bounds ±∞ (two_planes; StepData.tangents).  At the bound it
+violates (hi: outward normal n, σ = 1; lo: −n, σ = −1) the outward tangent is σt, and
+
+    μ_j = −σλ_n,  μ_T = σλ_t,  s = σ(y_T^{n+1} − y_T^{n−1}),
+
+the same law as above.  With the others fixed the block [[a, b], [b, d]] = D on (j, T) is
+linear (`coulomb_face`): separation lo ≤ ỹ_j ≤ hi, μ = 0; stick y_j = c (the bound),
+y_T = y_T^{n−1}: a 2×2 solve, kept in the cone; slip with sign ς: λ_t = −ςμ_f λ_n is
+μ_T = ςμ_f μ_j, so μ_j = (c − ỹ_j)/(a + ςμ_f b), kept if ςs ≥ 0.  Corners (two faces of a
+node active) are two blocks coupled through D.
+
+**Several contacts** (and frictionless box rows beside them): block Gauss–Seidel, each
+block exact with the others fixed, until a sweep moves no value by more than round-off
+(as round_hole.land_cone_solve, without its Newton polish).
 """
 from __future__ import annotations
 
@@ -131,6 +146,54 @@ def coulomb_disk(D2, z, q, r, f, out):
     return FRICTIONLESS if f == 0.0 or nq == 0.0 else FALLBACK
 
 
+@njit(cache=True)
+def coulomb_face(D2, yj, yt, qt, lo, hi, f, out):
+    """One face's (μ_j, μ_T) into out[0:2] (module docstring): ``D2`` = (a, b, d) the block
+    D on (j, T), ``yj``, ``yt`` its free values (the others' μ fixed), ``qt`` = y_T^{n−1},
+    [lo, hi] the face row's bounds, f Coulomb's μ.  Returns the case (as coulomb_disk's;
+    FRICTIONLESS: f = 0; FALLBACK: no case held, the frictionless projection)."""
+    a, b, d = D2
+    if lo <= yj <= hi:
+        out[0], out[1] = 0.0, 0.0
+        return SEPARATE
+    sg, c = (1.0, hi) if yj > hi else (-1.0, lo)
+    if f > 0.0:
+        det = a * d - b * b                                  # stick: y_j = c, y_T = q
+        mj = (d * (c - yj) - b * (qt - yt)) / det
+        mt = (-b * (c - yj) + a * (qt - yt)) / det
+        if -sg * mj >= 0.0 and abs(mt) <= f * (-sg * mj):
+            out[0], out[1] = mj, mt
+            return STICK
+        for varsigma in (1.0, -1.0):                         # slip with s of sign ς
+            g = varsigma * f
+            den = a + g * b
+            if den <= 0.0:
+                continue
+            mj = (c - yj) / den
+            s = sg * (yt + (b + g * d) * mj - qt)
+            if varsigma * s >= 0.0:
+                out[0], out[1] = mj, g * mj
+                return SLIP_FORWARD if varsigma > 0.0 else SLIP_BACKWARD
+    out[0], out[1] = (c - yj) / a, 0.0                      # frictionless
+    return FRICTIONLESS if f == 0.0 else FALLBACK
+
+
+@internal
+def _face_block(D, y, y_prev, lo, hi, fric, mu, j, t, local):
+    """Face j's exact Coulomb block (its tangent row t) with the others fixed; returns
+    its change."""
+    yj = y[j] - D[j, j] * mu[j] - D[j, t] * mu[t]
+    yt = y[t] - D[t, j] * mu[j] - D[t, t] * mu[t]
+    coulomb_face((D[j, j], D[j, t], D[t, t]), yj, yt, y_prev[t], lo[j], hi[j], fric[j],
+                 local)
+    dj, dt = local[0] - mu[j], local[1] - mu[t]
+    if dj != 0.0 or dt != 0.0:
+        for i in range(y.size):
+            y[i] += D[i, j] * dj + D[i, t] * dt
+        mu[j], mu[t] = local[0], local[1]
+    return max(abs(D[j, j] * dj + D[j, t] * dt), abs(D[t, j] * dj + D[t, t] * dt))
+
+
 @internal
 def _disk_block(D, y, y_prev, bounds, fric, mu, a, b, local):
     """Disk (a, b)'s exact Coulomb block with the others fixed; returns its change."""
@@ -149,17 +212,21 @@ def _disk_block(D, y, y_prev, bounds, fric, mu, a, b, local):
 
 
 @internal
-def friction_cone_solve(D, yf, y_prev, lo, hi, kind, fric, mu, active):
-    """The step's μ for boxes and round disks with Coulomb friction ``fric`` (per disk
-    first row; ``kind`` as round_hole.cone_solve's; ``y_prev`` = C u^{n−1}, the slip's
-    reference).  Returns the sweeps (< 0: no convergence)."""
+def friction_cone_solve(D, yf, y_prev, lo, hi, kind, fric, mu, active, tangent):
+    """The step's μ for boxes, faces and round disks with Coulomb friction ``fric`` (per
+    disk first row and face row; ``kind`` as round_hole.cone_solve's, a face's tangent
+    row −1; ``tangent[j]`` a face j's tangent row, −1 none; ``y_prev`` = C u^{n−1}, the
+    slip's reference).  Returns the sweeps (< 0: no convergence)."""
     m = yf.size
     y, scale, blocks = sweep_start(yf, lo, hi, kind, mu)
     local = np.empty(4)
     for sweeps in range(1, MAX_SWEEPS + 1):
         change = 0.0
         for j in range(m):
-            if kind[j] == 0:
+            if kind[j] == 0 and tangent[j] >= 0:
+                change = max(change, _face_block(D, y, y_prev, lo, hi, fric, mu, j,
+                                                 tangent[j], local))
+            elif kind[j] == 0:
                 change = max(change, box_row(D, y, lo, hi, mu, j))
             elif kind[j] > 0:
                 change = max(change, _disk_block(D, y, y_prev, (lo, hi), fric, mu, j,
@@ -174,28 +241,41 @@ def friction_cone_solve(D, yf, y_prev, lo, hi, kind, fric, mu, active):
 
 @internal
 def friction_rows(params, m):
-    """(kind, fric) from the law's params: [q, a0, b0, ..., μ_0, μ_1, ...] (μ per disk)."""
+    """(kind, fric, tangent) from the law's params: [q, a0, b0, ..., μ_0, ..., μ_{q−1},
+    k, j0, t0, ..., μ'_0, ..., μ'_{k−1}] (μ per disk, then the k faces with friction:
+    their rows, tangent rows and μ; kind −1 at a tangent row)."""
     fric = np.zeros(m)
+    tangent = np.full(m, -1, np.int64)
     q = int(params[0])
     for p in range(q):
         fric[int(params[1 + 2 * p])] = params[1 + 2 * q + p]
-    return kinds_of(params, m), fric
+    kind = kinds_of(params, m)
+    at = 1 + 3 * q
+    k = int(params[at]) if params.size > at else 0
+    for p in range(k):
+        j, t = int(params[at + 1 + 2 * p]), int(params[at + 2 + 2 * p])
+        tangent[j] = t
+        kind[t] = -1
+        fric[j] = params[at + 1 + 2 * k + p]
+    return kind, fric, tangent
 
 
 @compiled_law
 def round_hole_friction_kernel(D, yf, y_cur, y_prev, lo, hi, params, state, mu, active):
     m = yf.size
-    kind, fric = friction_rows(params, m)
+    kind, fric, tangent = friction_rows(params, m)
     for j in range(m):
         if fric[j] > 0.0:
-            return friction_cone_solve(D, yf, y_prev, lo, hi, kind, fric, mu, active)
+            return friction_cone_solve(D, yf, y_prev, lo, hi, kind, fric, mu, active,
+                                       tangent)
     # no friction anywhere: the frictionless law's own solve (the same numbers)
     return land_cone_solve(D, yf, lo, hi, kind, None, mu, active)
 
 
 class RoundHoleFriction(ContactLaw):
-    """Exact contact in round holes with Coulomb friction at position level (module
-    docstring); with μ = 0 everywhere it is the round-hole law, bit for bit."""
+    """Exact contact in round holes and on flat faces with Coulomb friction at position
+    level (module docstring); with μ = 0 everywhere it is the round-hole law, bit for
+    bit."""
     name = "round-hole-friction"
     kernel = round_hole_friction_kernel
     round_holes = True
@@ -209,7 +289,10 @@ class RoundHoleFriction(ContactLaw):
         fric = np.asarray(step.friction, dtype=float)
         if fric.size == 0:
             fric = np.zeros(step.lo.size)
-        if np.any(np.delete(fric, step.disks[:, 0]) > 0):
-            raise InputError("Coulomb friction acts at round holes only (the position-level "
-                             "law); flat faces are frictionless")
-        return np.concatenate([disk_params(step.disks), fric[step.disks[:, 0]]])
+        tangents = np.asarray(step.tangents, dtype=np.int64).reshape(-1, 2)
+        if np.any(np.delete(fric, np.concatenate([step.disks[:, 0], tangents[:, 0]])) > 0):
+            raise InputError("Coulomb friction acts at round holes and at a hole's faces "
+                             "(with their tangent rows) only")
+        return np.concatenate([disk_params(step.disks), fric[step.disks[:, 0]],
+                               [float(tangents.shape[0])], tangents.ravel().astype(float),
+                               fric[tangents[:, 0]]])

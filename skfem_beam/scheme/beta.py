@@ -21,8 +21,9 @@ from ..contact.round_hole import disk_kinds
 from ..errors import InputError, SolverError
 from ..linalg import band_solve, rows_matvec
 from .kernels import (CALLEES, EVENT_COLUMNS, FRICTION_COLUMN, IMPACT_FIELDS, NC_COLUMNS,
-                      SECTORS, Inputs, Ops, PythonLaw, Series, State, csr_product, energy_beta,
-                      move_bounds, record, run_steps, run_steps_python)
+                      SECTORS, TANGENT_COLUMN, Inputs, Ops, PythonLaw, Series, State,
+                      csr_product, energy_beta, move_bounds, record, run_steps,
+                      run_steps_python)
 from .operators import csr_arrays, load_norms, step_operators
 from .stepping import Stepping
 
@@ -113,6 +114,13 @@ def disk_rows(system) -> np.ndarray:
         np.ascontiguousarray(disks, dtype=np.int64).reshape(-1, 2)
 
 
+def tangent_rows(system) -> np.ndarray:
+    """The (k, 2) rows (face, its tangent row) of the faces with friction (none: (0, 2))."""
+    tangents = getattr(system, "tangents", None)
+    return np.zeros((0, 2), np.int64) if tangents is None else \
+        np.ascontiguousarray(tangents, dtype=np.int64).reshape(-1, 2)
+
+
 def land_rows(system) -> np.ndarray:
     """The (q, 3) lands of the system's disks (contact.lands; all round: (0, 3))."""
     lands = getattr(system, "lands", None)
@@ -130,7 +138,9 @@ def refuse_lands(system, law: str) -> None:
 def hole_arrays(system):
     """Ops' (pair, disks, Np, Ni, Nx, Nc) of ``system`` (kernels.Ops): the round holes'
     row pairs and first rows and, in two planes, each row's node and hole (one plane:
-    empty; Nc's columns 6:9: a disk's first row's lands, kernels.violation)."""
+    empty; Nc's columns 6:9: a disk's first row's lands, kernels.violation).  A face's
+    tangent row (friction) has pair −1, as a disk's second row, its direction t in Nc's
+    columns 4:6 and its face's row the tangent row in TANGENT_COLUMN."""
     m = system.C.shape[0]
     disks = disk_rows(system)
     pair = disk_kinds(m, disks)
@@ -151,6 +161,9 @@ def hole_arrays(system):
                       system.row_nodes[2 * j + c].multiply(system.row_nodes[2 * j + c]).sum()
                       for c in range(2))
             Nc[j, 4:6] = nv, nw
+    for j, t in tangent_rows(system):
+        pair[t] = -1
+        Nc[j, TANGENT_COLUMN] = t
     return (pair, first, *csr_arrays(system.row_nodes), np.ascontiguousarray(Nc))
 
 
@@ -205,7 +218,7 @@ class BetaScheme:
         self.step = StepData(op.A, op.C, op.D, np.ascontiguousarray(system.lo, dtype=float),
                              np.ascontiguousarray(system.hi, dtype=float), s.dt, s.beta,
                              disk_rows(system), land_rows(system), friction_of(system),
-                             obstacle_rows(system))
+                             obstacle_rows(system), tangent_rows(system))
         self.law = law = self._law(law, m)
         if friction(system) and not law.friction:
             raise InputError(f"Coulomb friction needs law = round-hole-friction (or auto: "
@@ -252,11 +265,12 @@ class BetaScheme:
                    *csr_arrays(system.K.tocsr()[op.Z]), *self._holes())
 
     def _holes(self):
-        """hole_arrays, and Nc's column FRICTION_COLUMN ← each round hole's μ when the law
-        takes friction (kernels.friction_split: its work is then split off the contact's)."""
+        """hole_arrays, and Nc's column FRICTION_COLUMN ← each round hole's and each face's
+        μ when the law takes friction (kernels.friction_split, face_friction_split: its
+        work is then split off the contact's)."""
         arrays = hole_arrays(self.system)
         if self.law.friction and arrays[-1].shape[0]:
-            first = arrays[1]
+            first = np.concatenate([arrays[1], tangent_rows(self.system)[:, 0]])
             arrays[-1][first, FRICTION_COLUMN] = friction_of(self.system)[first]
         return arrays
 

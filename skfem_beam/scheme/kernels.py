@@ -83,8 +83,9 @@ Series = namedtuple("Series", ["obs", "obsv", "energy", "work", "lam", "frames_u
 Inputs = namedtuple("Inputs", ["G", "phi", "H"], defaults=(np.zeros((0, 0)),))
 WORK_TERMS = ("damping", "input", "contact")   # the columns of State.work and Series.work
 FRICTION = 3           # ... and the friction work's (runs with friction only)
-NC_COLUMNS = 10        # Ops.Nc's columns
-FRICTION_COLUMN = 9    # ... the one of a round hole's μ (the β-scheme's friction law)
+NC_COLUMNS = 11        # Ops.Nc's columns
+FRICTION_COLUMN = 9    # ... the one of a round hole's or a face's μ (the β-scheme's law)
+TANGENT_COLUMN = 10    # ... a face with friction's tangent row (its pair is −1)
 SECTORS = 12           # the hole's angular sectors of the normal work (State.sectors)
 EVENT_COLUMNS = ("value", "start_step", "end_step", "velocity", "peak_force", "impulse",
                  "max_violation", "angle", "normal_velocity", "tangential_velocity", "slip",
@@ -417,6 +418,26 @@ def friction_split(mu, dy, at, work, rowwork, ev, a, b, dt):
         ev[10] += abs(mt) / dt
 
 
+@njit(cache=True, inline="always")
+def face_friction_split(mu, dy, work, rowwork, ev, t, dt):
+    """friction_split for a face with friction: its tangent row t's work ½ μ_t s/Δt²
+    (s = dy[t], the step's slip along t·(v, w); the face's outward tangent is ±t, the
+    product the same) moves from the contact's column to the friction's; the face's
+    event under way gets the slip |s|/2 and the impulse |μ_t|/Δt."""
+    if mu[t] == 0.0:
+        return
+    s = dy[t]
+    w = 0.5 * mu[t] * s / (dt * dt)
+    work[2] -= w
+    work[FRICTION] += w
+    if rowwork.shape[0]:
+        rowwork[t, 0] -= w
+        rowwork[t, 2] += w
+    if ev[0] >= 0.0:
+        ev[9] += 0.5 * abs(s)
+        ev[10] += abs(mu[t]) / dt
+
+
 @internal
 def hole_kinematics(ops, st, step, dt, p):
     """Two planes, after state step+1: every row's node position, its impact angle and
@@ -429,6 +450,9 @@ def hole_kinematics(ops, st, step, dt, p):
         if ops.pair[j] > 0 and ops.Nc[j, FRICTION_COLUMN] > 0.0:
             friction_split(st.mu, st.dy, (st.y_cur, st.lo, st.hi), st.work, st.rowwork,
                            st.impact[j], j, ops.pair[j], dt)
+        elif ops.Nc[j, FRICTION_COLUMN] > 0.0:     # a face with friction
+            face_friction_split(st.mu, st.dy, st.work, st.rowwork, st.impact[j],
+                                int(ops.Nc[j, TANGENT_COLUMN]), dt)
         node_position(ops, st, j, p)
         ev = st.impact[j]
         nx, ny = normal_of(ops, j, p[2], p[3])

@@ -48,7 +48,7 @@ from ..contact.restitution import Restitution
 from ..errors import InputError
 from ..linalg import Banded, band_solve, rows_dot, rows_matvec
 from .beta import (disk_rows, friction_of, hole_arrays, observers, penetration_samples,
-                   refuse_lands, start_positions, two_plane_state)
+                   refuse_lands, start_positions, tangent_rows, two_plane_state)
 from ..contact.friction import MAX_SWEEPS, nsgs
 from .kernels import (EVENT_COLUMNS, FAILED, FRICTION, IMPACT_FIELDS, ITERATIONS, ROW0,
                       STOPPED_AT, UNSTABLE, Inputs, Series, csr_product, hole_kinematics,
@@ -277,6 +277,9 @@ class MoreauJeanScheme:
             raise InputError(f"law={NAME!r} does not handle obstacles that move with a "
                              "support: use the position-level scheme")
         refuse_lands(system, NAME)
+        if tangent_rows(system).size:
+            raise InputError(f"friction on a hole's flat faces takes the position-level law "
+                             f"round-hole-friction (or auto), not {NAME} (round holes only)")
         if disk_rows(system).size and self.e > 0:
             raise InputError(f"restitution={self.e:g} with round holes: {NAME} holds a node "
                              "on the wall at the step's end there (e = 0)")

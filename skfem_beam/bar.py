@@ -379,11 +379,11 @@ def bar_method(bar: Bar, method="contact", solver="auto", restitution: float = 0
     return methods.make("penalty", solver, e, bar.k, method.massless, words=methods.KEYS)
 
 
-def bar_run(bar: Bar, dt: float, T: float, beta: float = 0.25, method="contact",
-            solver: str = "auto", frames: int = 200, all_states_limit: int = 4_000_000,
-            restitution: float = 0.0, massless: str = "beta"):
+def bar_run(bar: Bar, dt: float, T: float, beta: float = 0.25, method="contact", *,
+            frames: int = 200, all_states_limit: int = 4_000_000, **words):
     """The bar's :class:`~skfem_beam.scheme.Run` (not yet driven), to T + Δt, with the
-    method of :func:`bar_method`.
+    method of :func:`bar_method` (``words``: its ``solver``, ``restitution``,
+    ``massless``).
 
     rigid + contact: the Signorini condition u(0) ≥ 0 (one constrained value, so the
     step is the projection of Lemma 4.1); rigid + penalty: a one-sided spring of
@@ -394,7 +394,7 @@ def bar_run(bar: Bar, dt: float, T: float, beta: float = 0.25, method="contact",
     ``all_states_limit`` values (the energy split needs them); else ``frames`` frames.
     """
     from .scheme import Stepping
-    method = bar_method(bar, method, solver, restitution, massless)
+    method = bar_method(bar, method, **words)
     system = bar_system(bar)
     to_T = Stepping(dt, T, beta, massless=method.massless)   # the checks of Δt, T, β
     n_steps = to_T.steps
@@ -505,8 +505,8 @@ def run_bar(bar: Bar, dt: float, T: float, beta: float = 0.25, method: str = "co
             massless: str = "beta") -> BarRun:
     """Integrate the bar with the shared scheme (:func:`bar_run`, driven to its end)."""
     from .scheme import drive
-    run = bar_run(bar, dt, T, beta, method, solver, all_states_limit=all_states_limit,
-                  massless=massless)
+    run = bar_run(bar, dt, T, beta, method, solver=solver,
+                  all_states_limit=all_states_limit, massless=massless)
     drive(run)
     series = BarSeries(bar, run, T, method)
     return series.bar_run(series.rows(run, 0, series.ready(run)), run.result())

@@ -577,11 +577,11 @@ def _rod_gap(bar, sign: float):
     return d
 
 
-def whirl_force(M, K, B, b, row, r: float, omega: float, dt: float, beta: float) -> float:
+def whirl_force(plane, b, row, r: float, omega: float, dt: float, beta: float) -> float:
     """The contact force |λ| of the β-scheme's steady whirl in a round hole.
 
-    A beam bending alike in two planes (mass M, stiffness K, damping B of one plane; B
-    may be None), loaded by the rotating force b·(cos ωt, sin ωt) (b the load vector of
+    A beam bending alike in two planes (``plane`` = (M, K, B): mass, stiffness and
+    damping of one plane; B may be None), loaded by the rotating force b·(cos ωt, sin ωt) (b the load vector of
     one plane, in the system's units) and held at one node (``row``, the node's value
     row) in the round hole of radius r centred on the axis, whirls on the wall: in
     complex form v + iw = A·e^{iωtₙ} at every step, and the nodal contact force is
@@ -597,6 +597,7 @@ def whirl_force(M, K, B, b, row, r: float, omega: float, dt: float, beta: float)
     root is returned (NaN when the force does not reach the wall: no whirl on it)."""
     import scipy.sparse as sp
     import scipy.sparse.linalg as spla
+    M, K, B = plane
     s = np.sin(0.5 * omega * dt) ** 2
     Z = -(4 * s / dt**2) * sp.csc_matrix(M) + (1 - 4 * beta * s) * sp.csc_matrix(K)
     if B is not None:

@@ -138,39 +138,10 @@ def beam_system(problem: BeamProblem, samples_per_element: int = 20) -> SemiDisc
     sampler = space.sampler(np.linspace(0.0, 1.0, samples_per_element + 1))
     s_lo, s_hi = problem.obstacles.bounds(sampler.x)
     keep = np.isfinite(s_lo) | np.isfinite(s_hi)
-    # bounds on u = ũ − hφ: g − hφ (fixed to the ground), g + (1 − h)φ (carried)
-    motion = shift = s_shift = None
-    if lift is not None:
-        xs = sampler.x[keep]
-        shift, s_shift = (snap(problem.obstacles.carried_at(x) - lift.h(x)) for x in (x_c, xs))
-        if np.any(shift != 0) or np.any(s_shift != 0):
-            motion = sup.phi
-        else:
-            shift = s_shift = None
-
-    y0 = C @ u0
-    lo0, hi0 = (lo, hi) if motion is None else (lo + shift * float(sup.phi(0.0)),
-                                                hi + shift * float(sup.phi(0.0)))
-    tol = 1e-12 * max(1.0, np.abs(y0).max(initial=0.0))
-    bad = (y0 < lo0 - tol) | (y0 > hi0 + tol)
-    if bad.any():
-        i = int(np.argmax(bad))
-        raise InputError(f"u0 violates the obstacles at x={x_c[i]:g}: "
-                         f"u0={y0[i]:g} not in [{lo0[i]:g}, {hi0[i]:g}]")
-
-    with np.errstate(over="ignore", invalid="ignore"):
-        K = (k2 * space.S).tocsr()
-    if not np.isfinite(K.data).all():
-        raise InputError(f"k2={k2:g} on this mesh gives a stiffness outside floating-point range")
-    damp = problem.damping
-    B = None if damp.none else (damp.alpha * space.M + damp.alpha_K * K).tocsr()
-    if damp.modal:
-        B = B + modal_damping(space.M, K, damp.modal)
-
-    node = observed_node(problem, space)
-    row = space.C[-1] if node is None else space.nodal[node]
-    observe = {"tip_displacement": np.asarray(row.toarray()).ravel()}
-    x_obs = None if node is None else float(space.nodes[node])
+    motion, shift, s_shift = _moving_bounds(problem, lift, x_c, sampler.x[keep])
+    _check_u0(C @ u0, lo, hi, None if motion is None else (shift, float(sup.phi(0.0))), x_c)
+    K, B = _operators(problem, space)
+    observe, x_obs = _observation(problem, space)
     return SemiDiscrete(
         M=space.M, K=K, C=sp.csr_matrix(C), lo=lo, hi=hi,
         x_contact=x_c, loads=loads, load_time=times, u0=u0, v0=v0,
@@ -183,6 +154,55 @@ def beam_system(problem: BeamProblem, samples_per_element: int = 20) -> SemiDisc
                        problem.obstacles, beam.rho_S, beam.EI, lift, x_obs),
         bound_motion=motion, bound_shift=shift, sample_shift=s_shift,
         row_obstacle=problem.obstacles.owners(x_c))
+
+
+def _moving_bounds(problem: BeamProblem, lift, x_c, xs):
+    """(motion, shift, s_shift): the bounds on u = ũ − hφ are g − hφ (fixed to the
+    ground) and g + (1 − h)φ (carried), so they move with the support φ = ``motion`` by
+    ``shift`` at the constrained values x_c and ``s_shift`` at the sample points xs; all
+    None when they do not move."""
+    if lift is None:
+        return None, None, None
+    shift, s_shift = (snap(problem.obstacles.carried_at(x) - lift.h(x)) for x in (x_c, xs))
+    if np.any(shift != 0) or np.any(s_shift != 0):
+        return problem.support.phi, shift, s_shift
+    return None, None, None
+
+
+def _check_u0(y0, lo, hi, moved, x_c) -> None:
+    """InputError when the constrained values y0 = C u0 violate [lo, hi] (shifted by
+    shift·φ(0) when ``moved`` = (shift, φ(0)))."""
+    lo0, hi0 = (lo, hi) if moved is None else (lo + moved[0] * moved[1],
+                                               hi + moved[0] * moved[1])
+    tol = 1e-12 * max(1.0, np.abs(y0).max(initial=0.0))
+    bad = (y0 < lo0 - tol) | (y0 > hi0 + tol)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise InputError(f"u0 violates the obstacles at x={x_c[i]:g}: "
+                         f"u0={y0[i]:g} not in [{lo0[i]:g}, {hi0[i]:g}]")
+
+
+def _operators(problem: BeamProblem, space):
+    """(K, B): the stiffness k2·S and the damping of ``problem.damping`` (None: none)."""
+    k2 = problem.beam.k2
+    with np.errstate(over="ignore", invalid="ignore"):
+        K = (k2 * space.S).tocsr()
+    if not np.isfinite(K.data).all():
+        raise InputError(f"k2={k2:g} on this mesh gives a stiffness outside floating-point range")
+    damp = problem.damping
+    B = None if damp.none else (damp.alpha * space.M + damp.alpha_K * K).tocsr()
+    if damp.modal:
+        B = B + modal_damping(space.M, K, damp.modal)
+    return K, B
+
+
+def _observation(problem: BeamProblem, space):
+    """({"tip_displacement": row}, x): the observed value's row (the tip, or the node of
+    :func:`observed_node`) and its x (None at the tip)."""
+    node = observed_node(problem, space)
+    row = space.C[-1] if node is None else space.nodal[node]
+    observe = {"tip_displacement": np.asarray(row.toarray()).ravel()}
+    return observe, None if node is None else float(space.nodes[node])
 
 
 def modal_damping(M, K, zeta: float) -> sp.csr_matrix:

@@ -438,8 +438,9 @@ def parser():
 def main(argv=None) -> int:
     args = parser().parse_args(argv)
     fixed = {n: getattr(args, n) for n in SCENES["point_stops"][1] if hasattr(args, n)}
-    settings = make_settings(args.scene, args.param, args.transient, args.periods, args.dt,
-                             args.J, args.beta, args.element, args.solver, args.zeta,
+    settings = make_settings(args.scene, args.param, transient=args.transient,
+                             periods=args.periods, dt=args.dt, J=args.J, beta=args.beta,
+                             element=args.element, solver=args.solver, zeta=args.zeta,
                              **fixed)
     values = parse_values(args.values)
     check_values(settings, values)

@@ -75,7 +75,7 @@ def test_the_steady_whirl_has_the_contact_force_of_the_discrete_steady_state():
     result = solve(system, dt, 2.0, save_every=10)
     lam = np.hypot(result.contact_force[:, 0], result.contact_force[:, 1])
     n = system.meta["n_plane"]
-    Lam = whirl_force(system.M[:n, :n], system.K[:n, :n], system.B[:n, :n],
+    Lam = whirl_force((system.M[:n, :n], system.K[:n, :n], system.B[:n, :n]),
                       system.loads[:n, 0], system.C[0, :n].toarray(), R, omega, dt, 0.5)
     assert result.contact_fraction > 0.99
     assert np.abs(lam[-100:] / Lam - 1).max() <= 1e-6        # measured 1.2e-13

@@ -224,7 +224,7 @@ def beam_charts(case, problem, rho_S, stops, extra, observed_x=None, wear=None):
         t = data["t"]
         about = f"{run.label}, Δt={run.dt:g} s, J={problem.J}, {problem.element}"
         if problem.planes == 2:
-            two_plane_charts(folder, data, run, case, problem, about, where, what, rho_S)
+            two_plane_charts(folder, data, run, case, problem, about, where, what)
             if wear is not None:
                 wear_charts(folder, data, run, case, problem, about, rho_S, wear)
             if extra is not None:
@@ -254,7 +254,7 @@ def beam_charts(case, problem, rho_S, stops, extra, observed_x=None, wear=None):
     return finish
 
 
-def two_plane_charts(folder, data, run, case, problem, about, where, what, rho_S) -> None:
+def two_plane_charts(folder, data, run, case, problem, about, where, what) -> None:
     """A two-plane run's charts: v and w at the observed point, the energy, the net
     contact force per plane, and an orbit per hole node (w against v, the wall drawn)."""
     t = data["t"]

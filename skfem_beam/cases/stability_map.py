@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 import time
+from functools import partial
 
 import numpy as np
 
@@ -45,19 +46,23 @@ def reference_step(kappa: float, kappa_paper: float, beta: float) -> float:
     return linear_limit(kappa, beta) if beta < 0.25 else prop31_limit(kappa_paper, 0.25)
 
 
-def run_map(system, betas, ratios, methods, T, stiffness, kappa, kappa_paper, max_seconds):
-    """Every (β, ratio, method) run; refuses up front a grid that would not fit the budget."""
-    grid = [(b, r, m) for b in betas for r in ratios for m in methods]
-    steps = sum(math.ceil(T / (r * reference_step(kappa, kappa_paper, b))) for b, r, _ in grid)
+def check_budget(system, grid, T, step_of, max_seconds) -> None:
+    """Refuse up front a grid of (β, ratio, method) runs that would not fit the budget;
+    ``step_of(β)``: the step a ratio multiplies (:func:`reference_step`)."""
+    steps = sum(math.ceil(T / (r * step_of(b))) for b, r, _ in grid)
     probe = solve(system, 1e-5, 0.02, 0.5, frames=1)            # cost per step, measured here
     per_step = 2.0 * probe.wall_time_s / probe.steps + 1e-6      # margin: penalty, contact
     estimate = steps * per_step + 0.05 * len(grid)
     if estimate > max_seconds:
         raise InputError(f"the grid needs about {estimate:.0f} s ({len(grid)} runs, {steps} steps) "
                          f"> --max-seconds={max_seconds:g}: use fewer or larger ratios, or a shorter --T")
+
+
+def run_map(system, grid, T, stiffness, step_of) -> list[dict]:
+    """Every (β, ratio, method) run of ``grid``, with Δt = ratio·``step_of(β)``."""
     rows = []
     for beta, ratio, method in grid:
-        dt = ratio * reference_step(kappa, kappa_paper, beta)
+        dt = ratio * step_of(beta)
         law = Penalty(stiffness, equation_units=True) if method == "penalty" else None
         r = solve(system, dt, T, beta, law, save_every=max(1, int(1e-4 / dt)), frames=2, progress=False)
         tip = r.observed["tip_displacement"]
@@ -125,7 +130,10 @@ def main(argv=None) -> int:
     dx = pb.beam.L / pb.J
     kappa_paper = PAPER_KAPPA_BOUNDS["hermite"][PAPER_KAPPA] * pb.beam.k2 / dx**4
     t0 = time.perf_counter()
-    rows = run_map(system, betas, ratios, methods, T, stiffness, kappa, kappa_paper, max_seconds)
+    grid = [(b, r, m) for b in betas for r in ratios for m in methods]
+    step_of = partial(reference_step, kappa, kappa_paper)
+    check_budget(system, grid, T, step_of, max_seconds)
+    rows = run_map(system, grid, T, stiffness, step_of)
     summary = {"case": "stability_map", "J": pb.J, "T": T, "kappa_h": kappa,
                "kappa_paper_5_2": kappa_paper, "config": vars(args)}
     with Folder.open(out, summary, args.overwrite) as folder:

@@ -144,24 +144,27 @@ def spring_supports(table: dict, obstacles, stiffness, damping) -> list[dict]:
 
 
 def write_impacts(folder: Path, run, units: dict, scale: float = 1.0, sign: float = 1.0,
-                  obstacles=None, last: int | None = None, wear=None,
-                  springs: tuple | None = None) -> dict:
+                  obstacles=None, last: int | None = None, wear=None) -> dict:
     """Write ``folder/impacts.csv`` from ``run`` (a :class:`~skfem_beam.scheme.Run`) and
     return the summary entry ``{"impact_statistics": ...}``; ``units``: the force and
     impulse units (``{"force": "N", "impulse": "N·s"}``), see :func:`impact_table`.
     ``last``: the last state the loop computed when it is not ``run.n`` (a failed step
-    stops the loop inside a chunk).  ``springs``: (stiffness, damping) of the
-    supports' springs in N/m and N·s/m (a penalty run on ``obstacles``): the entry
-    ``spring_supports`` too (:func:`spring_supports`)."""
+    stops the loop inside a chunk)."""
     out = _write_impacts(folder, run, units, scale, sign, obstacles, last, wear)
-    table = out.pop("_table", None)
-    if springs is not None and obstacles is not None and table is not None:
-        out["spring_supports"] = spring_supports(table, obstacles, *springs)
-        out["impact_statistics"]["units"]["spring_supports"] = (
-            "per obstacle: stiffness N/m, damping N·s/m (as given), max_deflection m (the "
-            f"largest compression of its spring), max_force {units['force']} (its largest "
-            "peak_force)")
+    out.pop("_table", None)
     return out
+
+
+def _add_spring_supports(out: dict, table: dict, obstacles, springs: tuple,
+                         force_unit: str) -> None:
+    """Add to ``out`` (of :func:`_write_impacts`, with its impact ``table``) the entry
+    ``spring_supports`` (:func:`spring_supports`) of the supports' springs ``springs`` =
+    (stiffness, damping), N/m and N·s/m (a penalty run on ``obstacles``)."""
+    out["spring_supports"] = spring_supports(table, obstacles, *springs)
+    out["impact_statistics"]["units"]["spring_supports"] = (
+        "per obstacle: stiffness N/m, damping N·s/m (as given), max_deflection m (the "
+        f"largest compression of its spring), max_force {force_unit} (its largest "
+        "peak_force)")
 
 
 def _write_impacts(folder, run, units, scale, sign, obstacles, last, wear) -> dict:
@@ -224,8 +227,11 @@ def beam_impacts(folder: Path, run, problem, last: int | None = None, wear=None,
     rho_S = problem.beam.rho_S
     units = {"force": "N", "impulse": "N·s"} if rho_S else \
         {"force": "m²/s² (N per kg/m)", "impulse": "m²/s (N·s per kg/m)"}
-    return write_impacts(folder, run, units, rho_S or 1.0, 1.0, problem.obstacles, last, wear,
-                         springs)
+    out = _write_impacts(folder, run, units, rho_S or 1.0, 1.0, problem.obstacles, last, wear)
+    table = out.pop("_table", None)
+    if springs is not None and problem.obstacles is not None and table is not None:
+        _add_spring_supports(out, table, problem.obstacles, springs, units["force"])
+    return out
 
 
 def bar_impacts(folder: Path, run, bar, last: int | None = None) -> dict:

@@ -205,9 +205,36 @@ def sample_line(system, samples_per_element: int = 8) -> LineSamples:
     if space is None or not hasattr(space, "sampler"):
         raise InputError("field output needs a space with a sampler (Hermite, B-spline, P1)")
     smp = space.sampler(np.linspace(0.0, 1.0, s + 1))
+    x, R, e = _line_points(space, smp, s)
+    E0 = (R @ smp.E0).tocsr()
+
+    view = system.view or SceneView(kind="beam" if system.meta.get("kind", "beam") == "beam"
+                                    else "bar")
+    beam = view.kind == "beam" and smp.E2 is not None and smp.E2.nnz > 0
+    EIf = _element_EI(system, space, e) if beam else None
+    E2 = (R @ (smp.E2 if EIf is None else sp.diags(EIf) @ smp.E2)).tocsr() if beam else None
+
+    L = float(view.L if view.L is not None else x[-1])
+    lift = view.lift
+    h, h_dd = (None, None) if lift is None else \
+        _lift_values(lift, x, (space, smp, s, R), beam, EIf)
+    g1, g2, contact, carried, fixed = _obstacle_lines(system, view, x, L)
+    cells = np.column_stack([np.arange(x.size - 1), np.arange(1, x.size)])
+    return LineSamples(x=x, cells=cells, E0=E0, E2=E2, g1=_nan_outside(g1),
+                       g2=_nan_outside(g2), contact=contact,
+                       k2=view.k2 if beam else None, L=L,
+                       motion=None if lift is None else lift.motion, h=h, h_dd=h_dd,
+                       carried=carried, fixed=fixed, push=_push(system, view),
+                       rho_S=float(view.rho_S or 1.0) if beam else 1.0,
+                       **_two_plane_entries(system, view))
+
+
+def _line_points(space, smp, s: int):
+    """(x, R, e): the line's points, the matrix R averaging the sampler's rows onto them
+    and the element of every sampler row.  Keeps ξ = 0..(s−1)/s of every element and the
+    last end; a node shared by two elements averages its two one-sided rows (equal for
+    values; u'' may jump)."""
     J = space.nodes.size - 1
-    # keep ξ = 0..(s−1)/s of every element and the last end; a node shared by two
-    # elements averages its two one-sided rows (equal for values; u'' may jump)
     e, j = np.divmod(np.arange(J * (s + 1)), s + 1)
     point = e * s + j
     shared = ((j == 0) & (e > 0)) | ((j == s) & (e < J - 1))
@@ -216,49 +243,49 @@ def sample_line(system, samples_per_element: int = 8) -> LineSamples:
     x = np.empty(J * s + 1)
     x[point] = smp.x
     x[0], x[-1] = space.nodes[0], space.nodes[-1]
-    E0 = (R @ smp.E0).tocsr()
+    return x, R, e
 
-    view = system.view or SceneView(kind="beam" if system.meta.get("kind", "beam") == "beam"
-                                    else "bar")
-    beam = view.kind == "beam" and smp.E2 is not None and smp.E2.nnz > 0
-    # a stepped beam's moment is EI(x)u'': each element's rows carry its EI/EI_ref
+
+def _element_EI(system, space, e):
+    """EI/EI_ref of the element of every sampler row (a stepped beam's moment is
+    EI(x)u''), or None for a uniform beam."""
     problem = system.meta.get("problem")
-    EIf = None
-    if beam and problem is not None and problem.beam.segments:
-        EIf = problem.beam.factors(0.5 * (space.nodes[:-1] + space.nodes[1:]))[1][e]
-    E2 = None
-    if beam:
-        E2 = (R @ (smp.E2 if EIf is None else sp.diags(EIf) @ smp.E2)).tocsr()
+    if problem is None or not problem.beam.segments:
+        return None
+    return problem.beam.factors(0.5 * (space.nodes[:-1] + space.nodes[1:]))[1][e]
 
-    L = float(view.L if view.L is not None else x[-1])
-    lift, h, h_dd = view.lift, None, None
-    if lift is not None:
-        h = np.asarray(lift.h(x), dtype=float)
-        if beam and lift.kind == "paper":          # smooth: evaluated at the points
-            h_dd = np.asarray(lift.h_dd(x), dtype=float)
-        elif beam:                                 # per side, averaged like u''
-            side = _side_values(lift.h_dd, space, smp.x, s)
-            h_dd = R @ (side if EIf is None else EIf * side)
-    g1, g2, contact, carried, fixed = _obstacle_lines(system, view, x, L)
-    two = {}
-    if view.planes == 2:
-        from ..scheme.beta import hole_arrays
-        from .supports import row_planes
-        pair, *_, Nc = hole_arrays(system)
-        two = {"planes": 2, "direction": view.direction, "k2_w": view.k2_w,
-               "row_planes": row_planes(pair, Nc)}
-    # the bar's field force is the obstacle's push R ≥ 0, as in timeseries.csv: λ at a
-    # lower bound (x = 0), −λ at an upper one (x = L, where U = −u(L))
-    push = None
-    if view.kind == "bar":
-        push = np.where(np.isfinite(np.asarray(system.lo, dtype=float)), 1.0, -1.0)
-    cells = np.column_stack([np.arange(x.size - 1), np.arange(1, x.size)])
-    return LineSamples(x=x, cells=cells, E0=E0, E2=E2, g1=_nan_outside(g1),
-                       g2=_nan_outside(g2), contact=contact,
-                       k2=view.k2 if beam else None, L=L,
-                       motion=None if lift is None else lift.motion, h=h, h_dd=h_dd,
-                       carried=carried, fixed=fixed, push=push,
-                       rho_S=float(view.rho_S or 1.0) if beam else 1.0, **two)
+
+def _lift_values(lift, x, sampling, beam: bool, EIf):
+    """(h, h_dd) of the lifting at the points x: h'' only for a beam, evaluated at the
+    points when smooth (the paper's h), else per side and averaged like u''.
+    ``sampling``: (space, sampler, s, R) of :func:`_line_points`."""
+    space, smp, s, R = sampling
+    h, h_dd = np.asarray(lift.h(x), dtype=float), None
+    if beam and lift.kind == "paper":          # smooth: evaluated at the points
+        h_dd = np.asarray(lift.h_dd(x), dtype=float)
+    elif beam:                                 # per side, averaged like u''
+        side = _side_values(lift.h_dd, space, smp.x, s)
+        h_dd = R @ (side if EIf is None else EIf * side)
+    return h, h_dd
+
+
+def _two_plane_entries(system, view) -> dict:
+    """The LineSamples entries of a two-plane system (none for one plane)."""
+    if view.planes != 2:
+        return {}
+    from ..scheme.beta import hole_arrays
+    from .supports import row_planes
+    pair, *_, Nc = hole_arrays(system)
+    return {"planes": 2, "direction": view.direction, "k2_w": view.k2_w,
+            "row_planes": row_planes(pair, Nc)}
+
+
+def _push(system, view):
+    """The bar's field force is the obstacle's push R ≥ 0, as in timeseries.csv: λ at a
+    lower bound (x = 0), −λ at an upper one (x = L, where U = −u(L)); None for a beam."""
+    if view.kind != "bar":
+        return None
+    return np.where(np.isfinite(np.asarray(system.lo, dtype=float)), 1.0, -1.0)
 
 
 def _obstacle_lines(system, view, x, L):

@@ -13,9 +13,11 @@ from .stepping import Result, Stepping
 MAX_VALUES = 2 * 10**8    # saved values a Result may hold (1.6 GB)
 
 
-def solve(system, dt: float, T: float, beta: float | None = None, method=None,
-          save_every: int = 1, frames: int = 200, progress: bool | None = None,
-          load_window: str = "forward", growth_limit: float = 10.0) -> Result:
+RECORDING = ("save_every", "frames", "load_window", "growth_limit")   # solve's **recording
+
+
+def solve(system, dt: float, T: float, beta: float | None = None, method=None, *,
+          progress: bool | None = None, **recording) -> Result:
     """Integrate ``system`` over [0, T] with step ``dt``, in the style of ``solve_ivp``.
 
     ``method``: a :mod:`skfem_beam.methods` object, the one way a run names its method
@@ -24,8 +26,8 @@ def solve(system, dt: float, T: float, beta: float | None = None, method=None,
     semi-discrete equation with ``equation_units=True``; ``MoreauJean(theta,
     restitution)``); None: ``PositionLevel()``, exact contact by the cheapest exact law.
     ``beta``: the β-scheme's β (default: the method's own, 1/2 for exact contact, 1/4 for
-    springs).  ``save_every``, ``frames``, ``load_window``, ``growth_limit``: see
-    :class:`Stepping`.
+    springs).  ``recording``: any of ``save_every`` (1), ``frames`` (200),
+    ``load_window`` ("forward"), ``growth_limit`` (10): see :class:`Stepping`.
 
     The run stops with status "unstable" when the discrete energy exceeds
     ``growth_limit`` × the a-priori bound (√E¹ + Σ‖Gⁿ‖_{N⁻¹}Δt)² (operators.load_norms)
@@ -37,10 +39,13 @@ def solve(system, dt: float, T: float, beta: float | None = None, method=None,
         raise InputError(f"method={method!r}: a method object is needed "
                          f"(skfem_beam.methods.PositionLevel(solver=...), Penalty(stiffness), "
                          f"MoreauJean(theta))")
+    unknown = sorted(set(recording) - set(RECORDING))
+    if unknown:
+        raise TypeError(f"solve() got an unexpected keyword argument {unknown[0]!r} "
+                        f"(it takes {', '.join(RECORDING)} and progress)")
     if beta is None:
         beta = method.default_beta
-    stepping = Stepping(dt, T, beta, save_every, frames, load_window, growth_limit,
-                        massless=method.massless)
+    stepping = Stepping(dt, T, beta, **recording, massless=method.massless)
     rows = stepping.steps // stepping.save_every + 1
     values = rows * (2 * len(system.observe) + system.C.shape[0] + 4)
     if values > MAX_VALUES:   # a Result holds every saved row; the commands stream them

@@ -31,3 +31,47 @@ def test_quick_work_precision(tmp_path):
     # a soft penalty spring penetrates; a stiff one at Δt/h = 0.4 gains energy
     assert col("penetration", "bar", "penalty k=1e3, average, β=1/4", 0.04).min() > 1e-3
     assert col("energy_drift", "rod", "penalty k=1e5, average, β=1/4", 0.4).max() > 1
+
+
+def test_quick_work_precision_beams(tmp_path):
+    """The beams against the papers' scheme at Δt_min/16, up to the second impact
+    (numbers of docs/work_precision_beam.csv at the quick ladder)."""
+    assert work_precision.main(["--quick", "--scene", "beams", "--out", str(tmp_path)]) == 0
+    rows = list(csv.DictReader(open(tmp_path / "work_precision_beam.csv")))
+    assert (tmp_path / "work_precision_beam.png").stat().st_size > 30_000
+    assert not (tmp_path / "work_precision.csv").exists()     # rod and bar not run
+    by = {}
+    for r in rows:
+        by.setdefault((r["scene"], r["method"]), []).append(r)
+    col = lambda key, *k: np.array([float(r[key]) for r in by[k]])  # noqa: E731
+    papers, mj = work_precision.PAPERS, "Moreau–Jean θ=1/2 e=0, consistent"
+    mm = "modified mass (redistributed), β=1/2"
+    qs = "modified mass (redistributed), β=1/4, quasi-static"
+    assert len(by) == 6 + 4          # flat obstacles refuse a redistributed mass
+    assert not any(k == ("flat_obstacles", qs) for k in by)
+    for scene in ("point_stops", "flat_obstacles"):
+        assert all(len(v) == 4 and {r["status"] for r in v} == {"success"}
+                   for k, v in by.items() if k[0] == scene)
+        gap = work_precision.GAPS[scene]
+        dt, e = col("dt", scene, papers), col("error", scene, papers)
+        assert np.all(np.diff(dt) < 0) and np.all(np.diff(e) < 0)   # converges ...
+        order = np.log(e[0] / e[-1]) / np.log(dt[0] / dt[-1])
+        assert 0.4 < order < 1.5              # ... at about first order on the window
+        assert col("penetration", scene, papers).max() <= 1e-12 * gap       # exact
+        assert col("penetration", scene, mj).min() > 1e-4 * gap             # O(Δt)
+        # the reference's own error (2Δt_ref against Δt_ref): point stops' first impact
+        # chatters (a dozen contacts in 2 ms) and the chatter is not converged in Δt
+        own = col("ref_error", scene, papers).max()
+        assert own < (0.6 if scene == "point_stops" else 0.1) * e.min()
+    assert 0.45 < order < 1.2                 # flat obstacles: 0.71 (quick ladder)
+    # point stops: the modified mass is exact too, but its mass matrix is not the
+    # reference's: a floor of 3.8e-2 at every Δt, 3× the papers' error at the coarsest
+    for m in (mm, qs):
+        assert col("penetration", "point_stops", m).max() <= 1e-12 * 0.1
+        e = col("error", "point_stops", m)
+        assert np.all((3.5e-2 < e) & (e < 4.2e-2))
+        assert e.min() > 2.5 * col("error", "point_stops", papers).max()
+    # a stiffer spring penetrates less
+    soft, stiff = (f"penalty k={k:g} N/m, consistent, β=1/4" for k in (1e6, 1e8))
+    assert col("penetration", "point_stops", stiff).max() < \
+        0.1 * col("penetration", "point_stops", soft).min()

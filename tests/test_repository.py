@@ -5,27 +5,12 @@ import subprocess
 from pathlib import Path
 
 ROOT = Path(__file__).parents[1]
-MAX_PARAMETERS = 12
 
 
 def tracked(*patterns):
     out = subprocess.run(["git", "ls-files", *patterns], cwd=ROOT, capture_output=True,
                          text=True, check=True).stdout.split()
     return [ROOT / p for p in out if (ROOT / p).is_file()]
-
-
-def test_no_function_takes_more_than_twelve_parameters():
-    wide = []
-    for path in (ROOT / "skfem_beam").rglob("*.py"):
-        for f in ast.walk(ast.parse(path.read_text())):
-            if isinstance(f, (ast.FunctionDef, ast.AsyncFunctionDef)):
-                a = f.args
-                names = [x.arg for x in a.posonlyargs + a.args + a.kwonlyargs]
-                n = len(names) + bool(a.vararg) + bool(a.kwarg) \
-                    - (bool(names) and names[0] in ("self", "cls"))
-                if n > MAX_PARAMETERS:
-                    wide.append(f"{path.relative_to(ROOT)}:{f.lineno} {f.name} ({n})")
-    assert not wide, wide
 
 
 def test_no_file_cites_a_document_outside_the_repository():

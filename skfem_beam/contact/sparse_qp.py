@@ -59,7 +59,7 @@ import scipy.linalg
 import scipy.sparse as sp
 
 from ..errors import InputError, SolverError
-from ..linalg import Banded, band_solve
+from ..linalg import band_solve
 from .base import ContactLaw
 
 MAX_SWEEPS = 100   # active-set updates of one step before it gives up (SolverError)
@@ -125,16 +125,18 @@ class SelectorQP:
                  guess_sweeps: int = GUESS_SWEEPS):
         self.A = sp.csr_matrix(A, dtype=float)
         self.A.sort_indices()
-        self.band = Banded(self.A)
+        coo = sp.triu(self.A).tocoo()           # A's upper band in LAPACK's layout
+        self.kd = int((coo.col - coo.row).max()) if coo.nnz else 0
+        self.lap = np.zeros((self.kd + 1, self.A.shape[0]))  # lap[kd − o, j] = A[j − o, j]
+        self.lap[self.kd + coo.row - coo.col, coo.col] = coo.data
         self.dof = selected_unknowns(C)
         self.c = self.A.diagonal()[self.dof]
         self.n = self.A.shape[0]
         self.update, self.max_columns = update, int(max_columns)
         # inexact sweeps pay where a factorisation costs many solves: while the factor
         # stays in cache (dpbtrf = 45 dpbtrs at 40 × 40, 8.6 MB; 13 at 80 × 80, 68 MB)
-        small = 8.0 * self.n * (self.band.kd + 1) <= GUESS_MAX_BYTES
+        small = 8.0 * self.n * (self.kd + 1) <= GUESS_MAX_BYTES
         self.guess_sweeps = int(guess_sweeps) if update and small else 0
-        self.lap = None                         # A's upper band, LAPACK layout
         self.key, self.chol = None, None        # the last set's factor (update=False)
         self.factors = 0                        # factorisations so far
         self.solves = 0                         # banded solves (columns) so far
@@ -150,9 +152,7 @@ class SelectorQP:
     def pinned_band(self, pinned: np.ndarray, lapack: bool = False) -> np.ndarray:
         """The upper band of A_S: A with rows and columns ``pinned`` replaced by the
         identity; in the Banded layout (n, kd + 1), or LAPACK's (kd + 1, n)."""
-        kd, n = self.band.kd, self.band.n
-        if self.lap is None:
-            self.lap = np.ascontiguousarray(self.band.band.T)   # lap[kd − o, j] = A[j − o, j]
+        kd, n = self.kd, self.n
         lap = self.lap.copy()
         lap[:, pinned] = 0.0                          # column j pinned
         o = np.arange(1, kd + 1)

@@ -1,4 +1,5 @@
-"""What a plate step costs: ``python -m skfem_beam.plate.bench [--meshes 20 40 80]``.
+"""What a plate step costs: ``python -m skfem_beam.plate.bench [--meshes 20 40 80]
+[--steps 100 100 40]``.
 
 A simply supported 1 × 1 m steel plate (h = 1 cm, BFS on n × n), a flat obstacle under
 the whole plate at w ≥ −0.2 w_s (w_s: the static centre deflection under the load), the
@@ -6,10 +7,11 @@ plate starting flat at rest under a uniform −10 kPa: it falls onto the obstacl
 quarter period and stays pressed on it.  Printed per mesh: the half bandwidth, the setup
 (the banded Cholesky of A = M + βΔt²K alone, and the whole of scheme.operators:
 step_operators, with W = A⁻¹Cᵀ and D = C W, when W fits in W_LIMIT bytes) and the bytes
-of W and D; per step, one banded solve with A's factor, the scheme's step without
+of W and D; per step, one banded solve with A's factor (the scheme's, linalg.band_solve,
+and LAPACK's dpbtrs on one thread, which the x-space laws use), the scheme's step without
 obstacles, and the step pressed on the obstacle with each exact law (its mean over the
-run, with the fraction of steps in contact, and its ratio to the banded solve); the
-process's peak memory after each mesh.  The laws that need W and D (active-set, daqp,
+run, with the fraction of steps in contact, and its ratio to the scheme's banded solve
+and to dpbtrs); the process's peak memory after each mesh.  The laws that need W and D (active-set, daqp,
 osqp) run only where W fits; the x-space laws (contact.sparse_qp) build neither.  Only
 measured, nothing tuned (docs/plate.md, "Which engine at which size").
 """
@@ -20,7 +22,9 @@ import resource
 import time
 
 import numpy as np
+import scipy.linalg
 
+from ..contact.sparse_qp import COUNTS, _one_thread
 from ..linalg import Banded, band_solve
 from ..methods import PositionLevel
 from ..scheme import solve
@@ -32,7 +36,7 @@ from .system import PlateInitial, PlateObstacle, Pressure, half_bandwidth, plate
 
 LOAD = -1e4                  # Pa
 DT = 2e-4                    # s (the first period is 20 ms)
-STEPS = 100                  # steps of each law's run
+STEPS = 100                  # steps of each law's run (--steps: one number per mesh)
 DELASSUS_LAWS = ("active-set", "daqp", "osqp")               # need W and D
 X_SPACE_LAWS = ("pdas-sparse", "osqp-sparse", "clarabel-sparse")   # neither
 W_LIMIT = 200e6              # bytes: W = A⁻¹Cᵀ (dense n × m) is built below this only
@@ -69,10 +73,13 @@ def setup_row(system) -> dict:
     total = time.perf_counter() - t0
     b = np.ones(system.n)
     solve_s = timed(lambda: band_solve(ops.Ab.chol, b), 50)
+    with _one_thread():
+        lap, _ = scipy.linalg.lapack.dpbtrf(ops.Ab.lapack_band(), lower=0)
+        lapack_s = timed(lambda: scipy.linalg.lapack.dpbtrs(lap, b, lower=0), 50)
     return {"n": system.n, "m": system.C.shape[0], "kd": half_bandwidth(A),
             "factor_s": factor, "operators_s": total, "W_MB": ops.W.nbytes / 1e6,
             "D_MB": ops.D.nbytes / 1e6, "band_solve_ms": 1e3 * solve_s,
-            "delassus": delassus}
+            "lapack_solve_ms": 1e3 * lapack_s, "delassus": delassus}
 
 
 def step_ms(system, solver: str, steps: int) -> tuple[float, float]:
@@ -80,6 +87,7 @@ def step_ms(system, solver: str, steps: int) -> tuple[float, float]:
     from a first short run (compiles, builds the operators) and the timed run's own
     loop time."""
     solve(system, DT, 2 * DT, method=PositionLevel(solver), progress=False)
+    COUNTS.update(dict.fromkeys(COUNTS, 0))
     r = solve(system, DT, steps * DT, method=PositionLevel(solver), progress=False)
     return 1e3 * r.wall_time_s / r.steps, r.contact_fraction
 
@@ -89,24 +97,34 @@ def peak_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e3
 
 
-def law_rows(pressed, laws, solve_ms: float) -> None:
-    """One line per law: its mean step, the fraction in contact, the ratio to a solve."""
+def law_rows(pressed, laws, solve_ms: float, lapack_ms: float, steps: int = STEPS) -> None:
+    """One line per law: its mean step, the fraction in contact, the ratio to a solve
+    (the scheme's banded solve; LAPACK's dpbtrs)."""
     for law in laws:
         try:
-            ms, fraction = step_ms(pressed, law, STEPS)
+            ms, fraction = step_ms(pressed, law, steps)   # (COUNTS: the timed run's)
         except Exception as e:          # a law that does not run here says why
             print(f"  step with {law}: not run ({type(e).__name__}: {e})", flush=True)
             continue
-        print(f"  step with {law}: {ms:.2f} ms = {ms / solve_ms:.1f} solves ({STEPS} steps, "
-              f"{100 * fraction:.0f} % in contact)", flush=True)
+        print(f"  step with {law}: {ms:.2f} ms = {ms / solve_ms:.1f} solves "
+              f"({ms / lapack_ms:.0f} dpbtrs; {steps} steps, {100 * fraction:.0f} % in "
+              f"contact)", flush=True)
+        if law in X_SPACE_LAWS and COUNTS["steps"]:
+            c = {k: v / COUNTS["steps"] for k, v in COUNTS.items()}
+            print(f"    per contact step: {c['factors']:.2f} factorisations, "
+                  f"{c['solves']:.1f} banded solves, {c['guesses']:.1f} inexact and "
+                  f"{c['sweeps']:.1f} exact sweeps", flush=True)
 
 
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--meshes", type=int, nargs="+", default=[20, 40])
+    parser.add_argument("--meshes", type=int, nargs="+", default=[20, 40, 80])
+    parser.add_argument("--steps", type=int, nargs="+", default=[STEPS],
+                        help="steps of each run, one number per mesh (the last repeats)")
     parser.add_argument("--laws", nargs="+", default=DELASSUS_LAWS + X_SPACE_LAWS)
     args = parser.parse_args(argv)
-    for n in args.meshes:
+    for i, n in enumerate(args.meshes):
+        steps = args.steps[min(i, len(args.steps) - 1)]
         free, pressed = systems(n)
         row = setup_row(pressed)
         print(f"BFS {n} x {n}: {row['n']} unknowns, {row['m']} constrained vertices, half "
@@ -115,11 +133,13 @@ def main(argv=None) -> None:
             f"{8e-6 * row['n'] * row['m']:.0f} MB: not built)"
         print(f"  setup: Cholesky of A {row['factor_s']:.3f} s, step_operators {what} "
               f"{row['operators_s']:.2f} s; W {row['W_MB']:.1f} MB, D {row['D_MB']:.1f} MB")
-        print(f"  one banded solve: {row['band_solve_ms']:.3f} ms", flush=True)
-        ms, _ = step_ms(free, "auto", STEPS)
-        print(f"  step without obstacles: {ms:.2f} ms", flush=True)
+        print(f"  one banded solve: {row['band_solve_ms']:.3f} ms (LAPACK dpbtrs: "
+              f"{row['lapack_solve_ms']:.3f} ms)", flush=True)
+        ms, _ = step_ms(free, "auto", steps)
+        print(f"  step without obstacles: {ms:.2f} ms = {ms / row['band_solve_ms']:.1f} "
+              f"solves", flush=True)
         laws = [law for law in args.laws if row["delassus"] or law not in DELASSUS_LAWS]
-        law_rows(pressed, laws, row["band_solve_ms"])
+        law_rows(pressed, laws, row["band_solve_ms"], row["lapack_solve_ms"], steps)
         print(f"  peak memory of the process so far: {peak_mb():.0f} MB", flush=True)
 
 

@@ -67,6 +67,8 @@ RUNS = {
     "bar_A": [BAR, "--A", "2e-4", "--b", "0.01", "--restitution", "0.5"],
     **{f"toml_{p.stem}": ["skfem_beam", "run", str(p), "--set", "time.T=0.05"]
        for p in sorted(SCENES.glob("*.toml"))},
+    **{f"toml_{p.stem}": ["skfem_beam", "run", str(p)]      # their own T: short already
+       for p in sorted((SCENES / "plates").glob("*.toml"))},
     "toml_heat_mj": ["skfem_beam", "run", str(SCENES / "heat_exchanger_tube.toml"),
                      "--set", "time.T=0.05", "--set", "contact.law=moreau-jean"],
     "toml_friction_mj": ["skfem_beam", "run", str(SCENES / "tube_round_holes_friction.toml"),

@@ -79,3 +79,16 @@ def resumed(make, cut: int):
     ea, ec = a.impact_events(), c.impact_events()
     assert all(np.array_equal(ea[k], ec[k], equal_nan=True) for k in ea)
     return a, c
+
+
+def assert_exact_with_friction(r, clearance: float) -> None:
+    """A run of the position-level law with Coulomb friction: no penetration at the nodes
+    (≤ 1e-12 of the clearance), the energy identity with the friction's work to 1e-9, and
+    friction that dissipates at every step."""
+    assert r.solver == "round-hole-friction" and r.impacts > 10
+    assert r.max_nodal_violation <= 1e-12 * clearance
+    w = r.work
+    gap = r.energy - r.energy[0] + w["damping"] - w["input"] - w["contact"] - w["friction"]
+    assert np.abs(gap).max() <= 1e-9 * np.abs(r.energy).max()
+    assert w["friction"][-1] < 0 and w["contact"][-1] < 0
+    assert np.diff(w["friction"]).max() <= 1e-15 * abs(w["friction"][-1])

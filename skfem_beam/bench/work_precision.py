@@ -262,13 +262,20 @@ def beam_rows(scene: str, quick: bool):
                    "ref_error": own}
 
 
-def chart(path: Path, rows: list[dict]):
+def _panels(scenes, rows: list[dict]):
+    """(pyplot, figure, axes, the scenes among ``scenes`` that ``rows`` has): three panels
+    a scene."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    benches = [s for s in BENCHMARKS if any(r["scene"] == s for r in rows)]
+    benches = [s for s in scenes if any(r["scene"] == s for r in rows)]
     fig, axes = plt.subplots(len(benches), 3, figsize=(17, 4.6 * len(benches)), dpi=100,
                              squeeze=False)
+    return plt, fig, axes, benches
+
+
+def chart(path: Path, rows: list[dict]):
+    plt, fig, axes, benches = _panels(BENCHMARKS, rows)
     for row_axes, scene in zip(axes, benches):
         sel = [r for r in rows if r["scene"] == scene]
         for ax, courant in zip(row_axes, COURANTS):
@@ -303,17 +310,11 @@ def chart(path: Path, rows: list[dict]):
     plt.close(fig)
 
 
-
 def beam_chart(path: Path, rows: list[dict]):
     """Per beam scene: error against the time loop's wall time, error against Δt, and the
     largest penetration at the nodes against Δt (relative to the gap; 0 drawn at 1e-18)."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     from matplotlib.ticker import NullFormatter
-    benches = [s for s in BEAM_SCENES if any(r["scene"] == s for r in rows)]
-    fig, axes = plt.subplots(len(benches), 3, figsize=(17, 4.6 * len(benches)), dpi=100,
-                             squeeze=False)
+    plt, fig, axes, benches = _panels(BEAM_SCENES, rows)
     for row_axes, scene in zip(axes, benches):
         sel = [r for r in rows if r["scene"] == scene]
         first = sel[0]

@@ -186,12 +186,7 @@ def _face_block(D, y, y_prev, lo, hi, fric, mu, j, t, local):
     yt = y[t] - D[t, j] * mu[j] - D[t, t] * mu[t]
     coulomb_face((D[j, j], D[j, t], D[t, t]), yj, yt, y_prev[t], lo[j], hi[j], fric[j],
                  local)
-    dj, dt = local[0] - mu[j], local[1] - mu[t]
-    if dj != 0.0 or dt != 0.0:
-        for i in range(y.size):
-            y[i] += D[i, j] * dj + D[i, t] * dt
-        mu[j], mu[t] = local[0], local[1]
-    return max(abs(D[j, j] * dj + D[j, t] * dt), abs(D[t, j] * dj + D[t, t] * dt))
+    return _set_pair(D, y, mu, j, t, local)
 
 
 @internal
@@ -203,6 +198,13 @@ def _disk_block(D, y, y_prev, bounds, fric, mu, a, b, local):
     za, zb, _, r = radial(ya, yb, lo[a], hi[a], lo[b], hi[b])
     qa, qb, _, _ = radial(y_prev[a], y_prev[b], lo[a], hi[a], lo[b], hi[b])
     coulomb_disk((D[a, a], D[a, b], D[b, b]), (za, zb), (qa, qb), r, fric[a], local)
+    return _set_pair(D, y, mu, a, b, local)
+
+
+@internal
+def _set_pair(D, y, mu, a, b, local):
+    """Rows a, b's multipliers set to ``local``, y = yf + Dμ updated; returns the largest
+    change of y[a], y[b]."""
     da, db = local[0] - mu[a], local[1] - mu[b]
     if da != 0.0 or db != 0.0:
         for i in range(y.size):

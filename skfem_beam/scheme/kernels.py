@@ -406,16 +406,7 @@ def friction_split(mu, dy, at, work, rowwork, ev, a, b, dt):
     if rho == 0.0 or (mu[a] == 0.0 and mu[b] == 0.0):
         return
     ta, tb = -pb / rho, pa / rho
-    mt, s = ta * mu[a] + tb * mu[b], ta * dy[a] + tb * dy[b]
-    w = 0.5 * mt * s / (dt * dt)
-    work[2] -= w
-    work[FRICTION] += w
-    if rowwork.shape[0]:
-        rowwork[a, 0] -= w
-        rowwork[a, 2] += w
-    if ev[0] >= 0.0:
-        ev[9] += 0.5 * abs(s)
-        ev[10] += abs(mt) / dt
+    _to_friction(ta * mu[a] + tb * mu[b], ta * dy[a] + tb * dy[b], work, rowwork, ev, a, dt)
 
 
 @njit(cache=True, inline="always")
@@ -426,16 +417,23 @@ def face_friction_split(mu, dy, work, rowwork, ev, t, dt):
     event under way gets the slip |s|/2 and the impulse |μ_t|/Δt."""
     if mu[t] == 0.0:
         return
-    s = dy[t]
-    w = 0.5 * mu[t] * s / (dt * dt)
+    _to_friction(mu[t], dy[t], work, rowwork, ev, t, dt)
+
+
+@njit(cache=True, inline="always")
+def _to_friction(mt, s, work, rowwork, ev, row, dt):
+    """A contact's tangential work ½ μ_t s/Δt² moves from the contact's column to the
+    friction's (and in row ``row`` of rowwork); the event under way gets the slip |s|/2
+    and the impulse |μ_t|/Δt."""
+    w = 0.5 * mt * s / (dt * dt)
     work[2] -= w
     work[FRICTION] += w
     if rowwork.shape[0]:
-        rowwork[t, 0] -= w
-        rowwork[t, 2] += w
+        rowwork[row, 0] -= w
+        rowwork[row, 2] += w
     if ev[0] >= 0.0:
         ev[9] += 0.5 * abs(s)
-        ev[10] += abs(mu[t]) / dt
+        ev[10] += abs(mt) / dt
 
 
 @internal

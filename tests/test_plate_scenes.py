@@ -155,13 +155,14 @@ def test_modes_lists_the_plate_frequencies(tmp_path, capsys):
 
 def test_resume_extends_a_plate_run_bit_for_bit(tmp_path):
     """A finished run keeps its last checkpoint: --resume DIR --T longer continues it, and
-    its timeseries.csv is the uninterrupted longer run's, byte for byte."""
+    its timeseries.csv and impacts.csv are the uninterrupted longer run's, byte for byte."""
     scene = str(example("plate_rattling"))
     short, whole = tmp_path / "short", tmp_path / "whole"
     assert exit_code(run_main, [scene, "--T", "0.05", "--out", str(short)]) == 0
     assert exit_code(run_main, ["--resume", str(short), "--T", "0.1"]) == 0
     assert exit_code(run_main, [scene, "--T", "0.1", "--out", str(whole)]) == 0
     assert (short / "timeseries.csv").read_bytes() == (whole / "timeseries.csv").read_bytes()
+    assert (short / "impacts.csv").read_bytes() == (whole / "impacts.csv").read_bytes()
 
 
 def test_every_plate_key_is_in_docs_plate_md():

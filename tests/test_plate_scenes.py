@@ -12,13 +12,13 @@ import numpy as np
 import pytest
 
 from conftest import assert_refused, exit_code
-from skfem_beam.output.plate import vertex_fields
+from skfem_beam.output.plate import MOMENTS, vertex_fields
 from skfem_beam.scenefile import example, load, modes_main, run_main
 from skfem_beam.scheme import drive
 
 SHIPPED = ("plate_on_stops", "plate_rattling")
-FILES = ("timeseries.csv", "summary.json", "fields.xdmf", "fields.h5", "fields.pvd",
-         "probes.png", "energy.png", "deflection.png", "checkpoint.npz")
+FILES = ("timeseries.csv", "impacts.csv", "summary.json", "fields.xdmf", "fields.h5",
+         "fields.pvd", "probes.png", "energy.png", "deflection.png", "checkpoint.npz")
 
 
 def columns(folder) -> dict:
@@ -89,6 +89,8 @@ def test_fields_read_back_with_the_run_s_deflection(shipped):
             assert t == r.frames_t[k]
             np.testing.assert_array_equal(data["w"], expected[k]["w"])
             np.testing.assert_array_equal(data["contact_force"], expected[k]["contact_force"])
+            for m in MOMENTS:
+                np.testing.assert_array_equal(data[m], expected[k][m])
     assert points.shape[0] == system.meta["space"].vertices.shape[1]
     assert cells[0].type == "quad"
     last = meshio.read(out / "fields_vtu" / f"fields_{len(expected) - 1:06d}.vtu")
@@ -153,13 +155,14 @@ def test_modes_lists_the_plate_frequencies(tmp_path, capsys):
 
 def test_resume_extends_a_plate_run_bit_for_bit(tmp_path):
     """A finished run keeps its last checkpoint: --resume DIR --T longer continues it, and
-    its timeseries.csv is the uninterrupted longer run's, byte for byte."""
+    its timeseries.csv and impacts.csv are the uninterrupted longer run's, byte for byte."""
     scene = str(example("plate_rattling"))
     short, whole = tmp_path / "short", tmp_path / "whole"
     assert exit_code(run_main, [scene, "--T", "0.05", "--out", str(short)]) == 0
     assert exit_code(run_main, ["--resume", str(short), "--T", "0.1"]) == 0
     assert exit_code(run_main, [scene, "--T", "0.1", "--out", str(whole)]) == 0
     assert (short / "timeseries.csv").read_bytes() == (whole / "timeseries.csv").read_bytes()
+    assert (short / "impacts.csv").read_bytes() == (whole / "impacts.csv").read_bytes()
 
 
 def test_every_plate_key_is_in_docs_plate_md():

@@ -11,7 +11,7 @@ import numpy as np
 from ..chart_process import draw
 from ..output.charts import energy_chart, trajectory_chart
 from ..output.plate import (UNITS, PlateFieldWriter, deflection_chart, plate_cells,
-                            plate_columns, probe_name, vertex_fields)
+                            plate_columns, plate_impacts, probe_name, vertex_fields)
 from ..output.stream import Series, execute, prepare
 from ..spec import RunSpec
 
@@ -44,7 +44,8 @@ def run_plate_case(case: str, setup, spec: RunSpec) -> int:
                                     "vertices"},
         "config": spec.config,
     }
-    series = Series(plate_columns(setup.probes), writer=PlateFieldWriter)
+    series = Series(plate_columns(setup.probes), writer=PlateFieldWriter,
+                    events=plate_impacts)
     return execute(run, spec.options, summary, series, plate_charts(case, system, setup))
 
 

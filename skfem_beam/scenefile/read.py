@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import InputError
-from .schema import BEAM_KEYS, KINDS, check_keys, key_path
+from .schema import BEAM_KEYS, KINDS, Names, check_keys, key_path
 
 
 @dataclass(frozen=True)
@@ -90,6 +90,9 @@ def apply_set(data: dict, assignment: str) -> tuple[str, str]:
                 raise InputError(f"--set {key}: name a key of the item, e.g. "
                                  f"{key}.{next(iter(sub))}")
             continue
+        if isinstance(sub, Names) and last:
+            node[part] = _toml_value(text.strip())      # a name the objects check
+            return ".".join(parts), text.strip()
         if not isinstance(sub, dict) or part not in sub:
             allowed = ", ".join(sub) if isinstance(sub, dict) else "none"
             raise InputError(f"--set {key}: unknown key {part!r}; "

@@ -54,10 +54,22 @@ def _line_names(m, block: int, cells: np.ndarray) -> dict[str, np.ndarray]:
 
 
 def _read(path: Path):
+    """meshio's mesh in ``path``; what meshio prints on the way (it tries each format an
+    extension may be: .msh is ansys, then gmsh) is kept off the terminal."""
+    import contextlib
+    import io
+
     import meshio
+    if not path.is_file():
+        raise InputError(f"cannot read the mesh file {path}: no such file")
+    chatter = io.StringIO()
     try:
-        return meshio.read(path)
-    except Exception as e:      # meshio raises many kinds on a file it cannot parse
+        with contextlib.redirect_stdout(chatter), contextlib.redirect_stderr(chatter):
+            return meshio.read(path, file_format="gmsh" if path.suffix == ".msh" else None)
+    except SystemExit:      # meshio's way of saying no format it tried could parse it
+        raise InputError(f"cannot read the mesh file {path}: meshio cannot parse it as "
+                         f"{path.suffix or 'a file without extension'}") from None
+    except Exception as e:  # meshio raises many kinds on a file it cannot parse
         why = (str(e).strip().splitlines() or [type(e).__name__])[0]
         raise InputError(f"cannot read the mesh file {path}: {why}") from None
 

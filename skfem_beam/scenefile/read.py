@@ -142,10 +142,13 @@ def _shipped(name: str) -> Path | None:
 
 def example(name: str) -> Path:
     """The path of a shipped scene file (``skfem_beam/scene_files/NAME.toml``, a plate's
-    in ``skfem_beam/scene_files/plates/NAME.toml``)."""
+    in ``skfem_beam/scene_files/plates/NAME.toml``, a plate's on a mesh file beside its
+    mesh in ``skfem_beam/scene_files/plates/mesh/NAME.toml``)."""
     folder = Path(__file__).resolve().parents[1] / "scene_files"
-    for p in (folder / f"{Path(name).stem}.toml", folder / "plates" / f"{Path(name).stem}.toml"):
+    places = (".", "plates", "plates/mesh")
+    for place in places:
+        p = folder / place / f"{Path(name).stem}.toml"
         if p.is_file():
             return p
-    shipped = sorted(q.stem for q in [*folder.glob("*.toml"), *folder.glob("plates/*.toml")])
+    shipped = sorted(q.stem for place in places for q in folder.glob(f"{place}/*.toml"))
     raise InputError(f"no scene file {name!r}; shipped: {', '.join(shipped)}")

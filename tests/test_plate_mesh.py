@@ -93,7 +93,7 @@ def test_shipped_disk_scene_loads_and_its_first_frequency_is_the_disk(tmp_path):
     assert isinstance(plate, MeshPlate) and plate.element == "argyris"
     assert plate.boundary_names == ("rim",) and plate.box == (-0.5, 0.5, -0.5, 0.5)
     lam = natural_frequencies(space, 1)[0][0] * 0.25 * np.sqrt(plate.rho * plate.h / plate.D)
-    assert abs(lam / CLAMPED_DISK - 1) < 3e-3          # measured 2.4e-3 with 6 rings
+    assert abs(lam / CLAMPED_DISK - 1) < 3e-3          # measured 2.66e-3 with 6 rings
     assert scene.problem.system.C.shape[0] > 0 and scene.problem.probes[0] == (0.0, 0.0)
 
 

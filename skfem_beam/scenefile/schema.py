@@ -39,13 +39,13 @@ class ListOf:
         return f"an array of {inner}"
 
 
-class Names:
+class Names(dict):
     """In a schema: a table whose keys are names the objects check (a plate's edges:
-    the rectangle's left, right, bottom, top, or a mesh file's boundary names), each
-    value checked by the object it builds."""
+    the rectangle's left, right, bottom, top, its keys here, or a mesh file's boundary
+    names), each value checked by the object it builds."""
 
     def __init__(self, *usual):
-        self.usual = usual
+        super().__init__(dict.fromkeys(usual, V))
 
 
 class NumberOrWord:

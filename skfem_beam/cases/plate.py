@@ -23,6 +23,22 @@ def smallest_gap(system) -> float | None:
     return float(g.min()) if g.size else None
 
 
+def geometry(plate) -> dict:
+    """The summary's geometry: the rectangle's nx, ny, a, b; a mesh file's name, its
+    vertices and triangles, its bounding box [x0, x1, y0, y1] (m)."""
+    if hasattr(plate, "nx"):
+        return {"nx": plate.nx, "ny": plate.ny, "a": plate.a, "b": plate.b}
+    return {"mesh": plate.mesh.source, "vertices": int(plate.mesh.points.shape[1]),
+            "triangles": int(plate.mesh.triangles.shape[1]), "box": list(plate.box)}
+
+
+def grid(plate) -> str:
+    """The mesh, as the charts' titles name it."""
+    if hasattr(plate, "nx"):
+        return f"{plate.nx}×{plate.ny}"
+    return f"{plate.mesh.triangles.shape[1]} triangles"
+
+
 def run_plate_case(case: str, setup, spec: RunSpec) -> int:
     """Run the plate ``setup`` (scenefile.plate.PlateSetup) as ``spec`` says, write its
     folder, return the exit code."""
@@ -31,9 +47,8 @@ def run_plate_case(case: str, setup, spec: RunSpec) -> int:
     run = spec.method.build(system, spec.stepping)
     plate = system.meta["plate"]
     summary = {
-        "case": case, "kind": "plate", "element": plate.element, "nx": plate.nx,
-        "ny": plate.ny, "a": plate.a, "b": plate.b, "thickness": plate.h,
-        "edges": {e: plate.support(e) for e in ("left", "right", "bottom", "top")},
+        "case": case, "kind": "plate", "element": plate.element, **geometry(plate),
+        "thickness": plate.h, "edges": {e: plate.support(e) for e in plate.boundary_names},
         "dt": run.dt, "T": run.n_steps * run.dt, "beta": run.beta, "theta": run.theta,
         "method": spec.method.name, "unknowns": system.n,
         "constrained_vertices": int(system.C.shape[0]),
@@ -55,7 +70,7 @@ def plate_charts(case: str, system, setup):
     force (the last frame when there is none); summary entries of the contact."""
     def finish(folder: Path, data: dict, run) -> dict:
         t, plate = data["t"], system.meta["plate"]
-        about = (f"{run.label}, Δt={run.dt:g} s, {plate.element} {plate.nx}×{plate.ny}")
+        about = (f"{run.label}, Δt={run.dt:g} s, {plate.element} {grid(plate)}")
         draw(trajectory_chart, folder / "probes.png", t,
              {f"w({x:g}, {y:g})": data[probe_name(x, y)] for x, y in setup.probes},
              title=f"{case}: deflection at the probes ({about})")

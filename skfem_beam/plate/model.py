@@ -1,4 +1,5 @@
-"""The plate's data: a rectangle, its material, the support of each edge and the mesh."""
+"""The plate's data: a rectangle (:class:`Plate`) or a triangle mesh read from a file
+(:class:`MeshPlate`), its material, the support of each edge and the element."""
 from dataclasses import dataclass, field
 
 from ..errors import InputError
@@ -52,8 +53,113 @@ class Plate:
             raise InputError(f"plate nx={self.nx!r}, ny={self.ny!r} must be whole numbers ≥ 1")
 
     @property
+    def boundary_names(self) -> tuple[str, ...]:
+        return EDGES
+
+    @property
+    def box(self) -> tuple[float, float, float, float]:
+        """(x0, x1, y0, y1): the rectangle."""
+        return (0.0, self.a, 0.0, self.b)
+
+    @property
+    def size(self) -> float:
+        """The longer side (m): the scale of the geometric tolerances."""
+        return max(self.a, self.b)
+
+    @property
+    def centre(self) -> tuple[float, float]:
+        return (self.a / 2, self.b / 2)
+
+    def outline(self) -> str:
+        """The plate, as the error lines name it."""
+        return f"the plate [0, {self.a:g}] × [0, {self.b:g}]"
+
+    @property
     def D(self) -> float:
         """The bending stiffness E h³ / (12 (1 − ν²)), N·m."""
+        return self.E * self.h ** 3 / (12.0 * (1.0 - self.nu ** 2))
+
+    def support(self, edge: str) -> str:
+        return self.edges.get(edge, "free")
+
+
+def _check_supports(edges: dict, names, what: str) -> None:
+    for edge, support in edges.items():
+        if edge not in names:
+            raise InputError(f"plate edge {edge!r} is not one of {what}: "
+                             f"{', '.join(names) or '(none)'}")
+        if support not in SUPPORTS:
+            raise InputError(f"plate edge {edge}: support {support!r} is not one of: "
+                             f"{', '.join(SUPPORTS)}")
+
+
+@dataclass(eq=False)
+class MeshPlate:
+    """A Kirchhoff–Love plate on a triangle mesh (any outline) read from a file
+    (:func:`skfem_beam.plate.meshfile.read_plate_mesh`), SI units.
+
+    ``mesh`` a :class:`~skfem_beam.plate.meshfile.PlateMesh`; ``edges`` maps a boundary
+    name of the mesh to its support (a boundary not named, and any boundary line the
+    file does not name, is free); ``element`` "morley" or "argyris" (BFS needs the
+    rectangle's grid).  Regions are checked against the mesh's bounding box ``box``."""
+    mesh: object
+    h: float = 0.01
+    E: float = 210e9
+    rho: float = 7850.0
+    nu: float = 0.3
+    edges: dict[str, str] = field(default_factory=dict)
+    element: str = "argyris"
+
+    def __post_init__(self):
+        if not -1.0 < self.nu < 0.5:
+            raise InputError(f"plate nu={self.nu!r} must lie in (-1, 0.5)")
+        if not self.h > 0:
+            raise InputError(f"plate thickness h={self.h!r} must be > 0")
+        if self.element == "bfs":
+            raise InputError("plate element 'bfs' needs the rectangle's grid ([geometry] a, "
+                             "b); a mesh file's plate takes morley or argyris")
+        if self.element not in ELEMENTS:
+            raise InputError(f"plate element {self.element!r} is not one of: morley, argyris")
+        _check_supports(self.edges, self.boundary_names,
+                        f"the boundaries of the mesh {self.mesh.source}")
+
+    @property
+    def boundary_names(self) -> tuple[str, ...]:
+        return tuple(self.mesh.boundaries)
+
+    @property
+    def box(self) -> tuple[float, float, float, float]:
+        """(x0, x1, y0, y1): the mesh's bounding box."""
+        (x0, y0), (x1, y1) = self.mesh.points.min(axis=1), self.mesh.points.max(axis=1)
+        return (float(x0), float(x1), float(y0), float(y1))
+
+    @property
+    def a(self) -> float:
+        """The bounding box's width along x (m)."""
+        x0, x1, _, _ = self.box
+        return x1 - x0
+
+    @property
+    def b(self) -> float:
+        """The bounding box's height along y (m)."""
+        _, _, y0, y1 = self.box
+        return y1 - y0
+
+    @property
+    def size(self) -> float:
+        return max(self.a, self.b)
+
+    @property
+    def centre(self) -> tuple[float, float]:
+        x0, x1, y0, y1 = self.box
+        return ((x0 + x1) / 2, (y0 + y1) / 2)
+
+    def outline(self) -> str:
+        x0, x1, y0, y1 = self.box
+        return f"the plate (its mesh's bounding box [{x0:g}, {x1:g}] × [{y0:g}, {y1:g}])"
+
+    @property
+    def D(self) -> float:
         return self.E * self.h ** 3 / (12.0 * (1.0 - self.nu ** 2))
 
     def support(self, edge: str) -> str:

@@ -8,7 +8,8 @@ from skfem import (Basis, BilinearForm, ElementQuadBFS, ElementTriArgyris, Eleme
                    LinearForm, MeshQuad, MeshTri, asm)
 from skfem.helpers import dd, ddot, trace
 
-from .model import EDGES, Plate
+from ..errors import InputError
+from .model import MeshPlate, Plate
 
 # the coordinate normal to each edge of the rectangle (0: x, 1: y)
 NORMAL_AXIS = {"left": 0, "right": 0, "bottom": 1, "top": 1}
@@ -42,20 +43,55 @@ def rectangle_mesh(plate: Plate):
     })
 
 
+def file_mesh(plate: MeshPlate) -> MeshTri:
+    """The triangles of a mesh file's plate, with its named boundaries (facet indices)."""
+    m = plate.mesh
+    mesh = MeshTri(np.asarray(m.points, dtype=float), np.asarray(m.triangles, dtype=np.int64))
+    n = mesh.p.shape[1]
+    key = mesh.facets[0] * n + mesh.facets[1]          # skfem's facets: sorted pairs
+    order = np.argsort(key)
+    named = {}
+    for name, pairs in m.boundaries.items():
+        lines = np.sort(pairs, axis=0)
+        want = lines[0] * n + lines[1]
+        at = np.minimum(np.searchsorted(key, want, sorter=order), key.size - 1)
+        found = key[order[at]] == want
+        if not found.all():
+            raise InputError(f"the mesh {m.source}: {np.count_nonzero(~found)} line(s) of "
+                             f"boundary {name!r} are not edges of its triangles")
+        named[name] = np.unique(order[at])
+    return mesh.with_boundaries(named)
+
+
+def plate_mesh(plate):
+    """The skfem mesh of ``plate``, its boundaries named (the rectangle's left, right,
+    bottom, top; a mesh file's own names)."""
+    return file_mesh(plate) if isinstance(plate, MeshPlate) else rectangle_mesh(plate)
+
+
 def make_element(name: str):
     return {"bfs": ElementQuadBFS, "morley": ElementTriMorley,
             "argyris": ElementTriArgyris}[name]()
 
 
-def is_fixed(dofname: str, support: str, normal_axis: int) -> bool:
-    """Whether a support fixes the dof ``dofname`` (u, u_x, u_xy, u_n, ...) on an edge.
+def is_fixed(dofname: str, support: str, normal_axis: int | None) -> bool:
+    """Whether a support fixes the dof ``dofname`` (u, u_x, u_xy, u_n, ...) on an edge
+    whose normal is along x (``normal_axis`` 0), y (1) or neither (None: an oblique edge
+    of a mesh file's plate, below).
 
     Along the edge w = 0 fixes w and all its tangential derivatives; clamping also fixes
     ∂w/∂n = 0 and so its tangential derivatives.  A dof is fixed when its derivatives
     include no normal one (simply supported), or at most one (clamped).  u_n, the
     normal derivative at an edge's midpoint (Morley, Argyris), counts as one.  Sliding
-    (∂w/∂n = 0, w free: a line of symmetry) fixes those with exactly one."""
+    (∂w/∂n = 0, w free: a line of symmetry) fixes those with exactly one.
+
+    On an oblique edge the tangential and normal derivatives mix x and y, so only what
+    is a dof there is fixed: w (simply supported, clamped), w_x and w_y (clamped: the
+    whole gradient is 0) and u_n (clamped, sliding); the second derivatives stay free."""
     letters = dofname.partition("_")[2]
+    if normal_axis is None:
+        return {"clamped": letters in ("", "x", "y", "n"), "simply_supported": letters == "",
+                "sliding": letters == "n"}.get(support, False)
     normal_count = sum(c in ("n", "xy"[normal_axis]) for c in letters)
     if support == "clamped":
         return normal_count <= 1
@@ -66,14 +102,37 @@ def is_fixed(dofname: str, support: str, normal_axis: int) -> bool:
     return False
 
 
-def fixed_dofs(basis: Basis, plate: Plate) -> np.ndarray:
+def facet_axes(mesh, facets: np.ndarray) -> np.ndarray:
+    """The normal axis of each facet: 0 (along x: a facet parallel to y), 1 (along y),
+    -1 (oblique)."""
+    d = mesh.p[:, mesh.facets[1, facets]] - mesh.p[:, mesh.facets[0, facets]]
+    tol = 1e-9 * np.hypot(d[0], d[1])
+    return np.where(np.abs(d[0]) <= tol, 0, np.where(np.abs(d[1]) <= tol, 1, -1))
+
+
+def support_groups(basis: Basis, plate):
+    """(facets, support, normal axis or None) of each supported boundary: the
+    rectangle's edges whole (their axis, :data:`NORMAL_AXIS`), a mesh file's boundaries
+    split by their facets' directions (:func:`facet_axes`)."""
+    mesh = basis.mesh
+    for name in plate.boundary_names:
+        facets = mesh.boundaries[name]
+        if name in NORMAL_AXIS and isinstance(plate, Plate):
+            yield facets, plate.support(name), NORMAL_AXIS[name]
+            continue
+        axes = facet_axes(mesh, facets)
+        for axis in (0, 1, -1):
+            if np.any(axes == axis):
+                yield facets[axes == axis], plate.support(name), None if axis < 0 else axis
+
+
+def fixed_dofs(basis: Basis, plate) -> np.ndarray:
     """The dofs the edges' supports fix (a corner gets the union of its two edges')."""
     fixed = []
-    for edge in EDGES:
-        dofs = basis.get_dofs(edge)
+    for facets, support, axis in support_groups(basis, plate):
+        dofs = basis.get_dofs(facets)
         for kind in (dofs.nodal, dofs.facet):
-            fixed += [ix for name, ix in kind.items()
-                      if is_fixed(name, plate.support(edge), NORMAL_AXIS[edge])]
+            fixed += [ix for name, ix in kind.items() if is_fixed(name, support, axis)]
     return np.unique(np.concatenate(fixed)).astype(int) if fixed else np.zeros(0, int)
 
 
@@ -101,9 +160,10 @@ def load_vector(space: PlateSpace, pressure) -> np.ndarray:
     return asm(load, space.basis)
 
 
-def plate_space(plate: Plate) -> PlateSpace:
-    """The mesh, basis and matrices of ``plate``."""
-    mesh = rectangle_mesh(plate)
+def plate_space(plate) -> PlateSpace:
+    """The mesh, basis and matrices of ``plate`` (a :class:`Plate` or a
+    :class:`MeshPlate`)."""
+    mesh = plate_mesh(plate)
     basis = Basis(mesh, make_element(plate.element))
     fixed = fixed_dofs(basis, plate)
     return PlateSpace(

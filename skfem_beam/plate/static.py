@@ -18,7 +18,7 @@ def deflection_at_vertex(space: PlateSpace, u: np.ndarray, x: float, y: float) -
     """w at the mesh vertex (x, y); a point that is not a vertex is an InputError."""
     distance = np.hypot(space.vertices[0] - x, space.vertices[1] - y)
     nearest = int(np.argmin(distance))
-    if distance[nearest] > 1e-9 * max(space.plate.a, space.plate.b):
+    if distance[nearest] > 1e-9 * space.plate.size:
         raise InputError(f"({x:g}, {y:g}) is not a vertex of the plate's mesh; the nearest "
                          f"is ({space.vertices[0, nearest]:g}, {space.vertices[1, nearest]:g})")
     return float(u[space.w_dofs[nearest]])

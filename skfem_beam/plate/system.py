@@ -62,7 +62,7 @@ class PlateObstacle:
             where = np.zeros(x.size, dtype=bool)
             where[[vertex_index(space, px, py) for px, py in self.points]] = True
         else:
-            where = _inside(self.region, x, y, 1e-9 * max(space.plate.a, space.plate.b))
+            where = _inside(self.region, x, y, 1e-9 * space.plate.size)
         lo = np.where(where, _values(self.g1, x, y), -np.inf)
         hi = np.where(where, _values(self.g2, x, y), np.inf)
         return lo, hi
@@ -79,7 +79,7 @@ class Pressure:
 
     def vector(self, space: PlateSpace) -> np.ndarray:
         """b = ∫ p·1_region φ (N), all dofs."""
-        tol = 1e-9 * max(space.plate.a, space.plate.b)
+        tol = 1e-9 * space.plate.size
         return load_vector(space, lambda x, y: _values(self.p, x, y)
                            * _inside(self.region, x, y, tol))
 
@@ -97,7 +97,7 @@ def vertex_index(space: PlateSpace, x: float, y: float) -> int:
     """The mesh vertex at (x, y); a point that is not a vertex is an InputError."""
     distance = np.hypot(space.vertices[0] - x, space.vertices[1] - y)
     nearest = int(np.argmin(distance))
-    if distance[nearest] > 1e-9 * max(space.plate.a, space.plate.b):
+    if distance[nearest] > 1e-9 * space.plate.size:
         raise InputError(f"({x:g}, {y:g}) is not a vertex of the plate's mesh; the nearest "
                          f"is ({space.vertices[0, nearest]:g}, {space.vertices[1, nearest]:g})")
     return nearest
@@ -166,7 +166,7 @@ def _observers(space, points, position) -> dict[str, np.ndarray]:
     centre."""
     if points is None:
         x, y = space.vertices
-        c = int(np.argmin(np.hypot(x - space.plate.a / 2, y - space.plate.b / 2)))
+        c = int(np.argmin(np.hypot(x - space.plate.centre[0], y - space.plate.centre[1])))
         points = [(float(x[c]), float(y[c]))]
     rows = {}
     for px, py in points:

@@ -15,7 +15,7 @@ from .. import methods
 from ..checks import check_choice, check_count, check_positive
 from ..contact import SOLVERS
 from ..errors import InputError
-from ..plate.model import EDGES, ELEMENTS, SUPPORTS, Plate
+from ..plate.model import EDGES, ELEMENTS, SUPPORTS, MeshPlate, Plate
 from ..scheme import Stepping
 from .forcing import _time_function
 from .parts import need
@@ -53,20 +53,22 @@ class PlateScene:
     data: dict = field(default_factory=dict)
 
 
-def plate_of(data: dict) -> Plate:
-    """[geometry] a, b, [section] thickness, [material] E, rho, nu, [edges], [mesh]."""
-    g = need(data.get("geometry", {}), ("a", "b"), "geometry")
+def plate_of(data: dict, base=None):
+    """[geometry] a, b (a rectangle) or mesh (a file meshio reads, relative to ``base``:
+    the scene file's folder), [section] thickness, [material] E, rho, nu, [edges],
+    [mesh]."""
+    g = data.get("geometry", {})
+    if "mesh" in g:
+        return _mesh_plate(data, base)
+    g = need(g, ("a", "b"), "geometry")
     for key, value in g.items():
         check_positive(f"[geometry] {key}", value)
-    h = need(data.get("section", {}), ("thickness",), "section")["thickness"]
-    check_positive("[section] thickness", h)
-    m = need(data.get("material", {}), ("E", "rho", "nu"), "material")
-    check_positive("[material] E", m["E"])
-    check_positive("[material] rho", m["rho"])
-    if not -1.0 < m["nu"] < 0.5:
-        raise InputError(f"[material] nu={m['nu']!r} must lie in (-1, 0.5)")
+    h, m = _section_material(data)
     edges = data.get("edges", {})
     for edge, support in edges.items():
+        if edge not in EDGES:
+            raise InputError(f"[edges] {edge!r} is not an edge of the rectangle: "
+                             f"{', '.join(EDGES)}")
         check_choice(f"[edges] {edge}", support, SUPPORTS)
     mesh = data.get("mesh", {})
     element = check_choice("[mesh] element", mesh.get("element", "bfs"), ELEMENTS)
@@ -76,29 +78,76 @@ def plate_of(data: dict) -> Plate:
                  nx=nx, ny=ny)
 
 
+def _section_material(data: dict) -> tuple:
+    """(h, {E, rho, nu}) from [section] and [material], checked."""
+    h = need(data.get("section", {}), ("thickness",), "section")["thickness"]
+    check_positive("[section] thickness", h)
+    m = need(data.get("material", {}), ("E", "rho", "nu"), "material")
+    check_positive("[material] E", m["E"])
+    check_positive("[material] rho", m["rho"])
+    if not -1.0 < m["nu"] < 0.5:
+        raise InputError(f"[material] nu={m['nu']!r} must lie in (-1, 0.5)")
+    return h, m
+
+
+def _mesh_plate(data: dict, base) -> MeshPlate:
+    """A plate on the triangles of [geometry] mesh, its [edges] by the file's boundary
+    names."""
+    from pathlib import Path
+
+    from ..plate.meshfile import read_plate_mesh
+    g = data["geometry"]
+    if set(g) - {"mesh"}:
+        raise InputError("[geometry] give a, b (a rectangle) or mesh (a file), not both")
+    name = g["mesh"]
+    if not isinstance(name, str):
+        raise InputError(f"[geometry] mesh = {name!r} must be a file name (a string)")
+    grid = data.get("mesh", {})
+    element = check_choice("[mesh] element", grid.get("element", "argyris"), ELEMENTS)
+    if element == "bfs":
+        raise InputError("[mesh] element = 'bfs' needs the rectangle's grid ([geometry] a, "
+                         "b); a mesh file's plate takes morley or argyris")
+    if "nx" in grid or "ny" in grid:
+        raise InputError("[mesh] nx, ny are the rectangle's grid; a mesh file's plate has "
+                         "its own triangles")
+    h, m = _section_material(data)
+    path = Path(name) if Path(name).is_absolute() or base is None else Path(base) / name
+    mesh = read_plate_mesh(path, name)
+    edges = data.get("edges", {})
+    for edge, support in edges.items():
+        if edge not in mesh.boundaries:
+            raise InputError(f"[edges] {edge!r} is not a boundary of the mesh {name}; it has: "
+                             f"{', '.join(mesh.boundaries) or '(no named lines)'}")
+        check_choice(f"[edges] {edge}", support, SUPPORTS)
+    return MeshPlate(mesh, h=h, E=m["E"], rho=m["rho"], nu=m["nu"], edges=dict(edges),
+                     element=element)
+
+
 def _region(value, plate: Plate, where: str) -> tuple:
-    """region = [x0, y0, x1, y1] (m) on the plate, as (x0, x1, y0, y1)."""
+    """region = [x0, y0, x1, y1] (m) on the plate (a mesh file's: in its bounding box),
+    as (x0, x1, y0, y1)."""
     if len(value) != 4:
         raise InputError(f"{where} = {value!r} must be [x0, y0, x1, y1] (m)")
     x0, y0, x1, y1 = value
-    tol = 1e-9 * max(plate.a, plate.b)
+    bx0, bx1, by0, by1 = plate.box
+    tol = 1e-9 * plate.size
     if not (x0 < x1 and y0 < y1):
         raise InputError(f"{where} = {value!r} needs x0 < x1 and y0 < y1")
-    if x0 < -tol or y0 < -tol or x1 > plate.a + tol or y1 > plate.b + tol:
-        raise InputError(f"{where} = {value!r} is off the plate [0, {plate.a:g}] × "
-                         f"[0, {plate.b:g}] (m)")
+    if x0 < bx0 - tol or y0 < by0 - tol or x1 > bx1 + tol or y1 > by1 + tol:
+        raise InputError(f"{where} = {value!r} is off {plate.outline()} (m)")
     return (x0, x1, y0, y1)
 
 
 def _point(value, plate: Plate, where: str) -> tuple[float, float]:
-    """A point [x, y] (m) on the plate."""
+    """A point [x, y] (m) on the plate (a mesh file's: in its bounding box; the callers
+    then ask for a vertex)."""
     if len(value) != 2:
         raise InputError(f"{where} = {value!r} must be a point [x, y] (m)")
     x, y = value
-    tol = 1e-9 * max(plate.a, plate.b)
-    if not (-tol <= x <= plate.a + tol and -tol <= y <= plate.b + tol):
-        raise InputError(f"{where} = {value!r} is off the plate [0, {plate.a:g}] × "
-                         f"[0, {plate.b:g}] (m)")
+    bx0, bx1, by0, by1 = plate.box
+    tol = 1e-9 * plate.size
+    if not (bx0 - tol <= x <= bx1 + tol and by0 - tol <= y <= by1 + tol):
+        raise InputError(f"{where} = {value!r} is off {plate.outline()} (m)")
     return float(x), float(y)
 
 
@@ -165,7 +214,7 @@ def probes_of(data: dict, space) -> tuple:
     given = data.get("output", {}).get("probes")
     if given is None:
         x, y = space.vertices
-        c = int(np.argmin(np.hypot(x - space.plate.a / 2, y - space.plate.b / 2)))
+        c = int(np.argmin(np.hypot(x - space.plate.centre[0], y - space.plate.centre[1])))
         return ((float(x[c]), float(y[c])),)
     points = tuple(_point(p, space.plate, f"output.probes[{k}]") for k, p in enumerate(given))
     for k, (x, y) in enumerate(points):
@@ -203,7 +252,7 @@ def plate_scene(parsed: Parsed, tables: Tables, dynamic: bool = True) -> PlateSc
     from ..plate.space import plate_space
     from ..plate.system import plate_system
     data = parsed.data
-    space = plate_space(plate_of(data))
+    space = plate_space(plate_of(data, tables.base))
     if not dynamic:
         return PlateScene("plate", PlateSetup(space), None, text=parsed.text,
                           files=tables.read, data=data)

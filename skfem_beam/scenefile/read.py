@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import InputError
-from .schema import BEAM_KEYS, KINDS, check_keys, key_path
+from .schema import BEAM_KEYS, KINDS, Names, check_keys, key_path
 
 
 @dataclass(frozen=True)
@@ -90,6 +90,9 @@ def apply_set(data: dict, assignment: str) -> tuple[str, str]:
                 raise InputError(f"--set {key}: name a key of the item, e.g. "
                                  f"{key}.{next(iter(sub))}")
             continue
+        if isinstance(sub, Names) and last:
+            node[part] = _toml_value(text.strip())      # a name the objects check
+            return ".".join(parts), text.strip()
         if not isinstance(sub, dict) or part not in sub:
             allowed = ", ".join(sub) if isinstance(sub, dict) else "none"
             raise InputError(f"--set {key}: unknown key {part!r}; "
@@ -139,10 +142,13 @@ def _shipped(name: str) -> Path | None:
 
 def example(name: str) -> Path:
     """The path of a shipped scene file (``skfem_beam/scene_files/NAME.toml``, a plate's
-    in ``skfem_beam/scene_files/plates/NAME.toml``)."""
+    in ``skfem_beam/scene_files/plates/NAME.toml``, a plate's on a mesh file beside its
+    mesh in ``skfem_beam/scene_files/plates/mesh/NAME.toml``)."""
     folder = Path(__file__).resolve().parents[1] / "scene_files"
-    for p in (folder / f"{Path(name).stem}.toml", folder / "plates" / f"{Path(name).stem}.toml"):
+    places = (".", "plates", "plates/mesh")
+    for place in places:
+        p = folder / place / f"{Path(name).stem}.toml"
         if p.is_file():
             return p
-    shipped = sorted(q.stem for q in [*folder.glob("*.toml"), *folder.glob("plates/*.toml")])
+    shipped = sorted(q.stem for place in places for q in folder.glob(f"{place}/*.toml"))
     raise InputError(f"no scene file {name!r}; shipped: {', '.join(shipped)}")

@@ -39,6 +39,15 @@ class ListOf:
         return f"an array of {inner}"
 
 
+class Names(dict):
+    """In a schema: a table whose keys are names the objects check (a plate's edges:
+    the rectangle's left, right, bottom, top, its keys here, or a mesh file's boundary
+    names), each value checked by the object it builds."""
+
+    def __init__(self, *usual):
+        super().__init__(dict.fromkeys(usual, V))
+
+
 class NumberOrWord:
     """In a schema: a number, or one of ``words`` (a bar's obstacle x: 0, L, "left",
     "right")."""
@@ -112,9 +121,9 @@ BAR_KEYS = {
     "time": TIME_KEYS, "contact": CONTACT, "output": OUTPUT,
 }
 PLATE_KEYS = {
-    "kind": V, "geometry": {"a": N, "b": N}, "section": {"thickness": N},
+    "kind": V, "geometry": {"a": N, "b": N, "mesh": V}, "section": {"thickness": N},
     "material": {"E": N, "rho": N, "nu": N},
-    "edges": {"left": V, "right": V, "bottom": V, "top": V},
+    "edges": Names("left", "right", "bottom", "top"),
     "mesh": {"nx": N, "ny": N, "element": V},
     "obstacles": [{"g1": N, "g2": N, "region": NUMBERS, "points": ListOf(NUMBERS)}],
     "loads": [{"pressure": N, "region": NUMBERS, **TIME}],
@@ -178,6 +187,10 @@ def _check_value(value, sub, path: tuple, sets) -> None:
     if sub is N:
         if not _is_number(value):
             raise _bad_value(path, value, sets, f"a number, {SI}")
+    elif isinstance(sub, Names):
+        if not isinstance(value, dict):
+            raise InputError(f"{key_path(path)} must be a table of names = values "
+                             f"(got {value!r})")
     elif isinstance(sub, NumberOrWord):
         if not _is_number(value) and value not in sub.words:
             words = ", ".join(repr(w) for w in sub.words)

@@ -1,0 +1,141 @@
+"""Plates on a triangle mesh read from a file ([geometry] mesh, docs/plate.md "A mesh
+file"): the built-in rectangle written as a file gives the same plate to round-off; a
+clamped disk (Argyris) against the exact frequency and centre deflection, the error
+shrinking with the mesh; the shipped plate_disk scene; bad input one line, nothing
+written."""
+import meshio
+import numpy as np
+import pytest
+
+from conftest import assert_refused
+from skfem_beam.errors import InputError
+from skfem_beam.plate import (Plate, deflection_at_vertex, load_vector, natural_frequencies,
+                              plate_space, static_deflection)
+from skfem_beam.plate.meshfile import disk, read_plate_mesh, write_msh
+from skfem_beam.plate.model import MeshPlate
+from skfem_beam.plate.space import rectangle_mesh
+from skfem_beam.scenefile import example, load, run_main
+
+SIDES = ("left", "right", "bottom", "top")
+MIXED = {"left": "clamped", "right": "simply_supported", "bottom": "sliding"}
+
+
+def rectangle_file(plate: Plate, path, fmt: str = "gmsh22"):
+    """The built-in rectangle's triangles and edges as a mesh file (gmsh: physical lines
+    named left/right/bottom/top; vtu: the edges as integer line tags 1..4)."""
+    mesh = rectangle_mesh(plate)
+    lines = [mesh.facets[:, mesh.boundaries[k]].T for k in SIDES]
+    tags = [np.full(len(c), i + 1) for i, c in enumerate(lines)]
+    cells = [("triangle", mesh.t.T)] + [("line", c) for c in lines]
+    data = [np.full(mesh.t.shape[1], 9)] + tags
+    points = np.column_stack([mesh.p.T, np.zeros(mesh.p.shape[1])])
+    if fmt == "gmsh22":
+        meshio.write(path, meshio.Mesh(points, cells, cell_data={
+            "gmsh:physical": data, "gmsh:geometrical": data},
+            field_data={k: np.array([i + 1, 1]) for i, k in enumerate(SIDES)}),
+            file_format="gmsh22", binary=False)
+    else:
+        meshio.write(path, meshio.Mesh(points, cells, cell_data={"edge": data}))
+    return path
+
+
+@pytest.mark.parametrize("element", ["morley", "argyris"])
+@pytest.mark.parametrize("fmt", ["gmsh22", "vtu"])
+def test_the_rectangle_as_a_mesh_file_is_the_same_plate(tmp_path, element, fmt):
+    plate = Plate(a=1.3, b=0.7, element=element, nx=6, ny=4, edges=MIXED)
+    path = rectangle_file(plate, tmp_path / f"rect.{'msh' if fmt == 'gmsh22' else fmt}", fmt)
+    names = dict(zip(SIDES, SIDES)) if fmt == "gmsh22" else {k: str(i + 1) for i, k in
+                                                              enumerate(SIDES)}
+    mesh_plate = MeshPlate(read_plate_mesh(path), element=element,
+                           edges={names[k]: v for k, v in MIXED.items()})
+    built, read = plate_space(plate), plate_space(mesh_plate)
+    np.testing.assert_array_equal(built.fixed_dofs, read.fixed_dofs)
+    w_built = natural_frequencies(built, 4)[0]
+    w_read = natural_frequencies(read, 4)[0]
+    assert np.max(np.abs(w_read - w_built) / w_built) <= 1e-12
+    u_built = static_deflection(built, load_vector(built, lambda x, y: 1e3 + 0 * x))
+    u_read = static_deflection(read, load_vector(read, lambda x, y: 1e3 + 0 * x))
+    centre = deflection_at_vertex(built, u_built, 0.65, 0.35)
+    assert abs(deflection_at_vertex(read, u_read, 0.65, 0.35) - centre) <= 1e-12 * abs(centre)
+
+
+CLAMPED_DISK = 10.2158      # ω a² √(ρh/D), the first mode of a clamped disk (Leissa)
+# measured (rings: relative error of λ², of w(0)): 2: 1.35e-2, -2.25e-2; 4: 5.44e-3,
+# -1.00e-2; 8: 1.56e-3, -3.01e-3; 16: 4.13e-4, -8.08e-4 (O(h²): the polygon's area)
+DISK_ERRORS = {2: (1.4e-2, 2.3e-2), 4: (5.5e-3, 1.01e-2), 8: (1.6e-3, 3.1e-3)}
+
+
+def test_clamped_disk_argyris_converges_to_the_exact_plate(tmp_path):
+    radius, q = 0.5, 1e3
+    errors = []
+    for rings, (tol_frequency, tol_deflection) in DISK_ERRORS.items():
+        write_msh(disk(radius, rings), tmp_path / "disk.msh")
+        plate = MeshPlate(read_plate_mesh(tmp_path / "disk.msh"), edges={"rim": "clamped"},
+                          element="argyris")
+        space = plate_space(plate)
+        omega = natural_frequencies(space, 1)[0][0]
+        lam = omega * radius ** 2 * np.sqrt(plate.rho * plate.h / plate.D)
+        u = static_deflection(space, load_vector(space, lambda x, y: q + 0 * x))
+        w0 = deflection_at_vertex(space, u, 0.0, 0.0)
+        exact = q * radius ** 4 / (64 * plate.D)
+        errors.append((abs(lam / CLAMPED_DISK - 1), abs(w0 / exact - 1)))
+        assert errors[-1][0] <= tol_frequency and errors[-1][1] <= tol_deflection, (rings,
+                                                                                     errors)
+    # each halving of h: ratios 2.5, 3.5 (λ²), 2.2, 3.3 (w0): towards 4
+    assert all(a[0] > 2 * b[0] and a[1] > 2 * b[1] for a, b in zip(errors, errors[1:])), \
+        errors
+
+
+def test_shipped_disk_scene_loads_and_its_first_frequency_is_the_disk(tmp_path):
+    scene = load(example("plate_disk"))
+    space = scene.problem.space
+    plate = space.plate
+    assert isinstance(plate, MeshPlate) and plate.element == "argyris"
+    assert plate.boundary_names == ("rim",) and plate.box == (-0.5, 0.5, -0.5, 0.5)
+    lam = natural_frequencies(space, 1)[0][0] * 0.25 * np.sqrt(plate.rho * plate.h / plate.D)
+    assert abs(lam / CLAMPED_DISK - 1) < 3e-3          # measured 2.66e-3 with 6 rings
+    assert scene.problem.system.C.shape[0] > 0 and scene.problem.probes[0] == (0.0, 0.0)
+
+
+DISK = example("plate_disk").read_text()
+
+
+@pytest.mark.parametrize("old, new, word", [
+    ('rim = "clamped"', 'edge = "clamped"', "rim"),         # the names the mesh has
+    ('rim = "clamped"', 'rim = "glued"', "glued"),
+    ('element = "argyris"', 'element = "bfs"', "bfs"),
+    ('element = "argyris"', 'element = "argyris"\nnx = 4', "nx"),
+    ('mesh = "plate_disk.msh"', 'mesh = "garbage.msh"', "garbage.msh"),
+    ('mesh = "plate_disk.msh"', 'mesh = "missing.msh"', "missing.msh"),
+    ('mesh = "plate_disk.msh"', 'mesh = "plate_disk.msh"\na = 1.0', "not both"),
+    ("region = [-0.2, -0.2, 0.2, 0.2]", "region = [-0.2, -0.2, 0.6, 0.2]", "off the plate"),
+    ("probes = [[0.0, 0.0], [0.25, 0.0]]", "probes = [[0.0, 0.7]]", "off the plate"),
+    ("probes = [[0.0, 0.0], [0.25, 0.0]]", "probes = [[0.01, 0.0]]", "not a vertex"),
+])
+def test_bad_mesh_plate_scene_one_line_nothing_written(tmp_path, capsys, old, new, word):
+    assert old in DISK
+    src = tmp_path / "src"
+    src.mkdir()
+    (src / "plate_disk.msh").write_bytes(example("plate_disk").with_suffix(".msh").read_bytes())
+    (src / "garbage.msh").write_text("not a mesh\n")
+    (src / "disk.toml").write_text(DISK.replace(old, new))
+    out = tmp_path / "out"
+    out.mkdir()
+    assert_refused(run_main, [str(src / "disk.toml"), "--out", str(out / "run")], word,
+                   capsys, out)
+
+
+def test_an_unknown_boundary_lists_the_mesh_names(tmp_path):
+    write_msh(disk(1.0, 2), tmp_path / "d.msh")
+    with pytest.raises(InputError) as refused:
+        MeshPlate(read_plate_mesh(tmp_path / "d.msh"), edges={"left": "clamped"})
+    assert "'left'" in str(refused.value) and "rim" in str(refused.value)
+
+
+def test_a_rectangle_edge_name_is_still_refused_by_name(tmp_path, capsys):
+    text = example("plate_on_stops").read_text().replace('left = "clamped"', 'rim = "clamped"')
+    (tmp_path / "p.toml").write_text(text)
+    out = tmp_path / "out"
+    out.mkdir()
+    assert_refused(run_main, [str(tmp_path / "p.toml"), "--out", str(out / "run")],
+                   "left, right, bottom, top", capsys, out)

@@ -142,10 +142,9 @@ def _shipped(name: str) -> Path | None:
 
 def example(name: str) -> Path:
     """The path of a shipped scene file (``skfem_beam/scene_files/NAME.toml``, a plate's
-    in ``skfem_beam/scene_files/plates/NAME.toml``, a plate's on a mesh file beside its
-    mesh in ``skfem_beam/scene_files/plates/mesh/NAME.toml``)."""
+    in ``skfem_beam/scene_files/plates/NAME.toml``, beside its mesh file if it has one)."""
     folder = Path(__file__).resolve().parents[1] / "scene_files"
-    places = (".", "plates", "plates/mesh")
+    places = (".", "plates")
     for place in places:
         p = folder / place / f"{Path(name).stem}.toml"
         if p.is_file():

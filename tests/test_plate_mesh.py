@@ -2,7 +2,8 @@
 file"): the built-in rectangle written as a file gives the same plate to round-off; a
 clamped disk (Argyris) against the exact frequency and centre deflection, the error
 shrinking with the mesh; the shipped plate_disk scene; bad input one line, nothing
-written."""
+written; --resume builds the plate from the mesh file's bytes the run stored (the
+scene's copy moved or changed), a changed file refused in one line."""
 import meshio
 import numpy as np
 import pytest
@@ -139,3 +140,152 @@ def test_a_rectangle_edge_name_is_still_refused_by_name(tmp_path, capsys):
     out.mkdir()
     assert_refused(run_main, [str(tmp_path / "p.toml"), "--out", str(out / "run")],
                    "left, right, bottom, top", capsys, out)
+
+
+# --resume and the mesh file: the run stores its bytes (summary.json config
+# scene_meshes: path as written → sha256, base64) and a resume builds from them.
+SHORT, LONG = "0.002", "0.004"
+
+
+def _disk_scene(folder):
+    """The shipped plate_disk scene and its mesh copied into ``folder``."""
+    folder.mkdir()
+    shipped = example("plate_disk")
+    (folder / "plate_disk.toml").write_text(shipped.read_text())
+    (folder / "plate_disk.msh").write_bytes(shipped.with_suffix(".msh").read_bytes())
+    return folder / "plate_disk.toml"
+
+
+@pytest.fixture(scope="module")
+def disk_runs(tmp_path_factory):
+    """The disk scene run to SHORT (to be resumed) and to LONG (never stopped)."""
+    from conftest import exit_code
+    base = tmp_path_factory.mktemp("disk_runs")
+    scene = _disk_scene(base / "src")
+    short, whole = base / "short", base / "whole"
+    assert exit_code(run_main, [str(scene), "--set", f"time.T={SHORT}", "--out",
+                                str(short)]) == 0
+    assert exit_code(run_main, [str(scene), "--set", f"time.T={LONG}", "--out",
+                                str(whole)]) == 0
+    return short, whole
+
+
+def _copy_run(short, tmp_path):
+    """The short run's folder and its scene copied (the scene where the run names it)."""
+    import shutil
+    scene = _disk_scene(tmp_path / "src")
+    run = tmp_path / "run"
+    shutil.copytree(short, run)
+    _edit_config(run, lambda c: c.update(scene=str(scene), out=str(run)))
+    return scene, run
+
+
+def _edit_config(run, edit):
+    """``edit`` the stored config in summary.json and in the checkpoint (as a folder an
+    older version wrote, or one whose stored copy was lost)."""
+    import json
+    from skfem_beam.output.checkpoint import read_checkpoint, write_checkpoint
+    summary = json.loads((run / "summary.json").read_text())
+    edit(summary["config"])
+    (run / "summary.json").write_text(json.dumps(summary))
+    ck = read_checkpoint(run)
+    config = ck.pop("config")
+    edit(config)
+    write_checkpoint(run / "checkpoint.npz", {k: v for k, v in ck.items()
+                                              if k not in ("sha256", "format")}, config)
+
+
+def _same_as_whole(run, whole):
+    for name in ("timeseries.csv", "impacts.csv"):
+        assert (run / name).read_bytes() == (whole / name).read_bytes(), name
+
+
+def test_resume_builds_the_plate_from_the_stored_mesh_not_the_scene_folder(
+        disk_runs, tmp_path, capsys):
+    import base64
+    import hashlib
+    import json
+    from conftest import exit_code
+    short, whole = disk_runs
+    scene, run = _copy_run(short, tmp_path)
+    shipped = example("plate_disk").with_suffix(".msh").read_bytes()
+    stored = json.loads((run / "summary.json").read_text())["config"]["scene_meshes"]
+    assert list(stored) == ["plate_disk.msh"]
+    assert base64.b64decode(stored["plate_disk.msh"]["base64"]) == shipped
+    assert stored["plate_disk.msh"]["sha256"] == hashlib.sha256(shipped).hexdigest()
+    (scene.parent / "plate_disk.msh").rename(tmp_path / "moved.msh")    # moved away
+    capsys.readouterr()
+    assert exit_code(run_main, ["--resume", str(run), "--T", LONG]) == 0
+    assert "notice" not in capsys.readouterr().err
+    _same_as_whole(run, whole)
+    # the extended run stores the copy again: it resumes without the scene's folder too
+    config = json.loads((run / "summary.json").read_text())["config"]
+    assert config["scene_meshes"] == stored and config["T"] == float(LONG)
+
+
+def test_a_folder_without_the_stored_mesh_reads_the_scene_folder_with_a_notice(
+        disk_runs, tmp_path, capsys):
+    from conftest import exit_code
+    short, whole = disk_runs
+    scene, run = _copy_run(short, tmp_path)
+    _edit_config(run, lambda c: c.pop("scene_meshes"))        # as written before
+    capsys.readouterr()
+    assert exit_code(run_main, ["--resume", str(run), "--T", LONG]) == 0
+    notices = [line for line in capsys.readouterr().err.splitlines() if "notice" in line]
+    assert len(notices) == 1 and "plate_disk.msh" in notices[0], notices
+    _same_as_whole(run, whole)
+
+
+def _one_line_refusal(run, capsys, words):
+    from conftest import exit_code
+    before = {p.name: p.read_bytes() for p in run.iterdir() if p.is_file()}
+    capsys.readouterr()
+    assert exit_code(run_main, ["--resume", str(run), "--T", LONG]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and all(w in err for w in words), err
+    assert {p.name: p.read_bytes() for p in run.iterdir() if p.is_file()} == before
+
+
+def test_a_changed_mesh_file_is_refused_in_one_line(disk_runs, tmp_path, capsys):
+    """The stored copy lost (its sha256 kept) and the scene's mesh file changed: refused,
+    naming the file; the run's folder unchanged."""
+    short, _ = disk_runs
+    scene, run = _copy_run(short, tmp_path)
+    _edit_config(run, lambda c: c["scene_meshes"]["plate_disk.msh"].pop("base64"))
+    mesh = scene.parent / "plate_disk.msh"
+    mesh.write_text(mesh.read_text().replace("2 8.3333333333333329e-02", "2 8.4e-02", 1))
+    _one_line_refusal(run, capsys, [str(mesh), "differs", "sha256"])
+
+
+def test_an_older_folder_with_another_mesh_is_refused_in_one_line(disk_runs, tmp_path,
+                                                                   capsys):
+    """No sha256 recorded (a folder written before): the summary's vertices, triangles
+    and box are what the mesh is checked against."""
+    short, _ = disk_runs
+    scene, run = _copy_run(short, tmp_path)
+    _edit_config(run, lambda c: c.pop("scene_meshes"))
+    write_msh(disk(0.5, 4), scene.parent / "plate_disk.msh")
+    _one_line_refusal(run, capsys, ["plate_disk.msh", "vertices"])
+
+
+def test_a_binary_mesh_file_is_stored_and_read_back_exactly(tmp_path):
+    """A binary gmsh file's bytes round-trip through the stored copy (base64): the scene
+    built from the copy, the file gone, is the same plate."""
+    m = disk(0.5, 3)
+    points = np.column_stack([m.points.T, np.zeros(m.points.shape[1])])
+    tags = [np.full(m.triangles.shape[1], 2), np.full(m.boundaries["rim"].shape[1], 1)]
+    meshio.write(tmp_path / "bin.msh", meshio.Mesh(
+        points, [("triangle", m.triangles.T), ("line", m.boundaries["rim"].T)],
+        cell_data={"gmsh:physical": tags, "gmsh:geometrical": tags},
+        field_data={"rim": np.array([1, 1]), "plate": np.array([2, 2])}),
+        file_format="gmsh22", binary=True)
+    raw = (tmp_path / "bin.msh").read_bytes()
+    assert b"\0" in raw                                     # binary indeed
+    (tmp_path / "s.toml").write_text(DISK.replace("plate_disk.msh", "bin.msh"))
+    first = load(tmp_path / "s.toml", dynamic=False)
+    (tmp_path / "bin.msh").unlink()
+    again = load(tmp_path / "s.toml", dynamic=False, meshes=first.meshes)
+    assert again.meshes == first.meshes
+    a, b = first.problem.space.plate.mesh, again.problem.space.plate.mesh
+    assert np.array_equal(a.points, b.points) and np.array_equal(a.triangles, b.triangles)
+    assert a.source == b.source == "bin.msh"

@@ -65,19 +65,20 @@ class Scene:
 
 
 def load(path, overrides=(), files: dict | None = None, text: str | None = None,
-         dynamic: bool = True) -> Scene:
+         dynamic: bool = True, meshes: dict | None = None) -> Scene:
     """Read the scene file ``path`` (``overrides``: ``KEY=VALUE`` strings as ``--set``).
-    ``text``/``files``: the file's and its tables' stored texts (a resumed run) instead of
-    the file system.  ``dynamic=False``: the structure alone (natural frequencies need
-    no [time], [contact] or [output]: they are not read, and ``stepping`` is None)."""
-    return build(read(path, overrides, files, text), dynamic)
+    ``text``/``files``/``meshes``: the file's and its tables' stored texts and its mesh
+    files' stored bytes (a resumed run) instead of the file system.  ``dynamic=False``:
+    the structure alone (natural frequencies need no [time], [contact] or [output]: they
+    are not read, and ``stepping`` is None)."""
+    return build(read(path, overrides, files, text, meshes), dynamic)
 
 
 def build(parsed: Parsed, dynamic: bool = True) -> Scene:
     """The scene :func:`~skfem_beam.scenefile.read.read` parsed as the API's objects
     (``dynamic``: as :func:`load`); every error line names the file."""
     path = parsed.path
-    tables = Tables(path.parent, parsed.files)
+    tables = Tables(path.parent, parsed.files, parsed.meshes)
     try:    # every error line names the file
         with tempfile.TemporaryDirectory() as tmp:
             tables.tmp = Path(tmp)

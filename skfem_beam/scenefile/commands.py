@@ -15,6 +15,7 @@ from ..output.options import OutputOptions
 from ..problem import BeamProblem
 from ..spec import RunSpec
 from .build import Scene, load, wear
+from .read import scene_path
 
 
 def _run_parser() -> argparse.ArgumentParser:
@@ -62,15 +63,42 @@ def run_main(argv) -> int:
 def _scene_of(path, sets, resume) -> Scene:
     """The scene file (or, resuming, the text the run stored) with the --set overrides."""
     from ..output.checkpoint import read_summary
-    stored = {}
+    stored, summary = {}, {}
     if resume:
-        config = read_summary(Path(resume))["config"]
+        summary = read_summary(Path(resume))
+        config = summary["config"]
         if "scene_text" not in config:
             raise InputError(f"--resume {resume}: not a run of python -m skfem_beam run")
-        stored = {"text": config["scene_text"], "files": config.get("scene_files", {})}
+        stored = {"text": config["scene_text"], "files": config.get("scene_files", {}),
+                  "meshes": config.get("scene_meshes", {})}
     elif path is None:
         raise InputError("run needs a scene file: python -m skfem_beam run SCENE.toml")
-    return load(path or "scene.toml", sets or (), **stored)
+    scene = load(path or "scene.toml", sets or (), **stored)
+    if resume and scene.kind == "plate":
+        _same_mesh(scene, summary, resume)
+        for name in scene.meshes:       # read from the scene's folder: no stored copy
+            if "base64" not in stored["meshes"].get(name, {}):
+                where = scene_path(path or "scene.toml").parent / name
+                print(f"notice: --resume {resume}: the run stored no copy of the mesh file "
+                      f"{name}; read {where} (its sha256 is stored from now on)",
+                      file=sys.stderr)
+    return scene
+
+
+def _same_mesh(scene, summary: dict, resume) -> None:
+    """A resumed plate's mesh is the run's: its vertices, triangles and box as its
+    summary.json records them (a folder written before the mesh file's bytes were stored
+    has no sha256: this is what it can be checked against)."""
+    from ..cases.plate import geometry
+    built = geometry(scene.problem.space.plate)
+    if "mesh" not in built or "vertices" not in summary:
+        return
+    differ = [k for k in ("vertices", "triangles", "box") if summary.get(k) != built[k]]
+    if differ:
+        k = differ[0]
+        raise InputError(f"--resume {resume}: the mesh file {built['mesh']} has {k}="
+                         f"{built[k]}, the run's had {summary.get(k)}: not the mesh the run "
+                         "used; cannot resume, nothing was changed")
 
 
 def _grid(scene, flags: dict, resume) -> tuple[OutputOptions, object]:
@@ -118,6 +146,8 @@ def _plate_spec(scene, flags: dict, resume) -> RunSpec:
     config = {"command": "python -m skfem_beam run", "scene_text": scene.text,
               "scene_files": scene.files, **flags, "probe": None, "dt": stepping.dt,
               "beta": stepping.beta, "law": scene.method.name}
+    if scene.meshes:    # a mesh file's bytes: --resume builds the plate from them
+        config["scene_meshes"] = scene.meshes
     return RunSpec(stepping, scene.method, options, config)
 
 

@@ -42,7 +42,8 @@ class PlateScene:
     """A plate scene file read into the plate's objects (as :class:`.build.Scene` for a
     beam): ``problem`` a :class:`PlateSetup`, ``method`` the run's method, ``stepping``
     the time grid, ``output`` the [output] keys with their defaults, ``text``/``files``/
-    ``data`` as a beam scene's."""
+    ``data`` as a beam scene's; ``meshes`` the mesh file's bytes ([geometry] mesh: path
+    as written → {"sha256", "base64"}, :meth:`.read.Tables.mesh`), stored with the run."""
     kind: str
     problem: PlateSetup
     stepping: Stepping | None
@@ -51,11 +52,13 @@ class PlateScene:
     text: str = ""
     files: dict = field(default_factory=dict)
     data: dict = field(default_factory=dict)
+    meshes: dict = field(default_factory=dict)
 
 
 def plate_of(data: dict, base=None):
     """[geometry] a, b (a rectangle) or mesh (a file meshio reads, relative to ``base``:
-    the scene file's folder), [section] thickness, [material] E, rho, nu, [edges],
+    the scene file's folder, or its :class:`~.read.Tables`, which keep the file's bytes and
+    give a resumed run its stored copy), [section] thickness, [material] E, rho, nu, [edges],
     [mesh]."""
     g = data.get("geometry", {})
     if "mesh" in g:
@@ -111,7 +114,10 @@ def _mesh_plate(data: dict, base) -> MeshPlate:
         raise InputError("[mesh] nx, ny are the rectangle's grid; a mesh file's plate has "
                          "its own triangles")
     h, m = _section_material(data)
-    path = Path(name) if Path(name).is_absolute() or base is None else Path(base) / name
+    if isinstance(base, Tables):
+        path = base.mesh(name)
+    else:
+        path = Path(name) if Path(name).is_absolute() or base is None else Path(base) / name
     mesh = read_plate_mesh(path, name)
     edges = data.get("edges", {})
     for edge, support in edges.items():
@@ -252,10 +258,10 @@ def plate_scene(parsed: Parsed, tables: Tables, dynamic: bool = True) -> PlateSc
     from ..plate.space import plate_space
     from ..plate.system import plate_system
     data = parsed.data
-    space = plate_space(plate_of(data, tables.base))
+    space = plate_space(plate_of(data, tables))
     if not dynamic:
         return PlateScene("plate", PlateSetup(space), None, text=parsed.text,
-                          files=tables.read, data=data)
+                          files=tables.read, data=data, meshes=tables.meshes)
     t = data.get("time", {})
     if "dt" not in t or "T" not in t:
         raise InputError("[time] needs dt and T (s)")
@@ -267,4 +273,4 @@ def plate_scene(parsed: Parsed, tables: Tables, dynamic: bool = True) -> PlateSc
     stepping = Stepping(t["dt"], t["T"], t.get("beta", method.default_beta),
                         out["save_every"], out["frames"])
     return PlateScene("plate", PlateSetup(space, system, probes), stepping, method, out,
-                      parsed.text, tables.read, data)
+                      parsed.text, tables.read, data, tables.meshes)

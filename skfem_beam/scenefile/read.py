@@ -4,6 +4,8 @@ builders read; nothing after :func:`read` opens the file again); the tables it n
 (:class:`Tables`); the shipped scene files (:func:`example`)."""
 from __future__ import annotations
 
+import base64
+import hashlib
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -17,21 +19,24 @@ class Parsed:
     """A scene file as read: ``path`` (relative tables are relative to its folder),
     ``text`` (the file as read), ``data`` (the parsed TOML with the overrides), ``kind``
     ("beam" or "bar") and ``files`` (the stored texts of its tables, path as written →
-    text: a resumed run's, else empty)."""
+    text: a resumed run's, else empty); ``meshes`` a resumed run's stored mesh files
+    (path as written → {"sha256", "base64"}: :meth:`Tables.mesh`), None when not
+    resuming."""
     path: Path
     text: str
     data: dict
     kind: str
     files: dict
+    meshes: dict | None = None
 
 
-def read(path, overrides=(), files: dict | None = None, text: str | None = None) -> Parsed:
+def read(path, overrides=(), files: dict | None = None, text: str | None = None,
+         meshes: dict | None = None) -> Parsed:
     """Read the scene file ``path`` once (or take its stored ``text``), parse it, apply
     ``overrides`` (``KEY=VALUE`` strings as ``--set``) and check its keys and the values
-    the schema marks (every such error line names the file)."""
-    path = Path(path)
-    if text is None and not path.exists() and path.parent == Path("."):
-        path = _shipped(path.name) or path      # `run point_stops.toml` from any folder
+    the schema marks (every such error line names the file).  ``meshes``: a resumed
+    run's stored mesh files (None: not a resume)."""
+    path = scene_path(path)
     if text is None:
         try:
             text = path.read_text(encoding="utf-8")
@@ -54,7 +59,17 @@ def read(path, overrides=(), files: dict | None = None, text: str | None = None)
         check_keys(data, KINDS[kind], sets=sets)
     except InputError as e:
         raise InputError(f"{path.name}: {e}") from None
-    return Parsed(path, text, data, kind, dict(files or {}))
+    return Parsed(path, text, data, kind, dict(files or {}),
+                  None if meshes is None else dict(meshes))
+
+
+def scene_path(path) -> Path:
+    """The scene file ``path``, or the shipped one of its name (``run point_stops.toml``
+    from any folder; a resumed run's too, whose relative files are beside it)."""
+    path = Path(path)
+    if not path.exists() and path.parent == Path("."):
+        return _shipped(path.name) or path
+    return path
 
 
 def _toml_value(text: str):
@@ -111,10 +126,47 @@ def apply_set(data: dict, assignment: str) -> tuple[str, str]:
 
 class Tables:
     """Files named in the scene, relative to it; their texts are kept (``read``) so that a
-    run stores them, and a resumed run reads the stored texts (``stored``)."""
+    run stores them, and a resumed run reads the stored texts (``stored``).  A mesh file
+    (:meth:`mesh`, binary or text) is kept as its bytes: ``meshes``, path as written →
+    {"sha256", "base64"}; ``resumed``: a resumed run's stored ones (None: not a resume)."""
 
-    def __init__(self, base: Path, stored: dict):
+    def __init__(self, base: Path, stored: dict, resumed: dict | None = None):
         self.base, self.stored, self.read, self.tmp = base, stored, {}, None
+        self.resumed, self.meshes = resumed, {}
+
+    def mesh(self, name: str) -> Path:
+        """The path of the mesh file ``name`` to read, its bytes kept in ``meshes``.  A
+        resumed run builds from its stored copy (written to ``tmp`` under its own name,
+        for the extension), never from the scene's folder; a run that stored none (a
+        folder written before mesh files were stored) reads the scene's folder's file
+        (the run command says so), refused in one line if the run recorded another
+        sha256."""
+        given = (self.resumed or {}).get(name) or {}
+        if "base64" in given:
+            data = base64.b64decode(given["base64"])
+            digest = hashlib.sha256(data).hexdigest()
+            if given.get("sha256", digest) != digest:
+                raise InputError(f"the stored copy of the mesh file {name} does not match "
+                                 "its sha256 in the run's summary.json; cannot resume, "
+                                 "nothing was changed")
+            p = self.tmp / "meshes" / str(len(self.meshes)) / Path(name).name
+            p.parent.mkdir(parents=True)
+            p.write_bytes(data)
+        else:
+            p = Path(name) if Path(name).is_absolute() else self.base / name
+            try:
+                data = p.read_bytes()
+            except OSError:
+                return p    # the reader names the file and why (read_plate_mesh)
+            digest = hashlib.sha256(data).hexdigest()
+            if given.get("sha256", digest) != digest:
+                raise InputError(f"the mesh file {p} differs from the one the run used "
+                                 f"(sha256 {digest[:12]}…, recorded "
+                                 f"{given['sha256'][:12]}…); cannot resume, nothing was "
+                                 "changed")
+        self.meshes[name] = {"sha256": digest,
+                             "base64": base64.b64encode(data).decode("ascii")}
+        return p
 
     def path(self, name) -> Path:
         if not isinstance(name, str):

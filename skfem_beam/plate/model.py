@@ -13,8 +13,49 @@ def all_simply_supported() -> dict[str, str]:
     return {edge: "simply_supported" for edge in EDGES}
 
 
+class _Plate:
+    """What every plate derives from its material, its edges and its bounding ``box``."""
+
+    def _check_section(self) -> None:
+        if not -1.0 < self.nu < 0.5:
+            raise InputError(f"plate nu={self.nu!r} must lie in (-1, 0.5)")
+        if not self.h > 0:
+            raise InputError(f"plate thickness h={self.h!r} must be > 0")
+
+    @property
+    def size(self) -> float:
+        """The longer side of the bounding box (m): the scale of geometric tolerances."""
+        x0, x1, y0, y1 = self.box
+        return max(x1 - x0, y1 - y0)
+
+    @property
+    def centre(self) -> tuple[float, float]:
+        x0, x1, y0, y1 = self.box
+        return ((x0 + x1) / 2, (y0 + y1) / 2)
+
+    @property
+    def D(self) -> float:
+        """The bending stiffness E h³ / (12 (1 − ν²)), N·m."""
+        return self.E * self.h ** 3 / (12.0 * (1.0 - self.nu ** 2))
+
+    def support(self, edge: str) -> str:
+        return self.edges.get(edge, "free")
+
+
+def _check_supports(edges: dict, names, whose: str = "") -> None:
+    """Each edge a name of ``names`` (``whose``: " the boundaries of ..." in the error
+    line) with a support of SUPPORTS."""
+    for edge, support in edges.items():
+        if edge not in names:
+            raise InputError(f"plate edge {edge!r} is not one of{whose}: "
+                             f"{', '.join(names) or '(none)'}")
+        if support not in SUPPORTS:
+            raise InputError(f"plate edge {edge}: support {support!r} is not one of: "
+                             f"{', '.join(SUPPORTS)}")
+
+
 @dataclass
-class Plate:
+class Plate(_Plate):
     """A rectangular Kirchhoff–Love plate [0, a] × [0, b] (SI units).
 
     ``edges`` maps an edge (left x=0, right x=a, bottom y=0, top y=b) to its support;
@@ -34,18 +75,10 @@ class Plate:
     ny: int = 8
 
     def __post_init__(self):
-        if not -1.0 < self.nu < 0.5:
-            raise InputError(f"plate nu={self.nu!r} must lie in (-1, 0.5)")
-        if not self.h > 0:
-            raise InputError(f"plate thickness h={self.h!r} must be > 0")
+        self._check_section()
         if not (self.a > 0 and self.b > 0):
             raise InputError(f"plate sides a={self.a!r}, b={self.b!r} must be > 0")
-        for edge, support in self.edges.items():
-            if edge not in EDGES:
-                raise InputError(f"plate edge {edge!r} is not one of: {', '.join(EDGES)}")
-            if support not in SUPPORTS:
-                raise InputError(f"plate edge {edge}: support {support!r} is not one of: "
-                                 f"{', '.join(SUPPORTS)}")
+        _check_supports(self.edges, EDGES)
         if self.element not in ELEMENTS:
             raise InputError(f"plate element {self.element!r} is not one of: "
                              f"{', '.join(ELEMENTS)}")
@@ -61,40 +94,13 @@ class Plate:
         """(x0, x1, y0, y1): the rectangle."""
         return (0.0, self.a, 0.0, self.b)
 
-    @property
-    def size(self) -> float:
-        """The longer side (m): the scale of the geometric tolerances."""
-        return max(self.a, self.b)
-
-    @property
-    def centre(self) -> tuple[float, float]:
-        return (self.a / 2, self.b / 2)
-
     def outline(self) -> str:
         """The plate, as the error lines name it."""
         return f"the plate [0, {self.a:g}] × [0, {self.b:g}]"
 
-    @property
-    def D(self) -> float:
-        """The bending stiffness E h³ / (12 (1 − ν²)), N·m."""
-        return self.E * self.h ** 3 / (12.0 * (1.0 - self.nu ** 2))
-
-    def support(self, edge: str) -> str:
-        return self.edges.get(edge, "free")
-
-
-def _check_supports(edges: dict, names, what: str) -> None:
-    for edge, support in edges.items():
-        if edge not in names:
-            raise InputError(f"plate edge {edge!r} is not one of {what}: "
-                             f"{', '.join(names) or '(none)'}")
-        if support not in SUPPORTS:
-            raise InputError(f"plate edge {edge}: support {support!r} is not one of: "
-                             f"{', '.join(SUPPORTS)}")
-
 
 @dataclass(eq=False)
-class MeshPlate:
+class MeshPlate(_Plate):
     """A Kirchhoff–Love plate on a triangle mesh (any outline) read from a file
     (:func:`skfem_beam.plate.meshfile.read_plate_mesh`), SI units.
 
@@ -111,17 +117,14 @@ class MeshPlate:
     element: str = "argyris"
 
     def __post_init__(self):
-        if not -1.0 < self.nu < 0.5:
-            raise InputError(f"plate nu={self.nu!r} must lie in (-1, 0.5)")
-        if not self.h > 0:
-            raise InputError(f"plate thickness h={self.h!r} must be > 0")
+        self._check_section()
         if self.element == "bfs":
             raise InputError("plate element 'bfs' needs the rectangle's grid ([geometry] a, "
                              "b); a mesh file's plate takes morley or argyris")
         if self.element not in ELEMENTS:
             raise InputError(f"plate element {self.element!r} is not one of: morley, argyris")
         _check_supports(self.edges, self.boundary_names,
-                        f"the boundaries of the mesh {self.mesh.source}")
+                        f" the boundaries of the mesh {self.mesh.source}")
 
     @property
     def boundary_names(self) -> tuple[str, ...]:
@@ -145,22 +148,6 @@ class MeshPlate:
         _, _, y0, y1 = self.box
         return y1 - y0
 
-    @property
-    def size(self) -> float:
-        return max(self.a, self.b)
-
-    @property
-    def centre(self) -> tuple[float, float]:
-        x0, x1, y0, y1 = self.box
-        return ((x0 + x1) / 2, (y0 + y1) / 2)
-
     def outline(self) -> str:
         x0, x1, y0, y1 = self.box
         return f"the plate (its mesh's bounding box [{x0:g}, {x1:g}] × [{y0:g}, {y1:g}])"
-
-    @property
-    def D(self) -> float:
-        return self.E * self.h ** 3 / (12.0 * (1.0 - self.nu ** 2))
-
-    def support(self, edge: str) -> str:
-        return self.edges.get(edge, "free")

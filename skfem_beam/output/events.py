@@ -143,6 +143,11 @@ def spring_supports(table: dict, obstacles, stiffness, damping) -> list[dict]:
     return out
 
 
+# peak_force's unit under exact contact
+RIGID_PEAK = ("; rigid (exact) contact: the largest one-step force, which grows as dt "
+              "shrinks: quote the impulse")
+
+
 def write_impacts(folder: Path, run, units: dict, scale: float = 1.0, sign: float = 1.0,
                   obstacles=None, last: int | None = None, wear=None) -> dict:
     """Write ``folder/impacts.csv`` from ``run`` (a :class:`~skfem_beam.scheme.Run`) and
@@ -190,9 +195,8 @@ def _write_impacts(folder, run, units, scale, sign, obstacles, last, wear) -> di
     duration = max(0, last - 1) * run.dt
     stats = impact_statistics(table, duration, obstacles)
     f, i = units["force"], units["impulse"]
-    if run.solver != "penalty":     # exact contact: the force of one step, impulse/Δt
-        f += ("; rigid (exact) contact: the largest one-step force, which grows as dt "
-              "shrinks: quote the impulse, or give the supports a stiffness")
+    if not run.springs:     # exact contact: the force of one step, impulse/Δt
+        f += RIGID_PEAK + ", or give the supports a stiffness"
     stats["units"] = {"t_start": "s", "t_end": "s", "x": "m", "bound": "1 = g1 (lower), "
                       "2 = g2 (upper)", "velocity": "m/s", "peak_force": f, "impulse": i,
                       "max_violation": "m", "open": "1 = not over at the last state",

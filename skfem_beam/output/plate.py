@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from .events import COLUMNS, IMPACTS, impact_table
+from .events import COLUMNS, IMPACTS, RIGID_PEAK, impact_table
 from .fields import FieldWriter, check_format
 from .folder import atomic_write, csv_rows
 from .supports import union_length
@@ -221,9 +221,8 @@ def plate_impacts(folder: Path, run, last: int | None = None) -> dict:
     duration = max(0, last - 1) * run.dt       # states 1..n, as the run's contact_fraction
     touched = np.unique(table["value"])
     units = dict(IMPACT_UNITS)
-    if run.solver != "penalty":
-        units["peak_force"] += ("; rigid (exact) contact: the largest one-step force, "
-                                "which grows as dt shrinks: quote the impulse")
+    if not run.springs:
+        units["peak_force"] += RIGID_PEAK
     everything = np.arange(table["x"].size)
     stats = {"impacts": int(table["x"].size), "vertices_touched": int(touched.size),
              "total_impulse": float(np.sum(table["impulse"])),

@@ -52,6 +52,9 @@ def parser(prog: str, description: str, *, J=None, dt=None, T=None, beta=None,
         p.add_argument("--element", default="hermite", help="hermite | bspline")
     if solver:
         p.add_argument("--solver", default="auto", help=" | ".join(SOLVERS))
+        p.add_argument("--param", action="append", default=None, metavar="NAME=VALUE",
+                       help="repeatable: a parameter of the --solver's law (its table: "
+                            "docs/design.md, 'Adding a contact law')")
     p.add_argument("--law", default=None, help=" | ".join(methods.LAWS) + ": exact contact at "
                    "position level (the papers' scheme), at velocity level (Moreau–Jean, "
                    "θ = 1/2), or one-sided springs (default: from --method)")
@@ -118,7 +121,25 @@ def method(args) -> methods.Method:
     --massless)."""
     return methods.make(args.law, getattr(args, "solver", "auto"), args.restitution,
                         args.stiffness if args.law == "penalty" else None,
-                        getattr(args, "massless", None), theta=getattr(args, "theta", None))
+                        getattr(args, "massless", None),
+                        params=law_params(getattr(args, "param", None),
+                                          theta=getattr(args, "theta", None)))
+
+
+def law_params(given, theta: float | None = None) -> dict:
+    """--param NAME=VALUE flags as {NAME: number} (the law checks names and ranges), and
+    --theta (Moreau–Jean's) when given."""
+    out = {} if theta is None else {"theta": theta}
+    for text in given or ():
+        name, eq, value = text.partition("=")
+        try:
+            out[name.strip()] = float(value)
+        except ValueError:
+            eq = None
+        if not eq or not name.strip():
+            raise InputError(f"--param {text!r}: give NAME=VALUE with a number, e.g. "
+                             "--param gain=0.5")
+    return out
 
 
 def spec(args, config: dict | None = None) -> RunSpec:

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 from .checks import check_choice, check_restitution
 from .contact import SOLVERS, resolve
+from .contact.registry import check_params
 from .errors import InputError
 from .scheme.methods import Method, MoreauJean, Penalty, PositionLevel, mass_scale  # noqa: F401
 from .scheme.moreau_jean import NAME as MOREAU_JEAN, check_theta
@@ -30,10 +31,11 @@ class Words:
     law: str = "--law "
     restitution: str = "--restitution "
     theta: str = "--theta "
+    param: str = "--param "
 
 
 FLAGS = Words()
-KEYS = Words("solver=", "massless=", "law=", "restitution=", "theta=")   # the Python API's
+KEYS = Words("solver=", "massless=", "law=", "restitution=", "theta=", "params: ")   # the API's
 
 
 def _name(word: str) -> str:
@@ -42,12 +44,19 @@ def _name(word: str) -> str:
 
 def make(law: str = "position", solver: str = "auto", restitution: float = 0.0,
          stiffness: float | None = None, massless: str | None = None,
-         words: Words = FLAGS, damping: float = 0.0, theta: float | None = None) -> Method:
+         words: Words = FLAGS, damping: float = 0.0, params: dict | None = None) -> Method:
     """The method the words name: ``law`` one of LAWS, ``solver`` the position-level
     QP solver, ``stiffness`` and ``damping`` the penalty springs and their dashpots (N/m,
-    N·s/m, see :class:`Penalty`), ``massless`` the massless rows' stepping, ``theta``
-    Moreau–Jean's θ (None: the defaults)."""
+    N·s/m, see :class:`Penalty`), ``massless`` the massless rows' stepping; ``params``
+    the method's own parameters: ``theta``, Moreau–Jean's θ, and the position-level
+    solver's (its law's table, :func:`skfem_beam.contact.registry.check_params`); None:
+    the defaults."""
     check_choice(_name(words.law), law, LAWS)
+    params = dict(params or {})
+    theta = params.pop("theta", None)
+    if params and law != "position":
+        raise InputError(f"{words.param}{', '.join(params)}: parameters of a position-level "
+                         f"solver; {words.law}{law} takes none")
     e = check_restitution(restitution, words.restitution)
     if theta is not None and law != MOREAU_JEAN:
         raise InputError(f"{words.theta}{theta} is Moreau–Jean's θ ({words.law}{MOREAU_JEAN}); "
@@ -64,7 +73,8 @@ def make(law: str = "position", solver: str = "auto", restitution: float = 0.0,
         resolve("penalty" if solver == "auto" else solver, stiffness, e)
         return Penalty(stiffness, massless=massless or "beta", damping=damping)
     check_choice(_name(words.solver), solver, SOLVERS)
-    return PositionLevel(solver, e, massless or "beta")
+    return PositionLevel(solver, e, massless or "beta",
+                         check_params(solver, params, words.param))
 
 
 def split_law(word: str) -> tuple[str, str]:

@@ -103,9 +103,10 @@ SECTION_DOCS = {
         '(as `--law`); round holes take `auto` (the exact round-hole law) or `penalty` '
         '(radial springs); `stiffness` (N/m, the penalty spring), `restitution` (e in [0, 1],'
         ' position and moreau-jean), `theta` (θ in [1/2, 1] of moreau-jean, default 1/2; '
-        "as `--theta`), `friction` (Coulomb's μ at the holes' walls, two planes: runs "
-        'Moreau–Jean in round holes, `auto` (round-hole-friction) when a polygon or flat '
-        'bars have it)'
+        "as `--theta`), `friction` (Coulomb's μ at the holes' walls, two planes: `auto` "
+        'then runs the exact round-hole-friction law, in round holes and on faces; '
+        '`moreau-jean` as a choice); and the parameters of the law named, from its own table (a '
+        "registered law's, as `--param NAME=VALUE`)"
     ),
     'output': (
         '`format`, `save_every`, `frames`, `flush_every`, `checkpoint_every`, `probes` (x in '

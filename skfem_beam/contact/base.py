@@ -45,6 +45,7 @@ import scipy.sparse as sp
 from numba import cfunc, types
 
 from .. import aside
+from ..errors import InputError
 
 _vec = types.float64[::1]
 LAW_SIGNATURE = types.int64(types.float64[:, ::1], _vec, _vec, _vec, _vec, _vec, _vec,
@@ -103,6 +104,31 @@ def no_explicit(y_cur, y_prev, lo, hi, params, r):
 
 
 @dataclass(frozen=True)
+class Parameter:
+    """A law's parameter, as every front end names it: ``[contact] <name> = value`` in a
+    scene file, ``--param <name>=value`` on the command line, ``PositionLevel(solver,
+    params={name: value})`` from Python.  The law's constructor takes it by ``name``; its
+    value must be a finite number in [``low``, ``high``] (``unit``: as the docs and the
+    error line write it)."""
+    name: str
+    help: str
+    unit: str = ""
+    low: float = -np.inf
+    high: float = np.inf
+
+    def check(self, value, written: str) -> float:
+        """``value`` as a float, or one line naming it (``written``: the key or flag as the
+        user wrote it, e.g. ``[contact] gain = ``) and the range allowed."""
+        ok = isinstance(value, (int, float, np.number)) and not isinstance(value, bool) \
+            and np.isfinite(value) and self.low <= value <= self.high
+        if not ok:
+            unit = f" ({self.unit})" if self.unit else ""
+            raise InputError(f"{written}{value!r}: {self.name}{unit} must be a number in "
+                             f"[{self.low:g}, {self.high:g}]")
+        return float(value)
+
+
+@dataclass(frozen=True)
 class StepData:
     """What a law sees of the scheme, once per run."""
     A: sp.csr_matrix      # the step matrix M + Δt/2 B + Δt²βK
@@ -149,6 +175,7 @@ class ContactLaw:
     friction = False     # takes Coulomb friction (StepData.friction); the others refuse it
     x_space = False      # solves for uⁿ⁺¹ itself (contact.sparse_qp): the scheme builds
     #                      neither W nor D for it
+    parameters: tuple = ()   # its Parameter table: what the front ends let a user set
 
     def setup(self, step: StepData, first: bool = False) -> np.ndarray:
         return np.zeros(0)

@@ -1,13 +1,18 @@
 """The contact laws by name: one line per law, and :func:`register` for a law of the
 user's (then named by ``--solver``, a scene file's ``[contact] law`` and
-``PositionLevel(solver=)`` like the shipped ones, with no edit of the front end)."""
+``PositionLevel(solver=)`` like the shipped ones, with no edit of the front end).
+
+A law's parameters are its own table (``parameters``, :class:`.base.Parameter`): the
+front ends read it here (:func:`parameters_of`, :func:`all_parameters`), so a law with a
+parameter is set from a scene file's ``[contact]``, the command line's ``--param`` and
+``PositionLevel(params=)`` without a word of theirs."""
 from __future__ import annotations
 
 import numpy as np
 
 from ..errors import InputError
 from .active_set import ActiveSet
-from .base import ContactLaw, StepData
+from .base import ContactLaw, Parameter, StepData
 from .daqp_solver import DAQP
 from .osqp_solver import OSQP
 from .penalty import Penalty
@@ -67,11 +72,42 @@ def register(name: str, law) -> None:
     LAWS[name] = law
 
 
+def parameters_of(name) -> tuple[Parameter, ...]:
+    """The parameter table of the law registered as ``name`` (none for a name not in
+    LAWS, or a maker that is not a law class)."""
+    return tuple(getattr(LAWS.get(name), "parameters", ())) if isinstance(name, str) else ()
+
+
+def all_parameters() -> dict[str, Parameter]:
+    """Every registered law's parameters by name (the keys a scene file's [contact] may
+    hold besides its own)."""
+    return {p.name: p for name in LAWS for p in parameters_of(name)}
+
+
+def check_params(name, params: dict, written: str = "--param ") -> dict:
+    """``params`` checked against the table of the law ``name``: one line for a
+    parameter it does not have or a value out of its range (``written``: how the front
+    end writes a parameter, e.g. ``[contact] ``)."""
+    table = {p.name: p for p in parameters_of(name)}
+    for key in params:
+        if key not in table:
+            has = ", ".join(table) if table else "none"
+            raise InputError(f"{written}{key}: not a parameter of the {name!r} law (its "
+                             f"parameters: {has})")
+    return {key: table[key].check(value, f"{written}{key} = ")
+            for key, value in params.items()}
+
+
 def resolve(law: str | ContactLaw = "auto", stiffness: float | None = None,
-            restitution: float = 0.0) -> ContactLaw:
+            restitution: float = 0.0, params: dict | None = None) -> ContactLaw:
     """A law object from a name in LAWS, ``"auto"`` (decided at setup: the cheapest exact
     law for the scene) or a law object of the user's; ``stiffness`` means penalty,
-    ``restitution`` e > 0 the position-level scheme with Newton restitution."""
+    ``restitution`` e > 0 the position-level scheme with Newton restitution; ``params``:
+    values of the named law's parameters (its table)."""
+    if params:
+        made = LAWS[law](**check_params(law, params, "params: ")) \
+            if law in LAWS else check_params(law, params, "params: ")
+        return resolve(made, stiffness, restitution)
     e = Restitution(restitution).e
     if e > 0:
         if law not in ("auto", "restitution") or stiffness is not None:

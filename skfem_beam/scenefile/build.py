@@ -17,13 +17,14 @@ from .bar import bar_problem
 from .beam import beam_problem
 from .parts import need, plane_count
 from .read import Parsed, Tables, read
-from .schema import OUTPUT_DEFAULTS
+from .schema import CONTACT, OUTPUT_DEFAULTS
 
 
 BEAM_MASSES = ("consistent", "redistributed")        # [mesh] mass of a beam
+CONTACT_OWN = tuple(dict(CONTACT.items()))    # [contact]'s own keys; the others: the law's
 SCENE_WORDS = methods.Words(solver="[contact] law = ", massless="[mesh] massless = ",
                             law="[contact] law = ", restitution="[contact] restitution = ",
-                            theta="[contact] theta = ")
+                            theta="[contact] theta = ", param="[contact] ")
 
 
 @dataclass(frozen=True)
@@ -59,9 +60,11 @@ class Scene:
         if law == "penalty" and self.stiffness is None:
             raise InputError("[contact] law='penalty' needs stiffness (N/m)")
         massless = self.data.get("mesh", {}).get("massless")    # as written: None if not
-        theta = self.data.get("contact", {}).get("theta")
+        contact = self.data.get("contact", {})
+        # θ and the solver's parameters (the keys that are not [contact]'s own)
+        params = {k: v for k, v in contact.items() if k == "theta" or k not in CONTACT_OWN}
         return methods.make(law, solver, self.restitution or 0.0, self.stiffness, massless,
-                            words=SCENE_WORDS, damping=self.damping, theta=theta)
+                            words=SCENE_WORDS, damping=self.damping, params=params)
 
 
 def load(path, overrides=(), files: dict | None = None, text: str | None = None,

@@ -20,11 +20,11 @@ from ..scheme import Stepping
 from .forcing import _time_function
 from .parts import need
 from .read import Parsed, Tables
-from .schema import OUTPUT_DEFAULTS
+from .schema import OUTPUT_DEFAULTS, PLATE_KEYS
 
 PLATE_WORDS = methods.Words(solver="[contact] solver = ", massless="[mesh] massless = ",
                             law="[contact] law = ", restitution="[contact] restitution = ",
-                            theta="[contact] theta = ")
+                            theta="[contact] theta = ", param="[contact] ")
 TIME_FORMS = ("amplitude", "omega", "phase", "value", "sines", "table", "random", "psd")
 
 
@@ -248,8 +248,10 @@ def method_of(data: dict) -> methods.Method:
                          "take it")
     if solver != "auto":
         check_choice("[contact] solver", solver, SOLVERS)
+    own = dict(PLATE_KEYS["contact"].items())      # θ and the others: the method's
     return methods.make(law, solver, c.get("restitution", 0.0), c.get("stiffness"),
-                        words=PLATE_WORDS, theta=c.get("theta"))
+                        words=PLATE_WORDS,
+                        params={k: v for k, v in c.items() if k == "theta" or k not in own})
 
 
 def plate_scene(parsed: Parsed, tables: Tables, dynamic: bool = True) -> PlateScene:

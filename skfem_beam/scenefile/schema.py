@@ -82,7 +82,27 @@ OUTPUT = {"format": V, "save_every": N, "frames": N, "flush_every": N, "checkpoi
           "probes": NUMBERS}
 OUTPUT_DEFAULTS = {"format": "both", "save_every": 1, "frames": 200, "flush_every": 20000,
                    "checkpoint_every": None}      # [output] when the file leaves them out
-CONTACT = {"law": V, "stiffness": N, "restitution": N, "friction": N, "theta": N}
+class ContactKeys(dict):
+    """[contact]'s keys: its own, and the parameters of every registered law (numbers;
+    the law's table checks their range, scenefile.build that the law named has them), so
+    that a law of the user's with a parameter needs no edit here."""
+
+    def _all(self) -> dict:
+        from ..contact.registry import all_parameters
+        own = dict(self.items())
+        return {**own, **{k: N for k in all_parameters() if k not in own}}
+
+    def __contains__(self, key) -> bool:
+        return key in self._all()
+
+    def __getitem__(self, key):
+        return self._all()[key]
+
+    def __iter__(self):
+        return iter(self._all())
+
+
+CONTACT = ContactKeys(law=V, stiffness=N, restitution=N, friction=N, theta=N)
 G = NumberOr({"poly": NUMBERS, "about": N, "x": NUMBERS, "g": NUMBERS},   # the rest: obstacles._g
              "{ poly = [...] } or { x = [...], g = [...] }")
 HOLE = {"radius": N, "sides": N, "angle": N, "centre": NUMBERS,     # the rest: holes.py
@@ -129,7 +149,7 @@ PLATE_KEYS = {
     "loads": [{"pressure": N, "region": NUMBERS, **TIME}],
     "initial": {"static_pressure": N, "velocity": N},
     "time": {"dt": N, "T": N, "beta": N},
-    "contact": {"law": V, "solver": V, "stiffness": N, "restitution": N, "theta": N},
+    "contact": ContactKeys(law=V, solver=V, stiffness=N, restitution=N, theta=N),
     "output": {**OUTPUT, "probes": ListOf(NUMBERS)},
 }
 KINDS = {"beam": BEAM_KEYS, "bar": BAR_KEYS, "plate": PLATE_KEYS}

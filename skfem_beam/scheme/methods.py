@@ -55,10 +55,13 @@ def beta_run(system, stepping, law: ContactLaw) -> Run:
 @dataclass(frozen=True)
 class PositionLevel:
     """The β-scheme with exact contact at position level; ``massless``: how the massless
-    rows of a redistributed mass step ("beta" or "quasi-static", see Stepping)."""
+    rows of a redistributed mass step ("beta" or "quasi-static", see Stepping);
+    ``params``: values of the solver's own parameters (its law's ``parameters`` table),
+    a dict or (name, value) pairs."""
     solver: Union[str, ContactLaw] = "auto"
     restitution: float = 0.0
     massless: str = "beta"
+    params: tuple = ()
     name: ClassVar[str] = "position"
     default_beta: ClassVar[float] = 0.5
     theta: ClassVar[None] = None
@@ -66,10 +69,11 @@ class PositionLevel:
     def __post_init__(self):
         object.__setattr__(self, "restitution", check_restitution(self.restitution))
         check_choice("massless", self.massless, MASSLESS)
-        self.law(None)      # the solver's name and its combination with restitution
+        object.__setattr__(self, "params", tuple(dict(self.params).items()))
+        self.law(None)      # the solver's name, its parameters, restitution beside it
 
     def law(self, system) -> ContactLaw:
-        return resolve(self.solver, None, self.restitution)
+        return resolve(self.solver, None, self.restitution, dict(self.params))
 
     def build(self, system, stepping) -> Run:
         return beta_run(system, replace(stepping, massless=self.massless), self.law(system))

@@ -80,12 +80,12 @@ def penetration(run, hole) -> float:
 
 def advance_in_blocks(run, t0: float, blocks: int) -> tuple[list, str]:
     """Step ``run`` to t0 and then to T in ``blocks`` equal blocks; returns the
-    per-row work (State.rowwork copies) at t0 and at each block's end, with their times,
+    per-row work (Run.record's row_work) at t0 and at each block's end, with their times,
     and the status: "success", or why the run stopped (a solver's failure: the window
     then ends with the last whole block, and the row says so)."""
     n0 = int(round(t0 / run.dt))
     run.advance(n0)
-    marks = [(n0 * run.dt, run.st.rowwork.copy())]
+    marks = [(n0 * run.dt, run.record.row_work)]
     ends = np.linspace(n0, run.n_steps, blocks + 1).round().astype(int)[1:]
     for n1 in ends:
         try:
@@ -94,7 +94,7 @@ def advance_in_blocks(run, t0: float, blocks: int) -> tuple[list, str]:
             return marks, f"window cut at t = {marks[-1][0]:g} s: {e}"
         if run.status != "running" and run.status != "success":
             return marks, f"window cut at t = {marks[-1][0]:g} s: {run.message}"
-        marks.append((run.n * run.dt, run.st.rowwork.copy()))
+        marks.append((run.n * run.dt, run.record.row_work))
     return marks, run.status
 
 

@@ -72,7 +72,6 @@ def build(scene: str, p: dict):
 def child(scene: str, p: dict, solver: str, repeat: int) -> dict:
     """Runs in the child process: the timings of one configuration."""
     from .. import methods
-    from ..scheme.kernels import CONTACT_STEPS
     from ..scheme.solve import drive
     from ..scheme.stepping import Stepping
     from ..semidiscrete import beam_system
@@ -88,7 +87,7 @@ def child(scene: str, p: dict, solver: str, repeat: int) -> dict:
         r = run.result()
         if best is None or r.wall_time_s < best.wall_time_s:
             best, repairs = r, getattr(run.pysolver, "repairs", None)
-            contact_steps = int(run.st.counters[CONTACT_STEPS])
+            contact_steps = run.record.contact_steps
     A = system.M + p["dt"] ** 2 * beta * system.K
     floor = banded_solve_floor(A, best.steps)
     return {"solver": best.solver, "steps": best.steps, "wall_time_s": best.wall_time_s,

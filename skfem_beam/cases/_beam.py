@@ -8,7 +8,6 @@ import numpy as np
 
 from .. import cli
 from ..chart_process import draw
-from ..scheme.kernels import CONTACT_STEPS
 from ..output.charts import (energy_chart, orbit_chart, shape_chart, shapes,
                              trajectory_chart, wear_chart)
 from ..output.events import beam_impacts
@@ -114,7 +113,7 @@ def warn_no_contact(run, system) -> None:
     in millimetres written as metres looks exactly like this."""
     lo, hi = np.asarray(system.lo, dtype=float), np.asarray(system.hi, dtype=float)
     gaps = np.abs(np.concatenate([lo[np.isfinite(lo)], hi[np.isfinite(hi)]]))
-    if not gaps.size or run.n < 2 or int(run.st.counters[CONTACT_STEPS]) > 0:
+    if not gaps.size or run.n < 2 or run.record.contact_steps > 0:
         return
     reach = float(np.abs(system.C @ run.result().frames_u.T).max())
     if gaps.min() > 100 * reach:
@@ -164,8 +163,6 @@ def two_plane_columns(view, rho_S):
     """timeseries.csv's columns of saved rows k0..k1 of a two-plane beam run: each of the
     one-plane beam's displacement and force columns per plane (``_v``, ``_w``), the
     orbit of every hole's node (``hole_<x>_displacement_v``, ``_w``), the energy and work."""
-    from ..output.supports import row_planes
-
     def columns(run, k0, k1):
         names = list(run.system.observe)
         t = np.arange(k0, k1) * run.save_every * run.dt
@@ -183,7 +180,7 @@ def two_plane_columns(view, rho_S):
         cols["energy"] = run.energy[k0:k1]
         if "friction" in run.work_terms:     # the friction's Gauss–Seidel at each saved step
             cols["friction_residual"] = run.resid[k0:k1]
-        force = run.lam[k0:k1] @ row_planes(run.ops.pair, run.ops.Nc)   # net, per plane
+        force = run.lam[k0:k1] @ run.record.row_planes   # net, per plane
         for c, suffix in enumerate(PLANE_SUFFIXES):
             cols[f"contact_force{suffix}"] = force[:, c]
             if rho_S:

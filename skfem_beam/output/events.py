@@ -214,12 +214,13 @@ def _write_impacts(folder, run, units, scale, sign, obstacles, last, wear) -> di
                                "friction_impulse": i + ", Σ|p_t| over the contact"})
         from ..scheme.moreau_jean import NSGS_TOL
         coefficients = sorted({float(m) for m in run.system.friction if m > 0})
-        if not hasattr(run.st, "fres"):    # position level: each block exact, no NSGS
+        residual = run.record.friction_residual
+        if residual is None:               # position level: each block exact, no NSGS
             return {"impact_statistics": stats, "friction": {"coefficients": coefficients,
                                                              "law": run.solver}}
         return {"impact_statistics": stats, "friction": {
             "coefficients": coefficients,
-            "nsgs_tolerance": NSGS_TOL, "nsgs_max_residual": float(run.st.fres[1])}}
+            "nsgs_tolerance": NSGS_TOL, "nsgs_max_residual": residual}}
     return {"impact_statistics": stats, "_table": table}
 
 

@@ -273,8 +273,7 @@ def _two_plane_entries(system, view) -> dict:
     """The LineSamples entries of a two-plane system (none for one plane)."""
     if view.planes != 2:
         return {}
-    from ..scheme.beta import hole_arrays
-    from .supports import row_planes
+    from ..scheme.beta import hole_arrays, row_planes
     pair, *_, Nc = hole_arrays(system)
     return {"planes": 2, "direction": view.direction, "k2_w": view.k2_w,
             "row_planes": row_planes(pair, Nc)}

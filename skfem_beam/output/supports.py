@@ -89,18 +89,6 @@ class Wear:
 ANGLE_BINS = SECTORS   # the impact-angle histogram: the wear's 30° sectors, −180° to 180°
 
 
-def row_planes(pair, Nc) -> np.ndarray:
-    """(m, 2): each constrained row's force direction in (v, w) (its face's normal, or a
-    round hole's rows (1, 0) and (0, 1)), so that the net contact force in each plane is
-    λ @ row_planes; ``pair``, ``Nc``: the run's (kernels.Ops)."""
-    m = pair.size
-    out = np.array(Nc[:, 4:6]) if Nc.shape[0] else np.zeros((m, 2))
-    for j in range(m):
-        if pair[j] > 0:
-            out[j], out[pair[j]] = (1.0, 0.0), (0.0, 1.0)
-    return out
-
-
 def union_length(start: np.ndarray, end: np.ndarray) -> float:
     """Total length of the union of the intervals [start, end) (a contact fraction's
     time: per support here, per node and obstacle in output.events)."""
@@ -120,7 +108,8 @@ def support_statistics(table: dict, run, scale: float, duration: float, T: float
     and the work rates over the run's time ``T`` (module docstring), forces times
     ``scale`` (ρS: W); with friction its work rate, with ``wear`` the support's wear."""
     x_rows = np.asarray(run.system.x_contact, dtype=float)
-    work = run.st.rowwork
+    record = run.record
+    work = record.row_work
     T = T if T > 0 else math.nan
     edges = np.linspace(-math.pi, math.pi, ANGLE_BINS + 1)
     out = []
@@ -136,7 +125,7 @@ def support_statistics(table: dict, run, scale: float, duration: float, T: float
             "impact_angle_histogram": {"edges_rad": edges.tolist(), "counts": counts.tolist()},
             "impact_work_rate": -scale * float(work[rows, 0].sum()) / T,
             "normal_work_rate": _normal_work_rate(run, rows, scale, T)}
-        if run.st.fc.shape[0] or "friction" in run.work_terms:
+        if record.friction_tallied:
             entry["friction_work_rate"] = -scale * float(work[rows, 2].sum()) / T
         if wear is not None:
             entry["wear"] = support_wear(run, x, scale, T, wear)
@@ -150,7 +139,7 @@ def support_rows(run, x: float) -> np.ndarray:
 
 
 def _normal_work_rate(run, rows, scale: float, T: float) -> float:
-    return scale * float(run.st.rowwork[rows, 1].sum()) / T
+    return scale * float(run.record.row_work[rows, 1].sum()) / T
 
 
 def support_wear(run, x: float, scale: float, T: float, wear: Wear) -> dict:
@@ -159,7 +148,7 @@ def support_wear(run, x: float, scale: float, T: float, wear: Wear) -> dict:
     T = T if T > 0 else math.nan
     rows = support_rows(run, x)
     return wear.of(_normal_work_rate(run, rows, scale, T),
-                   scale * run.st.sectors[rows].sum(axis=0), T)
+                   scale * run.record.sector_work[rows].sum(axis=0), T)
 
 
 def _wear_units(wear: Wear) -> str:

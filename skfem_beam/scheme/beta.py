@@ -167,6 +167,18 @@ def hole_arrays(system):
     return (pair, first, *csr_arrays(system.row_nodes), np.ascontiguousarray(Nc))
 
 
+def row_planes(pair, Nc) -> np.ndarray:
+    """(m, 2): each constrained row's force direction in (v, w) (its face's normal, or a
+    round hole's rows (1, 0) and (0, 1)), so that the net contact force in each plane is
+    λ @ row_planes; ``pair``, ``Nc``: the run's (kernels.Ops, :func:`hole_arrays`)."""
+    m = pair.size
+    out = np.array(Nc[:, 4:6]) if Nc.shape[0] else np.zeros((m, 2))
+    for j in range(m):
+        if pair[j] > 0:
+            out[j], out[pair[j]] = (1.0, 0.0), (0.0, 1.0)
+    return out
+
+
 def two_plane_state(ops, nsgs: bool = False) -> dict:
     """State's pos, rowwork, sectors (rows × 4, 3, SECTORS in two planes; none in one),
     hk, and fc (rows × 6 for Moreau–Jean's round holes, ``nsgs``: contact.friction.nsgs

@@ -5,17 +5,56 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import Deferred, InputError, SolverError
 from ..stability import kappa_h, linear_limit
-from .kernels import (EVENT_COLUMNS, EVENTS_FULL, EVENTS_WRITTEN, FAILED, ROW0, STOPPED_AT,
-                      UNSTABLE, WORK_TERMS, Inputs, PythonLaw)
+from .kernels import (CONTACT_STEPS, EVENT_COLUMNS, EVENTS_FULL, EVENTS_WRITTEN, FAILED, ROW0,
+                      STOPPED_AT, UNSTABLE, WORK_TERMS, Inputs, PythonLaw)
 from .stepping import Result
 
 FIRST_ROWS = 1 << 15      # saved rows allocated at first; more as a chunk needs them
 SAVED = ("obs", "obsv", "energy", "work", "lam", "resid")   # the saved series, by row
+
+
+@dataclass(frozen=True)
+class Record:
+    """A run's tallies so far, as output reads them (``Run.record``): a snapshot, its
+    arrays read-only copies that stay as they were while the run goes on.  Nothing outside
+    ``scheme/`` reads the compiled loop's state; a tally output needs is added here.
+
+    Per-row arrays have a row per constrained value (the system's C rows; m = 0 in one
+    plane, where the loop keeps no per-row tallies).
+
+    contact_steps      states so far with some constrained value in contact
+    row_work           (m, 3) per row, in the units of energy: Σ its share of the contact
+                       work ½μ(y^{n+1} − y^{n−1})/Δt² (impact work), Σ |F_n||v_t|Δt (normal
+                       work, Archard's wear), Σ friction work
+    sector_work        (m, SECTORS) per row: the normal work per 30° sector of the node's
+                       angle in its hole, from −π (wear per sector)
+    row_planes         (m, 2) each row's force direction in (v, w) (a face's normal, a round
+                       hole's rows (1, 0) and (0, 1)): the net force per plane is λ @ it
+    friction_tallied   whether row_work's friction column is this run's: the system has
+                       friction, or its law solves round holes by Gauss–Seidel (Moreau–Jean),
+                       which tallies it even at μ = 0
+    friction_residual  the largest residual of the friction's Gauss–Seidel (NSGS) so far;
+                       None for a law without one (position level: each block exact)
+    """
+    contact_steps: int
+    row_work: np.ndarray
+    sector_work: np.ndarray
+    row_planes: np.ndarray
+    friction_tallied: bool
+    friction_residual: float | None
+
+
+def _frozen(a) -> np.ndarray:
+    """A read-only copy of ``a``."""
+    a = np.array(a, dtype=float)
+    a.flags.writeable = False
+    return a
 
 
 class SavedRows:
@@ -88,7 +127,8 @@ class Run:
         if self.n == 0:                     # a scheme that starts from the data itself
             self.advance(1)
 
-    # the integrator's parts, as the output pipeline and the tests read them
+    # the integrator's parts, for the scheme's own modules and the tests (output reads
+    # ``record``, the saved series and ``impact_events``; tests/test_code_shape.py checks)
     st = property(lambda self: self.scheme.st)
     ops = property(lambda self: self.scheme.ops)
     op = property(lambda self: self.scheme.op)
@@ -98,6 +138,21 @@ class Run:
     pysolver = property(lambda self: self.scheme.pysolver)
     loads = property(lambda self: self.scheme.loads)
     load_norm = property(lambda self: self.scheme.load_norm)
+
+    @property
+    def record(self) -> Record:
+        """The run's tallies so far (:class:`Record`): what output reads of the compiled
+        loop, as a read-only snapshot."""
+        st = self.st
+        if getattr(self, "_row_planes", None) is None:    # fixed for the run: once
+            from .beta import row_planes
+            self._row_planes = _frozen(row_planes(self.ops.pair, self.ops.Nc))
+        fres = getattr(st, "fres", None)
+        return Record(contact_steps=int(st.counters[CONTACT_STEPS]),
+                      row_work=_frozen(st.rowwork), sector_work=_frozen(st.sectors),
+                      row_planes=self._row_planes,
+                      friction_tallied=bool(st.fc.shape[0]) or "friction" in self.work_terms,
+                      friction_residual=None if fres is None else float(fres[1]))
 
     @property
     def label(self) -> str:

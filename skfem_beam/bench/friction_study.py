@@ -70,11 +70,10 @@ def build(law: str, dt: float, T: float, path=None):
 
 def penetration(run, hole) -> float:
     """max over the saved states of |y_p − c| − r at the node of ``hole`` (a HoleAt)."""
-    n = run.n + 1
     name = f"hole_{hole.x:g}_displacement_"
     names = list(run.system.observe)
-    v = np.asarray(run.out.obs[:n, names.index(name + "v")]) - hole.hole.centre[0]
-    w = np.asarray(run.out.obs[:n, names.index(name + "w")]) - hole.hole.centre[1]
+    v = np.asarray(run.obs[:, names.index(name + "v")]) - hole.hole.centre[0]
+    w = np.asarray(run.obs[:, names.index(name + "w")]) - hole.hole.centre[1]
     return float(np.max(np.hypot(v, w)) - hole.hole.radius)
 
 

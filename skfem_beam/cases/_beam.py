@@ -45,7 +45,7 @@ def run_beam_case(case: str, problem, spec: RunSpec, stops=(), extra=None) -> in
         "kappa_h": kh,
         "linear_stability_limit_dt": limit if math.isfinite(limit) else None,
         "observed_x": system.view.observed_x or problem.beam.L,
-        "units": {**units(rho_S, system), "probes": probe_units(system)},
+        "units": units(rho_S, system),
         "penalty_stiffness_N_per_m": spec.method.stiffness if penalty else None,
         "penalty_damping_N_s_per_m": spec.method.damping if penalty else None,
         "config": spec.config,
@@ -57,11 +57,7 @@ def run_beam_case(case: str, problem, spec: RunSpec, stops=(), extra=None) -> in
     def events(folder: Path, run, last: int) -> dict:
         return beam_impacts(folder, run, problem, last, spec.wear, springs)
 
-    two = system.planes == 2
-    if two:
-        summary["units"].update(two_plane_units(rho_S))
-    series = Series((two_plane_columns if two else beam_columns)(system.view, rho_S),
-                    events=events)
+    series = Series(beam_columns(system.view, rho_S), events=events)
     code = execute(run, spec.options, summary, series,
                    beam_charts(case, problem, rho_S, stops, extra, system.view.observed_x,
                                spec.wear))
@@ -133,41 +129,24 @@ def stability_warning(system, stepping):
     return kh, limit
 
 
+def plane_suffixes(planes: int) -> tuple[str, ...]:
+    """The column suffix of each plane: ("",) for one plane, ("_v", "_w") for two."""
+    return ("",) if planes == 1 else PLANE_SUFFIXES
+
+
 def beam_columns(view, rho_S):
-    """timeseries.csv's columns of saved rows k0..k1 of a beam run."""
-    def columns(run, k0, k1):
-        force = run.lam[k0:k1].sum(axis=1)   # net force on the beam, m²/s² = N/(kg/m)
-        t = np.arange(k0, k1) * run.save_every * run.dt
-        # the physical ũ(L) = u(L) + h(L)φ(t), whatever the lifting (u(L) when h(L) = 0)
-        tip, tip_v = physical_tip(view, t, run.obs[k0:k1, 0], run.obsv[k0:k1, 0])
-        cols = {"t": t, "tip_displacement": tip, "tip_velocity": tip_v,
-                "energy": run.energy[k0:k1], "contact_force": force}
-        if rho_S:                            # physical units: N and J
-            cols["contact_force_N"] = force * rho_S
-            cols["energy_J"] = run.energy[k0:k1] * rho_S
-        return {**cols, **work_columns(run, k0, k1, rho_S), **probe_columns(run, k0, k1)}
-    return columns
+    """timeseries.csv's columns of saved rows k0..k1 of a beam run, for either plane count:
+    the tip's displacement and velocity and the net contact force once per plane (named
+    with the plane's suffix, :func:`plane_suffixes`), the orbit of every hole's node
+    (``hole_<x>_displacement_v``, ``_w``: two planes), the energy and the work."""
+    suffixes = plane_suffixes(view.planes)
 
-
-def work_columns(run, k0, k1, rho_S) -> dict:
-    """The work since state 1, in the units of energy (and J): energy − energy[0] +
-    damping = input + contact (+ friction) (the scheme's identity, docs/design.md §3)."""
-    work = run.work[k0:k1]
-    terms = {f"work_{name}": work[:, i] for i, name in enumerate(run.work_terms)}
-    if rho_S:
-        terms.update({f"{k}_J": v * rho_S for k, v in list(terms.items())})
-    return terms
-
-
-def two_plane_columns(view, rho_S):
-    """timeseries.csv's columns of saved rows k0..k1 of a two-plane beam run: each of the
-    one-plane beam's displacement and force columns per plane (``_v``, ``_w``), the
-    orbit of every hole's node (``hole_<x>_displacement_v``, ``_w``), the energy and work."""
     def columns(run, k0, k1):
         names = list(run.system.observe)
         t = np.arange(k0, k1) * run.save_every * run.dt
         cols = {"t": t}
-        for suffix, share in zip(PLANE_SUFFIXES, view.direction):
+        for suffix, share in zip(suffixes, view.direction):
+            # the physical ũ(L) = u(L) + h(L)φ(t), whatever the lifting (u(L) when h(L) = 0)
             i = names.index(f"tip_displacement{suffix}")
             tip, tip_v = physical_tip(view, t, run.obs[k0:k1, i], run.obsv[k0:k1, i], share)
             cols[f"tip_displacement{suffix}"], cols[f"tip_velocity{suffix}"] = tip, tip_v
@@ -180,98 +159,94 @@ def two_plane_columns(view, rho_S):
         cols["energy"] = run.energy[k0:k1]
         if "friction" in run.work_terms:     # the friction's Gauss–Seidel at each saved step
             cols["friction_residual"] = run.resid[k0:k1]
-        force = run.lam[k0:k1] @ run.record.row_planes   # net, per plane
-        for c, suffix in enumerate(PLANE_SUFFIXES):
-            cols[f"contact_force{suffix}"] = force[:, c]
-            if rho_S:
-                cols[f"contact_force{suffix}_N"] = force[:, c] * rho_S
+        for suffix, force in zip(suffixes, plane_forces(run, k0, k1)):
+            cols[f"contact_force{suffix}"] = force     # m²/s² = N/(kg/m)
+            if rho_S:                                  # physical units: N and J
+                cols[f"contact_force{suffix}_N"] = force * rho_S
         if rho_S:
             cols["energy_J"] = run.energy[k0:k1] * rho_S
         return {**cols, **work_columns(run, k0, k1, rho_S), **probe_columns(run, k0, k1)}
     return columns
 
 
-def two_plane_units(rho_S) -> dict:
-    """summary.json's units of the two-plane columns (beside the one-plane ones)."""
-    out = {"tip_displacement_v": "m, the first plane's (along y), as tip_displacement",
-           "tip_displacement_w": "m, the second plane's (along z)",
-           "hole_<x>_displacement_v": "m, the node of a hole at x, first plane (the orbit)",
-           "hole_<x>_displacement_w": "m, the same, second plane",
-           "contact_force_v": "net contact force along y, as contact_force",
-           "contact_force_w": "net contact force along z, as contact_force"}
+def plane_forces(run, k0, k1) -> list:
+    """The net contact force on the beam in each plane, saved rows k0..k1: one plane the
+    sum of λ, two planes λ @ row_planes (each row's share of v and w)."""
+    lam = run.lam[k0:k1]
+    if run.system.planes == 1:
+        return [lam.sum(axis=1)]
+    force = lam @ run.record.row_planes
+    return [force[:, c] for c in range(force.shape[1])]
+
+
+def work_columns(run, k0, k1, rho_S) -> dict:
+    """The work since state 1, in the units of energy (and J): energy − energy[0] +
+    damping = input + contact (+ friction) (the scheme's identity, docs/design.md §3)."""
+    work = run.work[k0:k1]
+    terms = {f"work_{name}": work[:, i] for i, name in enumerate(run.work_terms)}
     if rho_S:
-        out.update({"contact_force_v_N": "N", "contact_force_w_N": "N"})
-    out.update({"work_friction": "as energy: the work of Coulomb friction (≤ 0), cumulative "
-                                 "since t = 0; energy − energy[0] + work_damping = "
-                                 "work_input + work_contact + work_friction",
-                "friction_residual": "the friction's Gauss–Seidel residual at the saved "
-                                     "step (largest impulse change of its last sweep, "
-                                     "relative; 0 with one contact: exact)"})
-    return out
+        terms.update({f"{k}_J": v * rho_S for k, v in list(terms.items())})
+    return terms
+
+
+PLANE_LABELS = {"": "ũ", "_v": "v", "_w": "w"}   # a plane's displacement, in chart labels
 
 
 def beam_charts(case, problem, rho_S, stops, extra, observed_x=None, wear=None):
-    """The charts of a beam run (and the case's ``extra`` files), from the rows in memory;
-    ``observed_x``: where the default series observes a beam whose end at L is held;
-    ``wear``: the [wear] of a two-plane run (output.supports.Wear), a wear chart per hole."""
+    """The charts of a beam run (and the case's ``extra`` files), from the rows in memory:
+    the observed point's displacement, the energy and the net contact force, each plane's
+    line named by its suffix (:func:`plane_suffixes`); one plane the beam's shapes, two
+    planes an orbit per hole node; ``observed_x``: where the default series observes a
+    beam whose end at L is held; ``wear``: the [wear] of a two-plane run
+    (output.supports.Wear), a wear chart per hole."""
     where = "L" if observed_x is None else f"{observed_x:g} m"
     what = "tip displacement" if observed_x is None else f"displacement at x = {where}"
+    suffixes = plane_suffixes(problem.planes)
+    one = len(suffixes) == 1
 
     def finish(folder: Path, data: dict, run):
         t = data["t"]
         about = f"{run.label}, Δt={run.dt:g} s, J={problem.J}, {problem.element}"
-        if problem.planes == 2:
-            two_plane_charts(folder, data, run, case, problem, about, where, what)
-            if wear is not None:
-                wear_charts(folder, data, run, case, problem, about, rho_S, wear)
-            if extra is not None:
-                extra(folder, data, run)
-            return
         draw(trajectory_chart, folder / "tip_displacement.png", t,
-             {f"ũ({where}, t)": data["tip_displacement"]},
-             stops=stops if observed_x is None else (),
-             title=f"{case}: {what} ({about})")
+             {f"{PLANE_LABELS[s]}({where}, t)": data[f"tip_displacement{s}"] for s in suffixes},
+             stops=stops if observed_x is None and one else (),
+             title=f"{case}: {what}{'' if one else ', both planes'} ({about})")
         joules = "energy_J" in data         # in J when the mass per length ρS is known
         draw(energy_chart, folder / "energy.png", t, data["energy_J" if joules else "energy"],
              title=f"{case}: discrete energy ½E_β ({about})",
-             work={k: data[f"work_{k}" + ("_J" if joules else "")] for k in WORK_TERMS},
+             work={k: data[f"work_{k}" + ("_J" if joules else "")] for k in run.work_terms},
              joules=joules)
-        if np.any(data["contact_force"]):
-            # in newtons when the mass per length ρS is known (the column is λ·ρS)
-            newtons = "contact_force_N" in data
-            force = data["contact_force_N" if newtons else "contact_force"]
-            draw(trajectory_chart, folder / "contact_force.png", t, {"net contact force λ": force},
-                 title=f"{case}: net contact force on the beam ({about})"
-                       + (f", ρS={rho_S:g} kg/m" if newtons else ""),
-                 ylabel="force (N)" if newtons else "force per mass (m²/s² = N per kg/m)")
-        draw(shape_chart, folder / "beam_shapes.png", shapes(run.result()),
-             title=f"{case}: displacement ũ(x, t) at saved times ({about})")
+        force_chart(folder, data, case, about, rho_S if one else None, suffixes)
+        if one:
+            draw(shape_chart, folder / "beam_shapes.png", shapes(run.result()),
+                 title=f"{case}: displacement ũ(x, t) at saved times ({about})")
+        else:
+            orbit_charts(folder, data, case, problem, about)
+            if wear is not None:
+                wear_charts(folder, data, run, case, problem, about, rho_S, wear)
         if extra is not None:
             extra(folder, data, run)
     return finish
 
 
-def two_plane_charts(folder, data, run, case, problem, about, where, what) -> None:
-    """A two-plane run's charts: v and w at the observed point, the energy, the net
-    contact force per plane, and an orbit per hole node (w against v, the wall drawn)."""
-    t = data["t"]
-    draw(trajectory_chart, folder / "tip_displacement.png", t,
-         {f"v({where}, t)": data["tip_displacement_v"],
-          f"w({where}, t)": data["tip_displacement_w"]},
-         title=f"{case}: {what}, both planes ({about})")
-    joules = "energy_J" in data
-    draw(energy_chart, folder / "energy.png", t, data["energy_J" if joules else "energy"],
-         title=f"{case}: discrete energy ½E_β ({about})",
-         work={k: data[f"work_{k}" + ("_J" if joules else "")]
-               for k in run.work_terms}, joules=joules)
-    newtons = "contact_force_v_N" in data
-    forces = {f"net contact force, {p}": data[f"contact_force_{p}" + ("_N" if newtons else "")]
-              for p in ("v", "w")}
-    if any(np.any(f) for f in forces.values()):
-        draw(trajectory_chart, folder / "contact_force.png", t, forces,
-             title=f"{case}: net contact force on the beam ({about})",
-             ylabel="force (N)" if newtons else
-             "force per mass (m²/s² = N per kg/m)")
+def force_chart(folder, data, case, about, rho_S, suffixes) -> None:
+    """contact_force.png: the net contact force on the beam in each plane, in newtons when
+    the mass per length ρS is known (the columns ending ``_N``: λ·ρS), drawn when it is
+    not all zero; ``rho_S``: named in the title (None: not named)."""
+    newtons = f"contact_force{suffixes[0]}_N" in data
+    label = {"": "net contact force λ", "_v": "net contact force, v",
+             "_w": "net contact force, w"}
+    if not any(np.any(data[f"contact_force{s}"]) for s in suffixes):
+        return
+    draw(trajectory_chart, folder / "contact_force.png", data["t"],
+         {label[s]: data[f"contact_force{s}" + ("_N" if newtons else "")] for s in suffixes},
+         title=f"{case}: net contact force on the beam ({about})"
+               + (f", ρS={rho_S:g} kg/m" if newtons and rho_S is not None else ""),
+         ylabel="force (N)" if newtons else "force per mass (m²/s² = N per kg/m)")
+
+
+def orbit_charts(folder, data, case, problem, about) -> None:
+    """orbit_<x>.png per hole node: w against v there, the hole's wall drawn."""
     for h, x in hole_nodes(problem):
         key = f"hole_{x:g}_displacement"
         draw(orbit_chart, folder / f"orbit_{x:g}.png", data[f"{key}_v"],
@@ -299,8 +274,18 @@ def wear_charts(folder, data, run, case, problem, about, rho_S, wear) -> None:
              f"{h.hole.shape} hole\n({about})", h.hole.centre)
 
 
+PLANE_UNITS = {   # summary.json's units of each plane's own columns (two planes)
+    "_v": {"tip_displacement": "m, the first plane's (along y), as tip_displacement",
+           "hole_<x>_displacement": "m, the node of a hole at x, first plane (the orbit)",
+           "contact_force": "net contact force along y, as contact_force"},
+    "_w": {"tip_displacement": "m, the second plane's (along z)",
+           "hole_<x>_displacement": "m, the same, second plane",
+           "contact_force": "net contact force along z, as contact_force"}}
+
+
 def units(rho_S, system) -> dict:
-    """summary.json's ``units``: what every timeseries column is, in which unit and frame."""
+    """summary.json's ``units``: what every timeseries column is, in which unit and frame
+    (a two-plane run's per-plane columns, named with the plane's suffix, after the probes')."""
     lift = system.view.lift if system.view is not None else None
     frame = ("ũ(L) = u(L) + h(L)φ(t): the physical displacement in the fixed frame, "
              "support motion included" if lift is not None else "u(L): the support is at rest")
@@ -329,4 +314,21 @@ def units(rho_S, system) -> dict:
                     "energy_J": "J (energy × rho_S)",
                     **{f"work_{k}_J": f"J (work_{k} × rho_S)" for k in WORK_TERMS},
                     "rho_S": f"{rho_S:g} kg/m"})
+    return {**out, "probes": probe_units(system), **plane_units(rho_S, system.planes)}
+
+
+def plane_units(rho_S, planes: int) -> dict:
+    """The units of each plane's own columns, named with its suffix (none for one plane,
+    whose columns are :func:`units`' own), and of the friction's (two planes)."""
+    suffixes = [s for s in plane_suffixes(planes) if s]
+    out = {f"{name}{s}": PLANE_UNITS[s][name] for name in PLANE_UNITS["_v"] for s in suffixes}
+    if rho_S:
+        out.update({f"contact_force{s}_N": "N" for s in suffixes})
+    if suffixes:
+        out.update({"work_friction": "as energy: the work of Coulomb friction (≤ 0), "
+                                     "cumulative since t = 0; energy − energy[0] + "
+                                     "work_damping = work_input + work_contact + work_friction",
+                    "friction_residual": "the friction's Gauss–Seidel residual at the saved "
+                                         "step (largest impulse change of its last sweep, "
+                                         "relative; 0 with one contact: exact)"})
     return out

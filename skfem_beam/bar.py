@@ -294,7 +294,6 @@ def bar_system(bar: Bar) -> SemiDiscrete:
     return system
 
 
-METHODS = ("contact", "penalty", methods.MoreauJean.name)   # the API's words for the bar
 
 
 def spring_step_ratio(bar: Bar, dt: float) -> float:
@@ -360,13 +359,12 @@ def steps_to(T: float, dt: float) -> int:
 
 def bar_method(bar: Bar, method="contact", solver="auto", restitution: float = 0.0,
                massless: str = "beta"):
-    """The bar's method: a method object (:mod:`skfem_beam.methods`) or the words of
-    METHODS with ``solver``, ``restitution`` and ``massless``.  An elastic obstacle *is*
-    the spring R = kU⁻ of stiffness ``bar.k``, whatever method steps it; a rigid one with
-    the penalty method is approximated by springs of ``bar.k``."""
+    """The bar's method: a method object (:mod:`skfem_beam.methods`) or a word of
+    ``methods.law_of`` with ``solver``, ``restitution`` and ``massless``.  An elastic
+    obstacle *is* the spring R = kU⁻ of stiffness ``bar.k``, whatever method steps it; a
+    rigid one with the penalty method is approximated by springs of ``bar.k``."""
     if isinstance(method, str):
-        check_choice("method", method, METHODS)
-        law = "position" if method == "contact" else method
+        law = methods.law_of(method, "method")
         method = methods.make(law, solver, restitution, bar.k if law == "penalty" else None,
                               None if massless == "beta" else massless, words=methods.KEYS)
     if bar.obstacle != "elastic":

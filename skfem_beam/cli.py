@@ -104,12 +104,11 @@ def parse(p: Parser, argv=None):
 def check_law(args, p: Parser) -> None:
     """--law (or its alias --method), --mass and --massless, and the method they name;
     sets args.method to "penalty" for the penalty law and "contact" otherwise."""
-    if args.method not in ("contact", "penalty"):
-        raise InputError(f"--method {args.method!r} is not one of: contact, penalty")
+    check_choice("--method", args.method, ("contact", "penalty"))
     if args.law is None:
-        args.law = "penalty" if args.method == "penalty" else "position"
+        args.law = methods.law_of(args.method, "--method")
     check_choice("--law", args.law, methods.LAWS)
-    args.method = "penalty" if args.law == "penalty" else "contact"
+    args.method = methods.summary_word(args.law)
     allowed = next(a.help.split(" | ") for a in p._actions if a.dest == "mass")
     check_choice("--mass", args.mass, allowed)
     methods.check_massless(getattr(args, "massless", None), args.mass)

@@ -19,6 +19,9 @@ from .scheme.moreau_jean import NAME as MOREAU_JEAN, check_theta
 from .scheme.stepping import MASSLESS
 
 LAWS = ("position", MOREAU_JEAN, "penalty")   # the classes by name
+# "contact": the first wave's word for the position-level law (the command line's --method
+# contact, the bar's API, the stability map), and summary.json's "method" of a beam run
+ALIASES = {"contact": "position"}
 BAR_BETA = 0.25     # the bar's scheme (7.3) of the third paper: β = 1/4 whatever the law
 
 
@@ -77,6 +80,19 @@ def make(law: str = "position", solver: str = "auto", restitution: float = 0.0,
                          check_params(solver, params, words.param))
 
 
+def law_of(word: str, name: str = "--law") -> str:
+    """The law (one of LAWS) ``word`` names: a law's name or an alias of ALIASES; one line
+    naming the words allowed else (``name``: the flag or key as the user wrote it)."""
+    check_choice(name, word, (*LAWS, *ALIASES))
+    return ALIASES.get(word, word)
+
+
+def summary_word(law: str) -> str:
+    """summary.json's "method" of a beam run: "penalty" for springs, "contact" for rigid
+    contact at position or velocity level."""
+    return "penalty" if law == "penalty" else "contact"
+
+
 def split_law(word: str) -> tuple[str, str]:
     """A scene file's ``[contact] law`` names a method (one of LAWS) or a position-level
     solver (SOLVERS): the (law, solver) words of :func:`make` it stands for."""
@@ -101,5 +117,5 @@ def default_beta(method: Method, kind: str = "beam") -> float:
     return BAR_BETA if kind == "bar" else method.default_beta
 
 
-__all__ = ["LAWS", "Method", "MoreauJean", "Penalty", "PositionLevel", "Words", "check_massless",
-           "default_beta", "make", "mass_scale", "split_law"]
+__all__ = ["ALIASES", "LAWS", "Method", "MoreauJean", "Penalty", "PositionLevel", "Words", "check_massless",
+           "default_beta", "law_of", "make", "mass_scale", "split_law", "summary_word"]

@@ -16,7 +16,7 @@ from ..output.probes import probe_columns, probe_units
 from ..output.checkpoint import read_summary
 from ..output.stream import Series, execute, prepare
 from ..output.supports import support_table, support_wear
-from ..methods import Penalty
+from ..methods import Penalty, summary_word
 from ..scheme.kernels import WORK_TERMS
 from ..spec import RunSpec
 from ..semidiscrete import PLANE_SUFFIXES, add_probes, beam_system
@@ -41,7 +41,7 @@ def run_beam_case(case: str, problem, spec: RunSpec, stops=(), extra=None) -> in
     summary = {
         "case": case, "J": problem.J, "dt": run.dt, "T": run.n_steps * run.dt, "beta": run.beta,
         "theta": run.theta,
-        "element": problem.element, "method": "penalty" if penalty else "contact",
+        "element": problem.element, "method": summary_word(spec.method.name),
         "kappa_h": kh,
         "linear_stability_limit_dt": limit if math.isfinite(limit) else None,
         "observed_x": system.view.observed_x or problem.beam.L,

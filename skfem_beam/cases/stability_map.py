@@ -21,7 +21,7 @@ import numpy as np
 from .. import cli, scenes
 from ..errors import InputError
 from ..scheme import solve
-from ..scheme.methods import Penalty
+from ..methods import Penalty, law_of, make
 from ..output.charts import figure
 from ..output.folder import Folder, check_output_dir
 from ..checks import check_beta, check_positive
@@ -63,7 +63,8 @@ def run_map(system, grid, T, stiffness, step_of) -> list[dict]:
     rows = []
     for beta, ratio, method in grid:
         dt = ratio * step_of(beta)
-        law = Penalty(stiffness, equation_units=True) if method == "penalty" else None
+        law = Penalty(stiffness, equation_units=True) if law_of(method) == "penalty" \
+            else make(law_of(method))
         r = solve(system, dt, T, beta, law, save_every=max(1, int(1e-4 / dt)), frames=2, progress=False)
         tip = r.observed["tip_displacement"]
         rows.append({"beta": beta, "ratio": ratio, "dt": dt, "method": method,
@@ -105,7 +106,8 @@ def main(argv=None) -> int:
     p = cli.Parser(prog="skfem_beam.cases.stability_map", description=__doc__.splitlines()[0])
     p.add_argument("--betas", default="0,0.1,0.2,0.25,0.35,0.5")
     p.add_argument("--ratios", default="0.5,0.9,1.2,2,10,100")
-    p.add_argument("--methods", default="contact,penalty")
+    p.add_argument("--methods", default="contact,penalty",
+                   help="comma-separated: contact (= position), penalty, moreau-jean")
     p.add_argument("--T", type=float, default=0.5)
     p.add_argument("--J", type=int, default=19)
     p.add_argument("--stiffness", type=float, default=1e8, help="penalty stiffness (N/m)")
@@ -116,10 +118,9 @@ def main(argv=None) -> int:
     args = p.parse_args(argv)
     betas = [check_beta(b) for b in floats("betas", args.betas)]
     ratios = [check_positive("ratio", r) for r in floats("ratios", args.ratios)]
-    methods = [m.strip() for m in args.methods.split(",") if m.strip()]
-    for m in methods:
-        if m not in ("contact", "penalty"):
-            raise InputError(f"--methods: {m!r} is not one of: contact, penalty")
+    words = [m.strip() for m in args.methods.split(",") if m.strip()]
+    for m in words:
+        law_of(m, "--methods")
     T = check_positive("T", args.T)
     max_seconds = check_positive("max-seconds", args.max_seconds)
     stiffness = check_positive("stiffness", args.stiffness) / scenes.PIPE_RHO_S
@@ -130,7 +131,7 @@ def main(argv=None) -> int:
     dx = pb.beam.L / pb.J
     kappa_paper = PAPER_KAPPA_BOUNDS["hermite"][PAPER_KAPPA] * pb.beam.k2 / dx**4
     t0 = time.perf_counter()
-    grid = [(b, r, m) for b in betas for r in ratios for m in methods]
+    grid = [(b, r, m) for b in betas for r in ratios for m in words]
     step_of = partial(reference_step, kappa, kappa_paper)
     check_budget(system, grid, T, step_of, max_seconds)
     rows = run_map(system, grid, T, stiffness, step_of)

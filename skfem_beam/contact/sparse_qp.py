@@ -67,8 +67,8 @@ EPS = 1e-6         # OSQP's / Clarabel's tolerance in scaled units: enough to fi
 GUESS_SWEEPS = 10  # inexact sweeps (PCG with the kept factor) before the exact ones
 GUESS_ITERATIONS = 4   # PCG iterations of an inexact sweep
 GUESS_MAX_BYTES = 32e6   # inexact sweeps only where the banded factor has at most these
-# all SelectorQPs' factorisations, banded solves (columns), exact and inexact sweeps, and
-# finished steps so far in this process (read by plate.bench)
+# the one tally of every SelectorQP's factorisations, banded solves (columns), exact and
+# inexact sweeps, and finished steps so far in this process (plate.bench resets, reads it)
 COUNTS = {"factors": 0, "solves": 0, "sweeps": 0, "guesses": 0, "steps": 0}
 MAX_COLUMNS = 16   # cached columns G⁻¹z_j (one banded solve each) before A_S is refactored
 
@@ -138,10 +138,6 @@ class SelectorQP:
         small = 8.0 * self.n * (self.kd + 1) <= GUESS_MAX_BYTES
         self.guess_sweeps = int(guess_sweeps) if update and small else 0
         self.key, self.chol = None, None        # the last set's factor (update=False)
-        self.factors = 0                        # factorisations so far
-        self.solves = 0                         # banded solves (columns) so far
-        self.guesses = 0                        # inexact sweeps so far
-        self.columns = 0                        # cached columns G⁻¹z_j computed so far
         # the kept base S0 (update=True)
         self.side0 = None                       # S0 as a state (int8 per row)
         self.L = None                           # LAPACK upper Cholesky factor of A_{S0}
@@ -170,7 +166,6 @@ class SelectorQP:
         if key == self.key:
             return self.chol
         self.key, self.chol = key, band_cholesky(self.pinned_band(pinned))
-        self.factors += 1
         COUNTS["factors"] += 1
         return self.chol
 
@@ -188,13 +183,11 @@ class SelectorQP:
             self.Y = np.zeros((self.n, self.max_columns), order="F")
         self.col = {}
         self.y0 = None
-        self.factors += 1
         COUNTS["factors"] += 1
 
     def gsolve(self, b: np.ndarray) -> np.ndarray:
         """G⁻¹b with G = A_{S0} (b: a vector or Fortran-ordered columns)."""
         x, info = scipy.linalg.lapack.dpbtrs(self.L, b, lower=0)
-        self.solves += 1 if b.ndim == 1 else b.shape[1]
         COUNTS["solves"] += 1 if b.ndim == 1 else b.shape[1]
         if info != 0:
             raise SolverError(f"dpbtrs info {info}")
@@ -228,7 +221,6 @@ class SelectorQP:
         self.Y[:, first:first + rows.size] = self.gsolve(R)
         for i, j in enumerate(rows):
             self.col[int(j)] = first + i
-        self.columns += rows.size
 
     def solve_updated(self, F, lo, hi, state, u) -> None:
         """u ← the minimiser with ``state`` pinned, from G = A_{S0}'s factor:
@@ -298,7 +290,6 @@ class SelectorQP:
         rhs = F - self.A @ ub
         rhs[pinned] = b
         band_solve(self.factor(pinned), rhs)
-        self.solves += 1
         COUNTS["solves"] += 1
         rhs[pinned] = b                         # exactly on the bounds
         u[:] = rhs
@@ -367,7 +358,6 @@ class SelectorQP:
                         break
                     seen.add(new.tobytes())
                     state[:] = new
-                    self.guesses += 1
                     COUNTS["guesses"] += 1
         seen = {state.tobytes()}
         for sweep in range(1, MAX_SWEEPS + 1):

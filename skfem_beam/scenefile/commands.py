@@ -128,7 +128,7 @@ def _spec(scene: Scene, flags: dict, resume) -> RunSpec:
         [x for x in given if x not in scene.output.get("probes", [])]
     config = {"command": "python -m skfem_beam run", "scene_text": scene.text,
               "scene_files": scene.files, **flags, "dt": stepping.dt, "beta": stepping.beta,
-              "method": "penalty" if law == "penalty" else "contact",
+              "method": methods.summary_word(law),
               "law": law, "solver": "auto" if restitution else solver,
               "stiffness": scene.stiffness, "restitution": restitution, "mass": mass,
               "massless": stepping.massless, "probe": probes}

@@ -68,8 +68,9 @@ GUESS_SWEEPS = 10  # inexact sweeps (PCG with the kept factor) before the exact 
 GUESS_ITERATIONS = 4   # PCG iterations of an inexact sweep
 GUESS_MAX_BYTES = 32e6   # inexact sweeps only where the banded factor has at most these
 # the one tally of every SelectorQP's factorisations, banded solves (columns), exact and
-# inexact sweeps, and finished steps so far in this process (plate.bench resets, reads it)
-COUNTS = {"factors": 0, "solves": 0, "sweeps": 0, "guesses": 0, "steps": 0}
+# inexact sweeps, finished steps and cached columns G⁻¹z_j so far in this process
+# (plate.bench resets and reads it; a test takes one call's share by difference)
+COUNTS = {"factors": 0, "solves": 0, "sweeps": 0, "guesses": 0, "steps": 0, "columns": 0}
 MAX_COLUMNS = 16   # cached columns G⁻¹z_j (one banded solve each) before A_S is refactored
 
 
@@ -219,6 +220,7 @@ class SelectorQP:
                 R[d, i] = 1.0
         first = len(self.col)
         self.Y[:, first:first + rows.size] = self.gsolve(R)
+        COUNTS["columns"] += rows.size
         for i, j in enumerate(rows):
             self.col[int(j)] = first + i
 

@@ -8,22 +8,24 @@ so there is one time scheme for all scenes.
 """
 from __future__ import annotations
 
-from typing import Callable
+from dataclasses import replace
+from typing import Callable, NamedTuple
 
 import numpy as np
 import scipy.sparse as sp
 
 import scipy.sparse.linalg as spla
 
+from .constraints import check_start, constraint_rows, friction, moving_bounds
 from .errors import InputError
 from .modes import beam_space, modes
 from .problem import BeamProblem, lifting, lifting_d, lifting_dd
 from .spaces import has_rigid_motion
 from .spaces.ends import fixed_dofs
 from .spaces.hermite import five_point_slope
-from .system import Lifting, SceneView, SemiDiscrete, snap
+from .system import Lifting, SceneView, SemiDiscrete
 from .timefunctions import Constant
-from .two_planes import plane_problems, two_plane_system
+from .two_planes import plane_problems
 
 
 def static_lifting(space, at: float, k2: float) -> np.ndarray:
@@ -114,72 +116,141 @@ def _initial(problem: BeamProblem, space, lift: Lifting | None):
     return u0, v0
 
 
-def beam_system(problem: BeamProblem, samples_per_element: int = 20) -> SemiDiscrete:
-    """Discretise a beam scene (the papers' V_h, K_h of (8), loads with the lifting; two
-    planes: :func:`skfem_beam.two_planes.two_plane_system`)."""
-    if problem.planes == 2:
-        pv, pw = plane_problems(problem)
-        return two_plane_system(problem, beam_system(pv, samples_per_element),
-                                beam_system(pw, samples_per_element))
-    beam, sup = problem.beam, problem.support
-    space = beam_space(problem)
-    x_nodes = problem.nodes[space.value_nodes]     # where u is free (x_1..x_J when clamped)
-    lo_all, hi_all = problem.obstacles.bounds(x_nodes)
-    finite = np.isfinite(lo_all) | np.isfinite(hi_all)
-    C = space.nodal[space.value_nodes[finite]]
+class _Plane(NamedTuple):
+    """One bending plane's part of a beam's system (its own stiffness, loads, start)."""
+    problem: BeamProblem
+    space: object
+    lift: Lifting | None
+    loads: np.ndarray
+    times: list
+    u0: np.ndarray
+    v0: np.ndarray
+    K: sp.csr_matrix
+    B: sp.csr_matrix | None
+    observe: dict
+    x_obs: float | None
 
-    L, k2 = beam.L, beam.k2
-    lift, profiles, times = _lifting(problem, space) if sup.moves else (None, [], [])
+
+def beam_system(problem: BeamProblem, samples_per_element: int = 20) -> SemiDiscrete:
+    """Discretise a beam scene (the papers' V_h, K_h of (8), loads with the lifting), in one
+    bending plane or two (skfem_beam.two_planes): the planes' systems stacked
+    block-diagonally, every obstacle a row at a node (skfem_beam.constraints)."""
+    one_plane = plane_problems(problem)
+    spaces = [beam_space(p) for p in one_plane]
+    rows = constraint_rows(problem, spaces[0])
+    sampler = spaces[0].sampler(np.linspace(0.0, 1.0, samples_per_element + 1))
+    s_lo, s_hi = problem.obstacles.bounds(sampler.x)
+    keep = np.isfinite(s_lo) | np.isfinite(s_hi)     # penetration samples: flat obstacles
+    planes = [_plane(p, space) for p, space in zip(one_plane, spaces)]
+    lift = next((p.lift for p in planes if p.lift is not None), None)
+    motion, shift, s_shift, centres = moving_bounds(problem, lift, rows, sampler.x[keep])
+    C, lo, hi, x_c = rows.arrays()
+    u0 = np.concatenate([p.u0 for p in planes])
+    check_start(C @ u0, rows, motion, shift)
+    return SemiDiscrete(
+        M=_block_diagonal([p.space.M for p in planes]),
+        K=_block_diagonal([p.K for p in planes]), C=C, lo=lo, hi=hi, x_contact=x_c,
+        loads=_load_blocks([p.loads for p in planes]),
+        load_time=[a for p in planes for a in p.times], u0=u0,
+        v0=np.concatenate([p.v0 for p in planes]), observe=_observe(problem, planes),
+        B=_block_diagonal([p.B for p in planes]), space=planes[0].space,
+        sample_x=sampler.x[keep],
+        sample_E=rows.in_plane(sampler.E0[np.flatnonzero(keep)].tocsr(), 0),
+        sample_lo=s_lo[keep], sample_hi=s_hi[keep], meta=_meta(problem, planes),
+        view=_view(problem, planes, lift), bound_motion=motion, bound_shift=shift,
+        sample_shift=s_shift, planes=problem.planes,
+        **_row_fields(problem, spaces[0], rows, x_c, centres))
+
+
+def _plane(problem: BeamProblem, space) -> _Plane:
+    """One plane's lifting, loads, initial state, stiffness, damping and observed row."""
+    lift, profiles, times = _lifting(problem, space) if problem.support.moves \
+        else (None, [], [])
     loads, times = _load_columns(problem, space, profiles, times)
     u0, v0 = _initial(problem, space, lift)
-
-    lo, hi = lo_all[finite], hi_all[finite]
-    x_c = x_nodes[finite]
-    sampler = space.sampler(np.linspace(0.0, 1.0, samples_per_element + 1))
-    s_lo, s_hi = problem.obstacles.bounds(sampler.x)
-    keep = np.isfinite(s_lo) | np.isfinite(s_hi)
-    motion, shift, s_shift = _moving_bounds(problem, lift, x_c, sampler.x[keep])
-    _check_u0(C @ u0, lo, hi, None if motion is None else (shift, float(sup.phi(0.0))), x_c)
     K, B = _operators(problem, space)
     observe, x_obs = _observation(problem, space)
-    return SemiDiscrete(
-        M=space.M, K=K, C=sp.csr_matrix(C), lo=lo, hi=hi,
-        x_contact=x_c, loads=loads, load_time=times, u0=u0, v0=v0,
-        observe=observe, B=B, space=space,
-        sample_x=sampler.x[keep], sample_E=sampler.E0[np.flatnonzero(keep)].tocsr(),
-        sample_lo=s_lo[keep], sample_hi=s_hi[keep],
-        meta={"kind": "beam", "L": L, "k2": k2, "rho_S": beam.rho_S,
-              "element": problem.element, "J": problem.J, "problem": problem},
-        view=SceneView("beam", L, k2, sup if problem.lifting == "paper" else None,
-                       problem.obstacles, beam.rho_S, beam.EI, lift, x_obs),
-        bound_motion=motion, bound_shift=shift, sample_shift=s_shift,
-        row_obstacle=problem.obstacles.owners(x_c))
+    return _Plane(problem, space, lift, loads, times, u0, v0, K, B, observe, x_obs)
 
 
-def _moving_bounds(problem: BeamProblem, lift, x_c, xs):
-    """(motion, shift, s_shift): the bounds on u = ũ − hφ are g − hφ (fixed to the
-    ground) and g + (1 − h)φ (carried), so they move with the support φ = ``motion`` by
-    ``shift`` at the constrained values x_c and ``s_shift`` at the sample points xs; all
-    None when they do not move."""
-    if lift is None:
-        return None, None, None
-    shift, s_shift = (snap(problem.obstacles.carried_at(x) - lift.h(x)) for x in (x_c, xs))
-    if np.any(shift != 0) or np.any(s_shift != 0):
-        return problem.support.phi, shift, s_shift
-    return None, None, None
+def _block_diagonal(blocks):
+    """The planes' matrices as diag(A₁, A₂) (one plane: A₁ itself; None: none)."""
+    if len(blocks) == 1 or all(b is None for b in blocks):
+        return blocks[0]
+    return sp.block_diag(blocks, format="csr")
 
 
-def _check_u0(y0, lo, hi, moved, x_c) -> None:
-    """InputError when the constrained values y0 = C u0 violate [lo, hi] (shifted by
-    shift·φ(0) when ``moved`` = (shift, φ(0)))."""
-    lo0, hi0 = (lo, hi) if moved is None else (lo + moved[0] * moved[1],
-                                               hi + moved[0] * moved[1])
-    tol = 1e-12 * max(1.0, np.abs(y0).max(initial=0.0))
-    bad = (y0 < lo0 - tol) | (y0 > hi0 + tol)
-    if bad.any():
-        i = int(np.argmax(bad))
-        raise InputError(f"u0 violates the obstacles at x={x_c[i]:g}: "
-                         f"u0={y0[i]:g} not in [{lo0[i]:g}, {hi0[i]:g}]")
+def _in_block(vector: np.ndarray, plane: int, planes: int) -> np.ndarray:
+    """One plane's vector as a vector of all the unknowns (zero in the other plane)."""
+    zero = np.zeros(vector.shape[0])
+    return np.concatenate([vector if k == plane else zero for k in range(planes)])
+
+
+def _load_blocks(loads: list) -> np.ndarray:
+    """Each plane's load columns, zero in the other plane: [[L₁, 0], [0, L₂]]."""
+    return np.hstack([np.vstack([a if j == k else np.zeros_like(a) for j in range(len(loads))])
+                      for k, a in enumerate(loads)])
+
+
+def _observe(problem: BeamProblem, planes: list) -> dict:
+    """Each plane's observed rows (two planes: the names end in _v, _w), and with holes
+    the orbit (v, w) at every hole node."""
+    count, space = len(planes), planes[0].space
+    suffixes = PLANE_SUFFIXES if count == 2 else ("",)
+    observe = {f"{key}{suffix}": _in_block(row, k, count)
+               for k, (p, suffix) in enumerate(zip(planes, suffixes))
+               for key, row in p.observe.items()}
+    nodes = problem.nodes
+    for x in sorted({float(nodes[i]) for h in problem.holes
+                     for i in np.flatnonzero(h.acts_at(nodes, problem.beam.L))}):
+        ev = space.nodal[_node_of(nodes, x)].toarray().ravel()
+        for k, suffix in enumerate(suffixes):
+            observe[f"hole_{x:g}_displacement{suffix}"] = _in_block(ev, k, count)
+    return observe
+
+
+def _node_of(nodes: np.ndarray, x: float) -> int:
+    return int(np.abs(nodes - x).argmin())
+
+
+def _meta(problem: BeamProblem, planes: list) -> dict:
+    beam = problem.beam
+    meta = {"kind": "beam", "L": beam.L, "k2": beam.k2, "rho_S": beam.rho_S,
+            "element": problem.element, "J": problem.J, "problem": problem}
+    if len(planes) == 2:
+        meta.update(planes=2, k2_w=planes[1].problem.beam.k2, n_plane=planes[0].space.n)
+    return meta
+
+
+def _view(problem: BeamProblem, planes: list, lift: Lifting | None) -> SceneView:
+    """What the output needs; the lifting moves with the whole support (two planes: each
+    plane's lifting moved with its share)."""
+    beam, sup = problem.beam, problem.support
+    paper = sup if problem.planes == 1 and problem.lifting == "paper" else None
+    view = SceneView("beam", beam.L, beam.k2, paper, problem.obstacles, beam.rho_S, beam.EI,
+                     None if lift is None else replace(lift, motion=sup), planes[0].x_obs)
+    if len(planes) == 1:
+        return view
+    return replace(view, planes=2, direction=sup.direction,
+                   k2_w=planes[1].problem.beam.k2, holes=problem.holes)
+
+
+def _row_fields(problem: BeamProblem, space, rows, x_c, centres) -> dict:
+    """SemiDiscrete's per-row fields: one plane, the obstacle giving each bound; two
+    planes, the holes' (disks, lands, friction, tangent rows) and each row's node values
+    and centre (SemiDiscrete's two-plane fields)."""
+    if problem.planes == 1:
+        return {"row_obstacle": problem.obstacles.owners(x_c)}
+    nodal = [space.nodal[_node_of(problem.nodes, x)] for x in x_c]
+    row_nodes = sp.vstack([sp.vstack([rows.in_plane(e, 0), rows.in_plane(e, 1)])
+                           for e in nodal], format="csr") if nodal \
+        else sp.csr_matrix((0, 2 * rows.n))
+    return {"disks": np.array([d[:2] for d in rows.disks], dtype=np.int64).reshape(-1, 2),
+            "lands": np.array(rows.lands, dtype=float).reshape(-1, 3)
+            if any(land[0] > 0 for land in rows.lands) else None,
+            "friction": friction(rows),
+            "tangents": np.array([f[:2] for f in rows.faces], dtype=np.int64).reshape(-1, 2),
+            "row_nodes": row_nodes, "row_centres": centres}
 
 
 def _operators(problem: BeamProblem, space):

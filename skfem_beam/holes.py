@@ -293,7 +293,7 @@ class HoleAt:
     """A hole acting at the node x (``x_to`` None) or at every node of [x, x_to];
     ``carried``: it moves with the moving support (else fixed to the ground);
     ``friction``: Coulomb's μ at its wall (round holes: round-hole-friction or
-    Moreau–Jean; flat faces: round-hole-friction; broached holes: none)."""
+    Moreau–Jean; flat faces and broached holes: round-hole-friction)."""
     hole: Hole
     x: float
     x_to: float | None = None
@@ -312,10 +312,6 @@ class HoleAt:
         mu = check_finite("friction", self.friction)
         if mu < 0:
             raise InputError(f"friction={mu:g} must be ≥ 0 (Coulomb's μ)")
-        if mu > 0 and self.hole.is_broached:
-            raise InputError(f"friction={mu:g} at the {self.hole.shape} hole: friction acts "
-                             "in round holes and on flat faces (polygons, bars) here; "
-                             "broached holes (lands) are frictionless")
         object.__setattr__(self, "friction", mu)
 
     @property

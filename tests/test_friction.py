@@ -389,7 +389,7 @@ def test_a_step_that_misses_the_tolerance_stops_the_run_with_one_line():
     ("planes = 2\n[[obstacles]]\nx = 0.5\nhole = { radius = 4e-4 }\nfriction = 0.3\n"
      "[contact]\nlaw = \"round-hole\"\n", "velocity-level"),
     ("planes = 2\n[[obstacles]]\nx = 0.5\nhole = { lands = 4, land_width = 30, radius = 4e-4 }"
-     "\nfriction = 0.3\n", "frictionless"),
+     "\nfriction = 0.3\n[contact]\nlaw = \"moreau-jean\"\n", "round-hole-friction"),
     ("planes = 2\n[[obstacles]]\nx = 0.5\nhole = { sides = 3, radius = 4e-4 }\nfriction = 0.3\n"
      "[contact]\nlaw = \"moreau-jean\"\n", "round-hole-friction"),
 ])

@@ -133,3 +133,63 @@ def land_normal(pa, pb, lands, half, angle):
         return pa / rho, pb / rho
     phi = angle + step * k + (half if off > 0.0 else -half)
     return np.cos(phi), np.sin(phi)
+
+
+@njit(cache=True)
+def on_land(pa, pb, lands, half, angle):
+    """Whether p's direction lies on a land (1e-12 rad of slack)."""
+    step = 2.0 * np.pi / lands
+    off = np.arctan2(pb, pa) - angle
+    off -= step * math.floor(off / step + 0.5)
+    return abs(off) <= half + 1e-12
+
+
+
+@njit(cache=True)
+def corner_forces(mua, mub, slips, f, phis, tol):
+    """A corner's multiplier as two faces' Coulomb forces: −μ = λ₁g₁ + λ₂g₂ with
+    g_i = e_i + σ_i f t_i (e_i = e(φ_i), t_i = R e_i; σ_i = sign(s_i), either sign when
+    |s_i| ≤ tol: that face may stick).  Returns (whether some choice has λ₁, λ₂ ≥ 0,
+    λ₁, λ_t1, λ₂, λ_t2), λ_ti = −σ_i f λ_i."""
+    s1, s2 = slips
+    c1, n1, c2, n2 = np.cos(phis[0]), np.sin(phis[0]), np.cos(phis[1]), np.sin(phis[1])
+    for choice in range(4):
+        g1 = np.sign(s1) if abs(s1) > tol else (1.0 if choice % 2 == 0 else -1.0)
+        g2 = np.sign(s2) if abs(s2) > tol else (1.0 if choice < 2 else -1.0)
+        ax, ay = c1 - g1 * f * n1, n1 + g1 * f * c1
+        bx, by = c2 - g2 * f * n2, n2 + g2 * f * c2
+        det = ax * by - ay * bx
+        if det == 0.0:
+            continue
+        l1 = (-mua * by + mub * bx) / det
+        l2 = (-ax * mub + ay * mua) / det
+        if l1 >= 0.0 and l2 >= 0.0:
+            return True, l1, -g1 * f * l1, l2, -g2 * f * l2
+    return False, 0.0, 0.0, 0.0, 0.0
+
+
+@njit(cache=True)
+def land_split(mu2, p, slip, r, f, land):
+    """A broached block's multiplier μ (``mu2``) at the offset p from the centre, with the
+    step's y^{n+1} − y^{n−1} (``slip``), as its contacts' (λ_n, λ_t, s): at a lobe's
+    corner (p within 1e-9 r) two faces (corner_forces), else one with the normal
+    land_normal(p).  Returns (contacts: 1 or 2, λ_n, λ_t, s of the first, of the second)."""
+    lands, half, angle = land
+    step = 2.0 * np.pi / lands
+    off = np.arctan2(p[1], p[0]) - angle
+    k = math.floor(off / step + 0.5)
+    off -= step * k
+    if abs(off) > half:
+        phi1, phi2, delta = lobe_geometry(k if off > 0.0 else k - 1, lands, half, angle)
+        reach = r / np.cos(delta)
+        mid = 0.5 * (phi1 + phi2)
+        if np.hypot(p[0] - reach * np.cos(mid), p[1] - reach * np.sin(mid)) <= 1e-9 * r:
+            s1 = -np.sin(phi1) * slip[0] + np.cos(phi1) * slip[1]
+            s2 = -np.sin(phi2) * slip[0] + np.cos(phi2) * slip[1]
+            ok, l1, t1, l2, t2 = corner_forces(mu2[0], mu2[1], (s1, s2), f, (phi1, phi2),
+                                               1e-12 * r)
+            if ok:
+                return 2, l1, t1, s1, l2, t2, s2
+    nx, ny = land_normal(p[0], p[1], lands, half, angle)
+    return (1, -(nx * mu2[0] + ny * mu2[1]), -ny * mu2[0] + nx * mu2[1],
+            -ny * slip[0] + nx * slip[1], 0.0, 0.0, 0.0)

@@ -52,12 +52,15 @@ from numba import njit
 
 from ..errors import InputError
 from .base import ContactLaw, compiled_law
+from .lands import (PIECE_LINE, corner_forces, corner_candidate, land_excess, lobe_geometry,
+                    on_land, piece_of)
 from .round_hole import (MAX_SWEEPS, SWEEP_TOL, box_row, check_radii, contact_flags,
-                         disk_params, disk_root, kinds_of, land_cone_solve, radial, sweep_start)
+                         disk_params, disk_root, kinds_of, land_cone_solve, land_params,
+                         land_project, radial, sweep_start)
 
 internal = njit(cache=True)
 
-SEPARATE, STICK, SLIP_FORWARD, SLIP_BACKWARD, FRICTIONLESS, FALLBACK = range(6)
+SEPARATE, STICK, SLIP_FORWARD, SLIP_BACKWARD, FRICTIONLESS, FALLBACK, CORNER = range(7)
 
 
 @njit(cache=True)
@@ -178,6 +181,110 @@ def coulomb_face(D2, yj, yt, qt, lo, hi, f, out):
     return FRICTIONLESS if f == 0.0 else FALLBACK
 
 
+
+@njit(cache=True)
+def _disk_case(D2, z, q, r, f, case, out):
+    """coulomb_disk's candidate of ``case`` alone (STICK, SLIP_FORWARD, SLIP_BACKWARD),
+    μ_p into out[0:2], p into out[2:4]; returns whether its conditions hold (on a broached
+    hole's arc a later case may hold where the first one's point is off the lands)."""
+    a, b, d = D2
+    za, zb = z
+    nq = np.hypot(q[0], q[1])
+    if case == STICK:
+        pa, pb = r * q[0] / nq, r * q[1] / nq
+        det = a * d - b * b
+        ma = (d * (pa - za) - b * (pb - zb)) / det
+        mb = (-b * (pa - za) + a * (pb - zb)) / det
+        ln, lt = -(pa * ma + pb * mb) / r, (-pb * ma + pa * mb) / r
+        out[0], out[1], out[2], out[3] = ma, mb, pa, pb
+        return ln >= 0.0 and abs(lt) <= f * ln
+    g = f if case == SLIP_FORWARD else -f
+    root = np.empty(3)
+    tau = slip_root(a, b, d, za, zb, r, g, root)
+    pa, pb = root[0], root[1]
+    out[0], out[1] = -tau * (pa - g * pb), -tau * (pb + g * pa)
+    out[2], out[3] = pa, pb
+    return g * (pb * q[0] - pa * q[1]) >= 0.0
+
+
+@njit(cache=True)
+def coulomb_line(D2, z, q, r, f, piece, out):
+    """A lobe's line (``piece`` = piece_of's (kind, e_x, e_y, t_lo, t_hi)) as a face: the
+    row e·p ≤ r and its tangent row t·p (t = R e), coulomb_face's cases in that frame (each
+    on its own: with D anisotropic more than one may hold, and the segment takes the one
+    on it).  out[0:2] ← μ_p = μ_j e + μ_T t; returns the case, −1 when z does not cross
+    the line or no case holds with its point on the segment (1e-12 r of slack)."""
+    a, b, d = D2
+    _, ex, ey, t_lo, t_hi = piece
+    tx, ty = -ey, ex
+    yj = ex * z[0] + ey * z[1]
+    if yj <= r:
+        return -1
+    dex, dey, dtx, dty = a * ex + b * ey, b * ex + d * ey, a * tx + b * ty, b * tx + d * ty
+    a, b, d = ex * dex + ey * dey, tx * dex + ty * dey, tx * dtx + ty * dty
+    yt, qt = tx * z[0] + ty * z[1], tx * q[0] + ty * q[1]
+    for case in (STICK, SLIP_FORWARD, SLIP_BACKWARD):
+        if case == STICK:                   # y_j = r, y_T = q_T
+            det = a * d - b * b
+            mj, mt = (d * (r - yj) - b * (qt - yt)) / det, (-b * (r - yj) + a * (qt - yt)) / det
+            holds = -mj >= 0.0 and abs(mt) <= f * -mj
+        else:                               # λ_t = −ςμ_f λ_n: μ_T = ςμ_f μ_j
+            g = f if case == SLIP_FORWARD else -f
+            mj = (r - yj) / (a + g * b) if a + g * b > 0.0 else 0.0
+            mt = g * mj
+            holds = a + g * b > 0.0 and g * (yt + b * mj + d * mt - qt) >= 0.0
+        pt = yt + b * mj + d * mt
+        if holds and t_lo - 1e-12 * r <= pt <= t_hi + 1e-12 * r:
+            out[0], out[1] = mj * ex + mt * tx, mj * ey + mt * ty
+            return case
+    return -1
+
+
+@njit(cache=True)
+def coulomb_corner(D2, z, q, r, f, k, land, out):
+    """Lobe k's corner c as the block's point: μ_p = D⁻¹(c − z), kept (True) if it is two
+    faces' Coulomb forces (lands.corner_forces, the slips s_i = t_i·(c − q))."""
+    lands, half, angle = land
+    _, cx, cy, _, _ = piece_of(4 + 3 * k, r, lands, half, angle)
+    corner_candidate(D2[0], D2[1], D2[2], z[0], z[1], cx, cy, out)
+    phi1, phi2, _ = lobe_geometry(k, lands, half, angle)
+    s1 = -np.sin(phi1) * (cx - q[0]) + np.cos(phi1) * (cy - q[1])
+    s2 = -np.sin(phi2) * (cx - q[0]) + np.cos(phi2) * (cy - q[1])
+    return corner_forces(out[0], out[1], (s1, s2), f, (phi1, phi2), 1e-12 * r)[0]
+
+
+@njit(cache=True)
+def coulomb_lands(D2, z, q, r, f, land, out):
+    """One broached contact's μ_p into out[0:2] (module docstring): separation if z is in
+    K; else the first piece whose Coulomb law holds: the arc (coulomb_disk, its point on
+    a land), a lobe's line (coulomb_line), a lobe's corner (coulomb_corner); none: the
+    frictionless projection (land_project; FRICTIONLESS when f = 0, else FALLBACK)."""
+    lands, half, angle = land
+    if land_excess(z[0], z[1], r, lands, half, angle) <= 0.0:
+        out[0], out[1] = 0.0, 0.0
+        return SEPARATE
+    if f > 0.0:
+        case = coulomb_disk(D2, z, q, r, f, out)
+        if case != FALLBACK and on_land(out[2], out[3], lands, half, angle):
+            return case
+        for case in (STICK, SLIP_FORWARD, SLIP_BACKWARD):
+            if np.hypot(q[0], q[1]) > 0.0 and _disk_case(D2, z, q, r, f, case, out) \
+                    and on_land(out[2], out[3], lands, half, angle):
+                return case
+        for k in range(int(lands)):
+            if lobe_geometry(k, lands, half, angle)[2] <= 0.0:
+                break                            # full lands: no lobes
+            for which in range(2):
+                case = coulomb_line(D2, z, q, r, f,
+                                    piece_of(2 + 3 * k + which, r, lands, half, angle), out)
+                if case >= 0:
+                    return case
+            if coulomb_corner(D2, z, q, r, f, k, land, out):
+                return CORNER
+    land_project(D2[0], D2[1], D2[2], z[0], z[1], r, lands, half, angle, np.empty(3), out)
+    return FRICTIONLESS if f == 0.0 else FALLBACK
+
+
 @internal
 def _face_block(D, y, y_prev, lo, hi, fric, mu, j, t, local):
     """Face j's exact Coulomb block (its tangent row t) with the others fixed; returns
@@ -190,14 +297,19 @@ def _face_block(D, y, y_prev, lo, hi, fric, mu, j, t, local):
 
 
 @internal
-def _disk_block(D, y, y_prev, bounds, fric, mu, a, b, local):
-    """Disk (a, b)'s exact Coulomb block with the others fixed; returns its change."""
+def _disk_block(D, y, y_prev, bounds, fric, lands, mu, a, b, local):
+    """Disk (a, b)'s exact Coulomb block with the others fixed (a broached one's:
+    coulomb_lands; ``lands`` None: every disk round); returns its change."""
     lo, hi = bounds
     ya = y[a] - D[a, a] * mu[a] - D[a, b] * mu[b]
     yb = y[b] - D[b, a] * mu[a] - D[b, b] * mu[b]
     za, zb, _, r = radial(ya, yb, lo[a], hi[a], lo[b], hi[b])
     qa, qb, _, _ = radial(y_prev[a], y_prev[b], lo[a], hi[a], lo[b], hi[b])
-    coulomb_disk((D[a, a], D[a, b], D[b, b]), (za, zb), (qa, qb), r, fric[a], local)
+    if lands is not None and lands[a, 0] > 0.0:
+        coulomb_lands((D[a, a], D[a, b], D[b, b]), (za, zb), (qa, qb), r, fric[a],
+                      (lands[a, 0], lands[a, 1], lands[a, 2]), local)
+    else:
+        coulomb_disk((D[a, a], D[a, b], D[b, b]), (za, zb), (qa, qb), r, fric[a], local)
     return _set_pair(D, y, mu, a, b, local)
 
 
@@ -214,11 +326,12 @@ def _set_pair(D, y, mu, a, b, local):
 
 
 @internal
-def friction_cone_solve(D, yf, y_prev, lo, hi, kind, fric, mu, active, tangent):
+def friction_cone_solve(D, yf, y_prev, lo, hi, kind, fric, mu, active, tangent, lands):
     """The step's μ for boxes, faces and round disks with Coulomb friction ``fric`` (per
     disk first row and face row; ``kind`` as round_hole.cone_solve's, a face's tangent
     row −1; ``tangent[j]`` a face j's tangent row, −1 none; ``y_prev`` = C u^{n−1}, the
-    slip's reference).  Returns the sweeps (< 0: no convergence)."""
+    slip's reference; ``lands`` as land_cone_solve's, None: every disk round).  Returns
+    the sweeps (< 0: no convergence)."""
     m = yf.size
     y, scale, blocks = sweep_start(yf, lo, hi, kind, mu)
     local = np.empty(4)
@@ -231,8 +344,8 @@ def friction_cone_solve(D, yf, y_prev, lo, hi, kind, fric, mu, active, tangent):
             elif kind[j] == 0:
                 change = max(change, box_row(D, y, lo, hi, mu, j))
             elif kind[j] > 0:
-                change = max(change, _disk_block(D, y, y_prev, (lo, hi), fric, mu, j,
-                                                 kind[j], local))
+                change = max(change, _disk_block(D, y, y_prev, (lo, hi), fric, lands, mu,
+                                                 j, kind[j], local))
         if blocks == 1 or change <= SWEEP_TOL * scale:
             break
     else:
@@ -262,6 +375,20 @@ def friction_rows(params, m):
     return kind, fric, tangent
 
 
+@internal
+def friction_lands(params, m):
+    """land_cone_solve's ``lands`` from the broached kernel's params: friction_rows' then
+    3 numbers per disk (lands, half width, angle; round_hole.land_params)."""
+    lands = np.zeros((m, 3))
+    q = int(params[0])
+    at = 2 + 3 * q + 3 * int(params[1 + 3 * q])
+    for p in range(q):
+        a = int(params[1 + 2 * p])
+        for c in range(3):
+            lands[a, c] = params[at + 3 * p + c]
+    return lands
+
+
 @compiled_law
 def round_hole_friction_kernel(D, yf, y_cur, y_prev, lo, hi, params, state, mu, active):
     m = yf.size
@@ -269,9 +396,22 @@ def round_hole_friction_kernel(D, yf, y_cur, y_prev, lo, hi, params, state, mu, 
     for j in range(m):
         if fric[j] > 0.0:
             return friction_cone_solve(D, yf, y_prev, lo, hi, kind, fric, mu, active,
-                                       tangent)
+                                       tangent, None)
     # no friction anywhere: the frictionless law's own solve (the same numbers)
     return land_cone_solve(D, yf, lo, hi, kind, None, mu, active)
+
+
+@compiled_law
+def broached_friction_kernel(D, yf, y_cur, y_prev, lo, hi, params, state, mu, active):
+    m = yf.size
+    kind, fric, tangent = friction_rows(params, m)
+    lands = friction_lands(params, m)
+    for j in range(m):
+        if fric[j] > 0.0:
+            return friction_cone_solve(D, yf, y_prev, lo, hi, kind, fric, mu, active,
+                                       tangent, lands)
+    # no friction anywhere: the broached round-hole law's own solve (the same numbers)
+    return land_cone_solve(D, yf, lo, hi, kind, lands, mu, active)
 
 
 class RoundHoleFriction(ContactLaw):
@@ -285,9 +425,6 @@ class RoundHoleFriction(ContactLaw):
 
     def setup(self, step, first=False):
         check_radii(step)
-        if step.lands.size and np.any(step.lands[:, 0] > 0):
-            raise InputError("the round-hole-friction law takes round holes and flat faces; "
-                             "broached holes (lands) need the round-hole law (frictionless)")
         fric = np.asarray(step.friction, dtype=float)
         if fric.size == 0:
             fric = np.zeros(step.lo.size)
@@ -295,6 +432,11 @@ class RoundHoleFriction(ContactLaw):
         if np.any(np.delete(fric, np.concatenate([step.disks[:, 0], tangents[:, 0]])) > 0):
             raise InputError("Coulomb friction acts at round holes and at a hole's faces "
                              "(with their tangent rows) only")
-        return np.concatenate([disk_params(step.disks), fric[step.disks[:, 0]],
-                               [float(tangents.shape[0])], tangents.ravel().astype(float),
-                               fric[tangents[:, 0]]])
+        params = np.concatenate([disk_params(step.disks), fric[step.disks[:, 0]],
+                                 [float(tangents.shape[0])], tangents.ravel().astype(float),
+                                 fric[tangents[:, 0]]])
+        if step.lands.size and np.any(step.lands[:, 0] > 0):
+            self.kernel = broached_friction_kernel    # round holes only: no lands' code
+            return np.concatenate([params, land_params(step.lands)])
+        self.kernel = round_hole_friction_kernel
+        return params

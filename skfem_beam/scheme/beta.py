@@ -129,10 +129,10 @@ def land_rows(system) -> np.ndarray:
 
 
 def refuse_lands(system, law: str) -> None:
-    """One line when ``law`` meets a broached hole (the round-hole law's alone)."""
+    """One line when ``law`` meets a broached hole (the round-hole laws' alone)."""
     if np.any(land_rows(system)[:, 0] > 0):
         raise InputError(f"broached holes (lands) need the exact round-hole law (solver "
-                         f"auto or round-hole), not {law}")
+                         f"auto, round-hole or round-hole-friction), not {law}")
 
 
 def hole_arrays(system):
@@ -236,7 +236,7 @@ class BetaScheme:
             raise InputError(f"Coulomb friction needs law = round-hole-friction (or auto: "
                              f"exact contact at position level) or moreau-jean (a "
                              f"velocity-level law), not {law.name}")
-        if law.name != "round-hole":
+        if law.name not in ("round-hole", "round-hole-friction"):
             refuse_lands(system, f"the {law.name} law")
         if self.step.disks.size and not law.round_holes:
             raise InputError(f"the {law.name} law takes flat faces only; round holes need "

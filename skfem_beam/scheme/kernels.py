@@ -24,7 +24,7 @@ from collections import namedtuple
 import numpy as np
 from numba import njit, objmode, types
 
-from ..contact.lands import land_excess, land_normal
+from ..contact.lands import land_excess, land_normal, land_split
 from ..linalg import band_solve, csr_product, rows_dot, rows_matvec
 
 Ops = namedtuple("Ops", [
@@ -409,6 +409,23 @@ def friction_split(mu, dy, at, work, rowwork, ev, a, b, dt):
     _to_friction(ta * mu[a] + tb * mu[b], ta * dy[a] + tb * dy[b], work, rowwork, ev, a, dt)
 
 
+@njit(cache=True)
+def land_friction_split(ops, st, a, dt):
+    """friction_split for a broached hole's pair (a, pair[a]): its contacts' (one, two at
+    a lobe's corner: contact.lands.land_split) tangential work ½ λ_t s/Δt² moves from the
+    contact's column to the friction's."""
+    b = ops.pair[a]
+    if st.mu[a] == 0.0 and st.mu[b] == 0.0:
+        return
+    p = (st.y_cur[a] - 0.5 * (st.lo[a] + st.hi[a]), st.y_cur[b] - 0.5 * (st.lo[b] + st.hi[b]))
+    count, _, t1, s1, _, t2, s2 = land_split(
+        (st.mu[a], st.mu[b]), p, (st.dy[a], st.dy[b]), 0.5 * (st.hi[a] - st.lo[a]),
+        ops.Nc[a, FRICTION_COLUMN], (ops.Nc[a, 6], ops.Nc[a, 7], ops.Nc[a, 8]))
+    _to_friction(t1, s1, st.work, st.rowwork, st.impact[a], a, dt)
+    if count == 2:
+        _to_friction(t2, s2, st.work, st.rowwork, st.impact[a], a, dt)
+
+
 @njit(cache=True, inline="always")
 def face_friction_split(mu, dy, work, rowwork, ev, t, dt):
     """friction_split for a face with friction: its tangent row t's work ½ μ_t s/Δt²
@@ -445,7 +462,9 @@ def hole_kinematics(ops, st, step, dt, p):
     for j in range(st.active.size):
         if ops.pair[j] < 0:
             continue
-        if ops.pair[j] > 0 and ops.Nc[j, FRICTION_COLUMN] > 0.0:
+        if ops.pair[j] > 0 and ops.Nc[j, FRICTION_COLUMN] > 0.0 and ops.Nc[j, 6] > 0.0:
+            land_friction_split(ops, st, j, dt)
+        elif ops.pair[j] > 0 and ops.Nc[j, FRICTION_COLUMN] > 0.0:
             friction_split(st.mu, st.dy, (st.y_cur, st.lo, st.hi), st.work, st.rowwork,
                            st.impact[j], j, ops.pair[j], dt)
         elif ops.Nc[j, FRICTION_COLUMN] > 0.0:     # a face with friction

@@ -44,11 +44,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 import scipy.sparse as sp
 
-from . import methods
-from .errors import InputError
-from .checks import check_choice, check_count, check_finite, check_nonnegative, check_positive
-from .semidiscrete import SceneView, SemiDiscrete
-from .spaces.lagrange import MASSES, LagrangeSpace
+from .. import methods
+from ..errors import InputError
+from ..checks import check_choice, check_count, check_finite, check_nonnegative, check_positive
+from ..semidiscrete import SceneView, SemiDiscrete
+from ..spaces.lagrange import MASSES, LagrangeSpace
 
 OBSTACLES = ("rigid", "elastic")
 FAR_ENDS = ("free", "clamped")
@@ -289,7 +289,7 @@ def bar_system(bar: Bar) -> SemiDiscrete:
               "far_end": bar.far_end, "obstacle_at": bar.obstacle_at, "A": bar.A},
         view=SceneView("bar", bar.L))
     if bar.mass == "redistributed":      # no inertia at the contact node (modified mass)
-        from .spaces.redistribution import redistributed
+        from ..spaces.redistribution import redistributed
         system = redistributed(system)
     return system
 
@@ -391,7 +391,7 @@ def bar_run(bar: Bar, dt: float, T: float, beta: float = 0.25, method="contact",
     tₙ comes from step n + 1) and keeps every state as a frame when there are at most
     ``all_states_limit`` values (the energy split needs them); else ``frames`` frames.
     """
-    from .scheme import Stepping
+    from ..scheme import Stepping
     method = bar_method(bar, method, **words)
     system = bar_system(bar)
     to_T = Stepping(dt, T, beta, massless=method.massless)   # the checks of Δt, T, β
@@ -502,7 +502,7 @@ def run_bar(bar: Bar, dt: float, T: float, beta: float = 0.25, method: str = "co
             solver: str = "auto", all_states_limit: int = 4_000_000,
             massless: str = "beta") -> BarRun:
     """Integrate the bar with the shared scheme (:func:`bar_run`, driven to its end)."""
-    from .scheme import drive
+    from ..scheme import drive
     run = bar_run(bar, dt, T, beta, method, solver=solver,
                   all_states_limit=all_states_limit, massless=massless)
     drive(run)

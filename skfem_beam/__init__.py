@@ -7,12 +7,12 @@ if _sys.argv[:1] == ["-m"]:   # a command starting (runpy is importing it): Ctrl
 from .errors import InputError, SolverError
 from .modes import Modes, modes
 from .problem import (Beam, BeamProblem, Damping, InitialState, Load, Material, Obstacles,
-                      Section, Support)
+                      Plane, Section, Support)
 from .results import SavedRun, read_run
 from .scheme import Result, Stepping, solve
 from .semidiscrete import SemiDiscrete, beam_system
 from ._version import __version__
 
 __all__ = ["Beam", "BeamProblem", "Damping", "InitialState", "InputError", "Load",
-           "Material", "Modes", "Obstacles", "Result", "SavedRun", "Section", "SemiDiscrete",
+           "Material", "Modes", "Obstacles", "Plane", "Result", "SavedRun", "Section", "SemiDiscrete",
            "SolverError", "Stepping", "Support", "beam_system", "modes", "read_run", "solve"]

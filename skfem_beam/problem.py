@@ -512,6 +512,14 @@ class InitialState:
 
 
 @dataclass(frozen=True)
+class Plane:
+    """The second bending plane's load and initial state (``BeamProblem.second``, two
+    planes); ``initial`` None: at rest, in the frame the first plane's initial state says."""
+    load: Load = field(default_factory=Load)
+    initial: InitialState | None = None
+
+
+@dataclass(frozen=True)
 class BeamProblem:
     """A beam scene: beam, support motion, obstacles, load and initial state, on a mesh.
 
@@ -521,10 +529,10 @@ class BeamProblem:
     The defaults are the papers' beam, clamped at 0 and free at L.
 
     ``planes``: 1 (the papers' transverse u) or 2 (displacements v, w in two bending
-    planes, the second with the beam's ``k2_w``): then ``load`` acts in the first plane
-    and ``load_w`` in the second, ``obstacles`` (flat, g1 ≤ v ≤ g2) in the first, the
-    support moves along ``support.direction``, ``initial`` is the first plane's (the
-    second starts at rest, in the frame ``initial.fixed_frame`` says), and ``holes``
+    planes, the second with the beam's ``k2_w``): then ``load`` and ``initial`` are the
+    first plane's and ``second`` (:class:`Plane`) the second's load and initial state
+    (:meth:`plane` gives plane k's), ``obstacles`` (flat, g1 ≤ v ≤ g2) act in the first,
+    the support moves along ``support.direction``, and ``holes``
     (:class:`~skfem_beam.holes.HoleAt`) bound (v, w) at their nodes.
     """
     beam: Beam
@@ -540,7 +548,7 @@ class BeamProblem:
     damping: Damping = field(default_factory=Damping)
     planes: int = 1
     holes: tuple = ()
-    load_w: Load = field(default_factory=Load)
+    second: Plane = field(default_factory=Plane)
 
     def __post_init__(self):
         object.__setattr__(self, "ends", check_ends(self.ends))
@@ -576,7 +584,7 @@ class BeamProblem:
                                  f"node {d:.3g} m away); choose J or nodes so that it is one")
         self._check_load()
         if self.planes == 2:
-            self._check_load(self.load_w)
+            self._check_load(self.second.load)
         J = self.nodes.size - 1
         value_fixed, slope_fixed = fixed_dofs(J, self.ends,
                                               support_nodes(self.nodes, self.supports))
@@ -605,13 +613,19 @@ class BeamProblem:
             raise InputError(f"planes={self.planes!r} must be 1 or 2 (bending planes)")
         if self.planes == 1:
             given = [name for name, bad in (
-                ("holes", bool(self.holes)), ("load_w", self.load_w != Load()),
+                ("holes", bool(self.holes)),
+                ("a second plane's load or initial state", self.second != Plane()),
                 ("a support direction", self.support.direction != (1.0, 0.0))) if bad]
             if given:
                 raise InputError(f"{', '.join(given)} need planes = 2 (the beam bends in one "
                                  "plane here)")
             return
         self.beam.plane_w()          # a stepped beam must bend alike in both planes
+        sec = self.second
+        if not (isinstance(sec, Plane) and isinstance(sec.load, Load) and
+                isinstance(sec.initial, (InitialState, type(None)))):
+            raise InputError(f"second={sec!r} must be a Plane(load=Load(...), "
+                             "initial=InitialState(...) or None)")
         if self.element not in ("hermite", "bspline"):
             raise InputError(f"element={self.element!r}: two planes take hermite or bspline")
         from .holes import HoleAt
@@ -622,6 +636,17 @@ class BeamProblem:
             for b in h.breakpoints:
                 if not 0.0 <= b <= self.beam.L:
                     raise InputError(f"hole at x={b:g} lies outside [0, L={self.beam.L:g}]")
+
+    def plane(self, k: int) -> tuple[Load, InitialState]:
+        """Plane k's (load, initial state): k = 0 ``load``, ``initial``; k = 1 ``second``'s
+        (its initial None: at rest, in the frame ``initial.fixed_frame`` says)."""
+        if k == 0:
+            return self.load, self.initial
+        if k != 1 or self.planes != 2:
+            raise InputError(f"plane {k!r}: this problem has planes 0..{self.planes - 1}")
+        ini = self.second.initial
+        return self.second.load, (InitialState(fixed_frame=self.initial.fixed_frame)
+                                  if ini is None else ini)
 
     @property
     def hole_breakpoints(self) -> tuple[float, ...]:

@@ -81,10 +81,11 @@ SECTION_DOCS = {
         '(amplitude·cos(ωt + phase) along y, ·sin along z). Bar: `value` (a body force, N/m³)'
     ),
     'initial': (
-        "(two planes: the first plane's; w starts at rest) `mode = k`, `amplitude` (u0 = "
-        'amplitude × the k-th mode shape, its largest \\|u\\| 1) or `u0 = {x = [...], u = '
-        '[...]}` (cubic spline; bar: linear, or a number), `v0 = {x, v}`; beams read them in '
-        'the fixed frame (ũ, ũ_t) unless `fixed_frame = false`: no `[initial]` is at rest'
+        '`mode = k`, `amplitude` (u0 = amplitude × the k-th mode shape, its largest \\|u\\| 1) '
+        'or `u0 = {x = [...], u = [...]}` (cubic spline; bar: linear, or a number), `v0 = {x, '
+        "v}`; two planes: these are the first plane's, `u0_w = {x, u}`, `v0_w = {x, v}` the "
+        "second's (without them w starts at rest); beams read them in the fixed frame (ũ, "
+        'ũ_t) unless `fixed_frame = false`: no `[initial]` is at rest'
     ),
     'mesh': (
         '`J`, `element = "hermite"\\|"bspline"`, `nodes = [...]` (non-uniform), `mass = '

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from .problem import InitialState, Load, Obstacles, Support
+from .problem import Obstacles, Plane, Support
 from .timefunctions import Scaled
 
 
@@ -43,14 +43,16 @@ def along(support: Support, share: float) -> Support:
 
 def plane_problems(problem) -> tuple:
     """The one-plane problems of a BeamProblem's planes: (problem,) for one plane; two
-    planes (pv, pw), each with its own bending stiffness, loads and share of the
-    support's motion (the flat obstacles act in the first; the holes are the caller's)."""
+    planes (pv, pw), each with its own bending stiffness, load, initial state
+    (``problem.plane(k)``) and share of the support's motion (the flat obstacles act in
+    the first; the holes are the caller's)."""
     if problem.planes == 1:
         return (problem,)
     dy, dz = problem.support.direction
-    one = dict(planes=1, holes=(), load_w=Load())
-    pv = replace(problem, **one, support=along(problem.support, dy))
-    pw = replace(problem, **one, load=problem.load_w, obstacles=Obstacles(),
-                 beam=problem.beam.plane_w(), support=along(problem.support, dz),
-                 initial=InitialState(fixed_frame=problem.initial.fixed_frame))
+    one = dict(planes=1, holes=(), second=Plane())
+    (load_v, initial_v), (load_w, initial_w) = problem.plane(0), problem.plane(1)
+    pv = replace(problem, **one, load=load_v, initial=initial_v,
+                 support=along(problem.support, dy))
+    pw = replace(problem, **one, load=load_w, initial=initial_w, obstacles=Obstacles(),
+                 beam=problem.beam.plane_w(), support=along(problem.support, dz))
     return pv, pw

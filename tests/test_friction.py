@@ -13,7 +13,7 @@ from conftest import exit_code, resumed
 from skfem_beam import methods
 from skfem_beam.contact.friction import DRIFT, coulomb, nsgs
 from skfem_beam.holes import Hole, HoleAt
-from skfem_beam.problem import (Beam, BeamProblem, Damping, Load, Material, Section)
+from skfem_beam.problem import (Beam, BeamProblem, Damping, Load, Material, Plane, Section)
 from skfem_beam.scenefile import example, run_main
 from skfem_beam.scheme import Stepping, solve
 from skfem_beam.scheme import Run
@@ -31,7 +31,7 @@ def flow(mu, J=30, damping=Damping.ratio(0.02, 20.0, 200.0)):
                        holes=(HoleAt(Hole.round(R), 0.5, friction=mu),
                               HoleAt(Hole.round(R), 1.0, friction=mu)),
                        load=Load.distributed(1.0, Sine(300.0, 2 * np.pi * 30, np.pi / 2)),
-                       load_w=Load.distributed(1.0, Sine(300.0, 2 * np.pi * 23)))
+                       second=Plane(load=Load.distributed(1.0, Sine(300.0, 2 * np.pi * 23))))
 
 
 def test_the_cone_holds_and_slip_dissipates_at_every_step():
@@ -71,7 +71,8 @@ def test_the_tube_sticks_until_the_pull_reaches_mu_times_the_static_normal_force
     scene = BeamProblem(TUBE, J=10, ends=("pinned", "pinned"), planes=2,
                         damping=Damping(alpha=100.0),
                         holes=(HoleAt(Hole.round(R), 0.75, friction=mu),),
-                        load=Load.point(0.75, P), load_w=Load(points=((0.75, Pull()),)))
+                        load=Load.point(0.75, P),
+                        second=Plane(load=Load(points=((0.75, Pull()),))))
     system = beam_system(scene)
     n = system.meta["n_plane"]
     e = system.C[0, :n].toarray().ravel()
@@ -104,7 +105,7 @@ def test_mu_zero_is_the_frictionless_run_bit_for_bit():
     plain = BeamProblem(TUBE, J=30, ends=("pinned", "pinned"), planes=2,
                         damping=Damping.ratio(0.02, 20.0, 200.0),
                         holes=(HoleAt(Hole.round(R), 0.5), HoleAt(Hole.round(R), 1.0)),
-                        load=flow(0.0).load, load_w=flow(0.0).load_w)
+                        load=flow(0.0).load, second=flow(0.0).second)
     ref = solve(beam_system(plain), 1e-4, 0.2, method=methods.MoreauJean())
     assert zero.impacts == ref.impacts > 3 and "friction" not in zero.work
     assert np.array_equal(zero.energy, ref.energy)

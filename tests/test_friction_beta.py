@@ -11,7 +11,7 @@ from skfem_beam import methods
 from skfem_beam.contact.round_hole_friction import (SEPARATE, SLIP_BACKWARD, SLIP_FORWARD,
                                                     STICK, RoundHoleFriction, coulomb_disk)
 from skfem_beam.holes import Hole, HoleAt
-from skfem_beam.problem import Beam, BeamProblem, Damping, Load, Material, Section
+from skfem_beam.problem import Beam, BeamProblem, Damping, Load, Material, Plane, Section
 from skfem_beam.scenefile import example, load
 from skfem_beam.scheme import Run, Stepping, solve
 from skfem_beam.scheme.beta import BetaScheme
@@ -92,7 +92,7 @@ def whirl(mu, damping=Damping()):
     return BeamProblem(TUBE, J=10, ends=("pinned", "pinned"), planes=2, damping=damping,
                        holes=(HoleAt(Hole.round(R), 0.75, friction=mu),),
                        load=Load.distributed(20.0, Sine(1.0, 2 * np.pi * 15, np.pi / 2)),
-                       load_w=Load.distributed(20.0, Sine(1.0, 2 * np.pi * 15)))
+                       second=Plane(load=Load.distributed(20.0, Sine(1.0, 2 * np.pi * 15))))
 
 
 def test_mu_zero_is_the_frictionless_round_hole_run_bit_for_bit():
@@ -145,7 +145,7 @@ def test_the_tube_sticks_until_the_pull_reaches_mu_times_the_static_normal_force
                                      damping=Damping(alpha=100.0),
                                      holes=(HoleAt(Hole.round(R), 0.75, friction=mu),),
                                      load=Load.point(0.75, P),
-                                     load_w=Load(points=((0.75, Pull()),))))
+                                     second=Plane(load=Load(points=((0.75, Pull()),)))))
     n = system.meta["n_plane"]
     e = system.C[0, :n].toarray().ravel()
     T_star = mu * (P - TUBE.rho_S * R / (e @ np.linalg.solve(system.K[:n, :n].toarray(), e)))

@@ -15,7 +15,7 @@ from skfem_beam.contact.lands import land_split
 from skfem_beam.contact.round_hole_friction import (CORNER, FALLBACK, FRICTIONLESS, SEPARATE,
                                                     RoundHoleFriction, coulomb_lands)
 from skfem_beam.holes import Hole, HoleAt, land_excess
-from skfem_beam.problem import Beam, BeamProblem, Damping, Load, Material, Section
+from skfem_beam.problem import Beam, BeamProblem, Damping, Load, Material, Plane, Section
 from skfem_beam.scenefile import example, load
 from skfem_beam.scheme import Run, Stepping, solve
 from skfem_beam.scheme.beta import BetaScheme
@@ -34,7 +34,7 @@ def whirl(mu, hole):
     return BeamProblem(TUBE, J=10, ends=("pinned", "pinned"), planes=2, damping=Damping(),
                        holes=(HoleAt(hole, 0.75, friction=mu),),
                        load=Load.distributed(20.0, Sine(1.0, 2 * np.pi * 15, np.pi / 2)),
-                       load_w=Load.distributed(20.0, Sine(1.0, 2 * np.pi * 15)))
+                       second=Plane(load=Load.distributed(20.0, Sine(1.0, 2 * np.pi * 15))))
 
 
 def orbit(result, x=0.75):

@@ -16,7 +16,7 @@ from skfem_beam.contact.round_hole_friction import (FALLBACK, SEPARATE, SLIP_BAC
                                                     coulomb_face)
 from skfem_beam.errors import InputError
 from skfem_beam.holes import Hole, HoleAt
-from skfem_beam.problem import Beam, BeamProblem, Damping, Load, Material, Section
+from skfem_beam.problem import Beam, BeamProblem, Damping, Load, Material, Plane, Section
 from skfem_beam.scenefile import example, load, run_main
 from skfem_beam.scheme import Run, Stepping, solve
 from skfem_beam.scheme.beta import BetaScheme
@@ -99,7 +99,7 @@ def whirl(mu, sides=4, damping=Damping()):
     return BeamProblem(TUBE, J=10, ends=("pinned", "pinned"), planes=2, damping=damping,
                        holes=(HoleAt(Hole.regular(sides, R), 0.75, friction=mu),),
                        load=Load.distributed(20.0, Sine(1.0, 2 * np.pi * 15, np.pi / 2)),
-                       load_w=Load.distributed(20.0, Sine(1.0, 2 * np.pi * 15)))
+                       second=Plane(load=Load.distributed(20.0, Sine(1.0, 2 * np.pi * 15))))
 
 
 @pytest.mark.parametrize("sides", [4, 6])
@@ -199,7 +199,7 @@ def test_the_tube_sticks_on_a_face_until_the_pull_reaches_mu_times_the_normal_fo
                                      damping=Damping(alpha=1000.0),
                                      holes=(HoleAt(Hole.regular(4, R), 0.75, friction=mu),),
                                      load=Load.point(0.75, P),
-                                     load_w=Load(points=((0.75, Pull()),))))
+                                     second=Plane(load=Load(points=((0.75, Pull()),)))))
     n = system.meta["n_plane"]
     e = system.C[0, :n].toarray().ravel()
     T_star = mu * (P - TUBE.rho_S * R / (e @ np.linalg.solve(system.K[:n, :n].toarray(), e)))

@@ -159,6 +159,23 @@ def test_initial_mode_is_the_mode_shape_scaled_to_its_amplitude(tmp_path):
     assert np.abs(s.u0 - v).max() < 1e-15 and not s.v0.any()
 
 
+def test_initial_u0_w_v0_w_start_the_second_plane(tmp_path):
+    """[initial] u0_w, v0_w are the second plane's start (two planes), read as u0, v0 are:
+    the same tables give w the start of v; without them w starts at rest."""
+    u0 = "{ x = [0.0, 0.5, 1.0, 1.501], u = [0.0, 0.0001, 0.0003, 0.0002] }"
+    v0 = "{ x = [0.0, 0.75, 1.501], v = [0.0, 0.001, 0.002] }"
+    two = PIPE.replace('kind = "beam"', 'kind = "beam"\nplanes = 2')
+    both = load(write(tmp_path, two + f"[initial]\nu0 = {u0}\nv0 = {v0}\nu0_w = {u0}\n"
+                      f"v0_w = {v0}\n")).problem
+    s = beam_system(both)
+    n = s.meta["n_plane"]
+    assert np.abs(s.u0).max() > 0 and np.abs(s.v0).max() > 0
+    assert np.array_equal(s.u0[:n], s.u0[n:]) and np.array_equal(s.v0[:n], s.v0[n:])
+    first = beam_system(load(write(tmp_path, two + f"[initial]\nu0 = {u0}\nv0 = {v0}\n",
+                                   "v_only.toml")).problem)
+    assert np.array_equal(first.u0[:n], s.u0[:n]) and not first.u0[n:].any()
+
+
 def test_modes_command_prints_and_writes_the_cantilever_frequencies(tmp_path, capsys):
     out = tmp_path / "m"
     assert exit_code(modes_main, [str(example("point_stops")), "--n", "3", "--out",
@@ -221,6 +238,9 @@ BAD = {
     "unknown key": (PIPE.replace("L = 1.501", "L = 1.501\nwidth = 3"), "'geometry.width'"),
     "unknown section": (PIPE + "[solver]\nx = 1\n", "'solver'"),
     "malformed TOML": (PIPE + "[time\n", "not valid TOML"),
+    "second plane's start in one plane": (
+        PIPE + "[initial]\nu0_w = { x = [0.0, 1.501], u = [0.0, 0.001] }\n",
+        "[initial] u0_w start the second plane: they need planes = 2"),
     "table t not increasing": (PIPE + '[motion]\nend = "left"\ntable = "phi.csv"\n',
                                "t is not increasing at row 4"),
 }
@@ -556,6 +576,8 @@ g2 = { poly = [0.01, 0.001], about = 1.25 }
 [initial]
 u0 = { x = [0.0, 0.5, 1.0, 1.5], u = [0.0, 0.0001, 0.0002, 0.0003] }
 v0 = { x = [0.0, 0.75, 1.5], v = [0.0, 0.001, 0.002] }
+u0_w = { x = [0.0, 0.75, 1.5], u = [0.0, -0.0001, 0.0] }
+v0_w = { x = [0.0, 0.5, 1.0, 1.5], v = [0.0, 0.001, 0.0, 0.0] }
 [mesh]
 nodes = [0.0, 0.25, 0.5, 0.75, 1.0, 1.25, 1.5]
 [time]

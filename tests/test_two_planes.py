@@ -13,8 +13,9 @@ from skfem_beam import methods
 from skfem_beam.methods import PositionLevel
 from skfem_beam.contact.round_hole import cone_solve, disk_kinds, disk_root
 from skfem_beam.holes import Hole, HoleAt
-from skfem_beam.problem import (Beam, BeamProblem, Damping, Load, Material, Obstacles,
-                                Section)
+from skfem_beam.errors import InputError
+from skfem_beam.problem import (Beam, BeamProblem, Damping, InitialState, Load, Material,
+                                Obstacles, Plane, Section)
 from skfem_beam.reference import whirl_force
 from skfem_beam.scenefile import example, run_main
 from skfem_beam.scheme import Run, Stepping, solve
@@ -26,8 +27,8 @@ TUBE = Beam.physical(1.5, Material(2e11, 8000.0), Section.tube(0.01905, 0.00165)
 R = 4e-4          # the holes' radial clearance (m)
 
 
-def tube(planes=2, holes=(), load=Load(), load_w=Load(), J=30, **kw):
-    return BeamProblem(TUBE, load=load, load_w=load_w, J=J, ends=("pinned", "pinned"),
+def tube(planes=2, holes=(), load=Load(), second=Plane(), J=30, **kw):
+    return BeamProblem(TUBE, load=load, second=second, J=J, ends=("pinned", "pinned"),
                        planes=planes, holes=holes, **kw)
 
 
@@ -52,13 +53,40 @@ def test_a_square_hole_loaded_in_one_plane_is_the_one_plane_run(element):
     assert r2.energy[-1] == pytest.approx(r1.energy[-1], rel=1e-12)
 
 
+def test_the_second_plane_started_as_the_first_moves_as_the_first():
+    """A round tube, free of obstacles and support motion, with w started as v (u0 and v0
+    given, BeamProblem.second): w(t) is v(t), and both are the one-plane run, to round-off."""
+    L = TUBE.L
+    start = InitialState(lambda x: 1e-3 * np.sin(np.pi * x / L) * (1 + x),
+                         lambda x: 0.05 * np.sin(2 * np.pi * x / L))
+    assert TUBE.plane_w().k2 == TUBE.k2
+    one = tube(1, initial=start)
+    two = tube(2, initial=start, second=Plane(initial=start))
+    assert two.plane(1) == (Load(), start)
+    r1, r2 = solve(beam_system(one), 1e-4, 0.1), solve(beam_system(two), 1e-4, 0.1)
+    u, n = r1.frames_u, r2.system.meta["n_plane"]
+    v, w = r2.frames_u[:, :n], r2.frames_u[:, n:]
+    scale = np.abs(u).max()
+    assert scale > 1e-4 and u.shape == v.shape == w.shape
+    assert np.abs(w - v).max() <= 1e-13 * scale         # measured: 0
+    assert np.abs(v - u).max() <= 1e-13 * scale         # measured: 0
+    assert r2.energy[-1] == pytest.approx(2 * r1.energy[-1], rel=1e-12)
+    at_rest = solve(beam_system(tube(2, initial=start)), 1e-4, 0.1)
+    assert np.abs(at_rest.frames_u[:, n:]).max() == 0.0    # without second: w at rest
+
+
+def test_a_second_plane_needs_two_planes():
+    with pytest.raises(InputError, match="second plane.s load or initial state need planes = 2"):
+        tube(1, second=Plane(initial=InitialState(lambda x: 0 * x)))
+
+
 # ---------------------------------------------------------------- the whirl in a round hole
 def whirl_problem(q=20.0, omega=2 * np.pi * 15, damping=Damping(alpha=60.0, alpha_K=2e-4)):
     """A rotating distributed force q·(cos ωt, sin ωt) N/m on the tube, one round hole
     at mid-span (J = 10): it reaches the wall three times over and whirls on it."""
     return tube(holes=(HoleAt(Hole.round(R), 0.75),), J=10, damping=damping,
                 load=Load.distributed(q, Sine(1.0, omega, np.pi / 2)),
-                load_w=Load.distributed(q, Sine(1.0, omega)))
+                second=Plane(load=Load.distributed(q, Sine(1.0, omega))))
 
 
 def test_a_round_hole_is_never_penetrated_under_a_rotating_force():
@@ -85,7 +113,7 @@ def test_the_steady_whirl_has_the_contact_force_of_the_discrete_steady_state():
 def test_energy_identity_closes_with_impacts_in_both_planes():
     scene = tube(holes=(HoleAt(Hole.round(R), 0.5), HoleAt(Hole.regular(3, R), 1.0)),
                  load=Load.distributed(1.0, Sine(300.0, 2 * np.pi * 30)),
-                 load_w=Load.distributed(1.0, Sine(200.0, 2 * np.pi * 23)),
+                 second=Plane(load=Load.distributed(1.0, Sine(200.0, 2 * np.pi * 23))),
                  damping=Damping.ratio(0.02, 20.0, 200.0))
     r = solve(beam_system(scene), 1e-4, 0.5)
     ev = r.impact_events
@@ -104,7 +132,7 @@ def recorded_problems(count=40):
     scene = BeamProblem(beam, ends=("pinned", "pinned"), J=30, planes=2,
                         holes=(HoleAt(Hole.round(R), 0.45, 0.55), HoleAt(Hole.round(R), 1.0)),
                         load=Load.distributed(1.0, Sine(900.0, 2 * np.pi * 30, np.pi / 2)),
-                        load_w=Load.distributed(1.0, Sine(900.0, 2 * np.pi * 30)))
+                        second=Plane(load=Load.distributed(1.0, Sine(900.0, 2 * np.pi * 30))))
     run = Run(BetaScheme(beam_system(scene), Stepping(1e-4, 0.2)))
     kind = disk_kinds(run.st.yf.size, run.scheme.step.disks)
     out = []
@@ -185,7 +213,7 @@ def push_problem(hole):
     th = 0.35
     return tube(holes=(HoleAt(hole, 0.75),), J=10,
                 load=Load.distributed(30.0 * np.cos(th), Sine(1.0, 2 * np.pi * 10)),
-                load_w=Load.distributed(30.0 * np.sin(th), Sine(1.0, 2 * np.pi * 10)))
+                second=Plane(load=Load.distributed(30.0 * np.sin(th), Sine(1.0, 2 * np.pi * 10))))
 
 
 def test_ngons_converge_to_the_round_hole_at_second_order():

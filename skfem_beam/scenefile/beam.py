@@ -1,6 +1,6 @@
 """A beam scene's parsed keys → a BeamProblem: the beam ([material] with [section],
 [mass_normalised] or [[segments]], [mass] added), its ends, supports, obstacles, motion,
-loads, [damping] and [initial] state."""
+loads, [damping] and [initial] state (two planes: each plane's load and start)."""
 from __future__ import annotations
 
 import math
@@ -9,7 +9,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..errors import InputError
-from ..problem import Beam, BeamProblem, Damping, InitialState
+from ..problem import Beam, BeamProblem, Damping, InitialState, Plane
 from .forcing import loads_of, support_of
 from .obstacles import obstacles_and_holes
 from .parts import material_of, need, plane_count, section_of
@@ -85,7 +85,22 @@ def _initial(data: dict, problem: BeamProblem) -> BeamProblem:
     else:
         u0 = du0 = None
     v0 = _spline(ini["v0"], "v0", "v")[0] if "v0" in ini else None
-    return replace(problem, initial=InitialState(u0, v0, du0, fixed_frame=fixed))
+    return replace(problem, initial=InitialState(u0, v0, du0, fixed_frame=fixed),
+                   second=replace(problem.second, initial=_initial_w(data, fixed)))
+
+
+def _initial_w(data: dict, fixed: bool) -> InitialState | None:
+    """The second plane's start: [initial] u0_w = {x, u}, v0_w = {x, v} (None: at rest)."""
+    ini = data.get("initial", {})
+    given = [k for k in ("u0_w", "v0_w") if k in ini]
+    if not given:
+        return None
+    if plane_count(data) != 2:
+        raise InputError(f"[initial] {', '.join(given)} start the second plane: they need "
+                         "planes = 2")
+    u0, du0 = _spline(ini["u0_w"], "u0_w", "u") if "u0_w" in ini else (None, None)
+    v0 = _spline(ini["v0_w"], "v0_w", "v")[0] if "v0_w" in ini else None
+    return InitialState(u0, v0, du0, fixed_frame=fixed)
 
 
 def _mode_shape(problem: BeamProblem, k, amplitude):
@@ -114,5 +129,6 @@ def beam_problem(data: dict, reader: Tables) -> BeamProblem:
         J=mesh.get("J", 19), element=mesh.get("element", "hermite"), nodes=mesh.get("nodes"),
         ends=(ends.get("left", "clamped"), ends.get("right", "free")),
         supports=tuple(s.get("x", math.nan) for s in data.get("supports", [])),
-        damping=_damping(data), planes=plane_count(data), holes=holes, load_w=load_w)
+        damping=_damping(data), planes=plane_count(data), holes=holes,
+        second=Plane(load=load_w))
     return _initial(data, problem)

@@ -125,7 +125,8 @@ BEAM_KEYS = {
                "direction": NUMBERS, "rotating": {"amplitude": N, "omega": N,
                                                   "phase": N},
                **TIME}],
-    "initial": {"mode": N, "amplitude": N, "u0": U0, "v0": V0, "fixed_frame": V},
+    "initial": {"mode": N, "amplitude": N, "u0": U0, "v0": V0, "fixed_frame": V,
+                "u0_w": U0, "v0_w": V0},
     "mesh": {"J": N, "element": V, "nodes": NUMBERS, "mass": V, "massless": V},
     "time": TIME_KEYS, "contact": CONTACT, "output": OUTPUT,
 }

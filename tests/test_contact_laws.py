@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from skfem_beam import InputError, beam_system, scenes, solve
-from skfem_beam.contact import LAWS, ContactLaw, resolve
+from skfem_beam.contact import LAWS, SOLVERS, STEP_SOLVERS, ContactLaw, resolve
 from skfem_beam.contact.penalty import Penalty
 from skfem_beam.contact.restitution import Restitution
 from skfem_beam.methods import Penalty as PenaltyMethod, PositionLevel
@@ -32,9 +32,11 @@ def test_the_documented_law_runs_and_agrees_with_projection(tmp_path):
 
 
 def test_registry_names_and_auto():
-    assert set(LAWS) == {"projection", "active-set", "osqp", "daqp", "penalty", "restitution",
-                         "round-hole", "round-hole-friction", "pdas-sparse", "osqp-sparse",
-                         "clarabel-sparse"}
+    assert set(STEP_SOLVERS) == {"projection", "active-set", "osqp", "daqp", "round-hole",
+                                 "round-hole-friction", "pdas-sparse", "osqp-sparse",
+                                 "clarabel-sparse"}
+    assert set(LAWS) == {"penalty", "restitution"}           # named by their parameters
+    assert "penalty" not in SOLVERS and "auto" in SOLVERS
     for name in ("projection", "active-set", "osqp", "daqp"):
         assert resolve(name).name == name
     assert isinstance(resolve("auto", stiffness=1e3), Penalty)

@@ -16,7 +16,7 @@ import pytest
 
 import skfem_beam
 from skfem_beam import scenes
-from skfem_beam.contact import LAWS, SOLVERS, ContactLaw, register
+from skfem_beam.contact import SOLVERS, STEP_SOLVERS, ContactLaw, register
 from skfem_beam.errors import InputError
 from skfem_beam.methods import PositionLevel
 from skfem_beam.scheme import solve
@@ -57,14 +57,15 @@ class ToyClip(ContactLaw):
 
 @pytest.fixture
 def toy(tmp_path, monkeypatch):
-    """The toy law's module (a file of the user's), imported; LAWS as it was afterwards."""
+    """The toy law's module (a file of the user's), imported; STEP_SOLVERS as it was
+    afterwards."""
     (tmp_path / "toy_law.py").write_text(TOY)
     monkeypatch.syspath_prepend(str(tmp_path))
     import toy_law
-    saved = dict(LAWS)
+    saved = dict(STEP_SOLVERS)
     yield toy_law
-    LAWS.clear()
-    LAWS.update(saved)
+    STEP_SOLVERS.clear()
+    STEP_SOLVERS.update(saved)
     sys.modules.pop("toy_law", None)
 
 

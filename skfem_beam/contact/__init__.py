@@ -7,7 +7,8 @@ QP  min ½xᵀAx − Fᵀx, lo ≤ Cx ≤ hi  is equivalent to finding μ with
     y = y_free + D μ,  lo ≤ y ≤ hi,  μ_i ≥ 0 if y_i = lo_i,  μ_i ≤ 0 if y_i = hi_i,
     μ_i = 0 otherwise,
 
-and then x = x_free + W μ; μ/Δt² are the nodal contact forces.  Laws (registry.LAWS):
+and then x = x_free + W μ; μ/Δt² are the nodal contact forces.  The step solvers
+(registry.STEP_SOLVERS) and the two other laws (registry.LAWS: penalty, restitution):
 
 - ``projection``: D diagonal (one constrained value, Lemma 4.1): y = clip(y_free).
 - ``active-set``: exact, compiled, warm-started (any m).
@@ -24,7 +25,7 @@ The protocol a law follows (and how to write one) is in :mod:`.base`; ``register
 law)`` makes a law of one's own a solver of every front end.
 """
 from .base import LAW_SIGNATURE, ContactLaw, StepData, compiled_law
-from .registry import LAWS, SOLVERS, register, resolve
+from .registry import LAWS, SOLVERS, STEP_SOLVERS, register, resolve
 
-__all__ = ["LAW_SIGNATURE", "LAWS", "SOLVERS", "ContactLaw", "StepData", "compiled_law",
+__all__ = ["LAW_SIGNATURE", "LAWS", "SOLVERS", "STEP_SOLVERS", "ContactLaw", "StepData", "compiled_law",
            "register", "resolve"]

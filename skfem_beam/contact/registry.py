@@ -1,8 +1,8 @@
-"""The contact laws by name: one line per law, and :func:`register` for a law of the
-user's (then named by ``--solver``, a scene file's ``[contact] law`` and
-``PositionLevel(solver=)`` like the shipped ones, with no edit of the front end).
+"""The step solvers and the contact laws by name: one line each, and :func:`register`
+for a step solver of the user's (then named by ``--solver``, a scene file's ``[contact]
+law`` and ``PositionLevel(solver=)`` like the shipped ones, with no edit of the front end).
 
-A law's parameters are its own table (``parameters``, :class:`.base.Parameter`): the
+A step solver's parameters are its own table (``parameters``, :class:`.base.Parameter`): the
 front ends read it here (:func:`parameters_of`, :func:`all_parameters`), so a law with a
 parameter is set from a scene file's ``[contact]``, the command line's ``--param`` and
 ``PositionLevel(params=)`` without a word of theirs."""
@@ -22,13 +22,13 @@ from .round_hole import RoundHole
 from .round_hole_friction import RoundHoleFriction
 from .sparse_qp import ClarabelSparseLaw, OSQPSparseLaw, PDASSparse
 
-LAWS = {
-    "projection": Projection,
+# The step solvers: how the step's QP of exact contact at position level is solved (each
+# gives the same step where it applies); a user's own joins them by register()
+STEP_SOLVERS = {
+    "projection": Projection,     # decoupled values (one per row of D), Lemma 4.1
     "active-set": ActiveSet,
     "osqp": OSQP,
     "daqp": DAQP,
-    "penalty": Penalty,      # needs stiffness=
-    "restitution": Restitution,   # needs restitution= (e)
     "round-hole": RoundHole,      # round holes (and boxes beside them), exact
     "round-hole-friction": RoundHoleFriction,   # ... with Coulomb friction, exact contact
     # x-space engines for many contacts, C a selector (the plate): no W, no D
@@ -36,20 +36,30 @@ LAWS = {
     "osqp-sparse": OSQPSparseLaw,
     "clarabel-sparse": ClarabelSparseLaw,
 }
+# The contact laws other than exact contact, each with its parameters: normal compliance
+# (one-sided springs: stiffness κ in N/m and damping c in N·s/m, one each or one per
+# obstacle) and Newton's restitution (e in [0, 1], on the exact step).  They are named by
+# their parameters (resolve: stiffness=, restitution=), not as solvers.  Coulomb's μ is a
+# parameter of each obstacle (a hole's wall, a face), read by the exact solver that takes
+# friction (StepData.friction).
+LAWS = {
+    "penalty": Penalty,
+    "restitution": Restitution,
+}
 
 
 class _Names:
-    """The solvers' names as LAWS holds them now ("auto" first): a registered law joins
-    every list and check that holds this object, wherever it was imported."""
+    """The step solvers' names as STEP_SOLVERS holds them now ("auto" first): a registered
+    solver joins every list and check that holds this object, wherever it was imported."""
 
     def __iter__(self):
-        return iter(("auto", *LAWS))
+        return iter(("auto", *STEP_SOLVERS))
 
     def __contains__(self, name) -> bool:
-        return name == "auto" or name in LAWS
+        return name == "auto" or name in STEP_SOLVERS
 
     def __len__(self) -> int:
-        return 1 + len(LAWS)
+        return 1 + len(STEP_SOLVERS)
 
     def __repr__(self) -> str:
         return repr(tuple(self))
@@ -63,25 +73,26 @@ def register(name: str, law) -> None:
     of no arguments returning a law, e.g. ``functools.partial(MyLaw, gain=0.5)`` for a
     law with parameters) under ``name``: from then on it is a solver like the shipped
     ones.  A name already taken is refused."""
-    if not isinstance(name, str) or not name or name in SOLVERS:
+    if not isinstance(name, str) or not name or name in SOLVERS or name in LAWS:
         raise InputError(f"register({name!r}): a new, non-empty name is needed (taken: "
-                         f"{', '.join(SOLVERS)})")
+                         f"{', '.join([*SOLVERS, *LAWS])})")
     if not callable(law):
         raise InputError(f"register({name!r}, {law!r}): a ContactLaw subclass or a callable "
                          f"returning a law is needed")
-    LAWS[name] = law
+    STEP_SOLVERS[name] = law
 
 
 def parameters_of(name) -> tuple[Parameter, ...]:
-    """The parameter table of the law registered as ``name`` (none for a name not in
-    LAWS, or a maker that is not a law class)."""
-    return tuple(getattr(LAWS.get(name), "parameters", ())) if isinstance(name, str) else ()
+    """The parameter table of the step solver registered as ``name`` (none for a name
+    not in STEP_SOLVERS, or a maker that is not a law class)."""
+    return tuple(getattr(STEP_SOLVERS.get(name), "parameters", ())) \
+        if isinstance(name, str) else ()
 
 
 def all_parameters() -> dict[str, Parameter]:
-    """Every registered law's parameters by name (the keys a scene file's [contact] may
-    hold besides its own)."""
-    return {p.name: p for name in LAWS for p in parameters_of(name)}
+    """Every registered step solver's parameters by name (the keys a scene file's
+    [contact] may hold besides its own)."""
+    return {p.name: p for name in STEP_SOLVERS for p in parameters_of(name)}
 
 
 def check_params(name, params: dict, written: str = "--param ") -> dict:
@@ -105,8 +116,8 @@ def resolve(law: str | ContactLaw = "auto", stiffness: float | None = None,
     ``restitution`` e > 0 the position-level scheme with Newton restitution; ``params``:
     values of the named law's parameters (its table)."""
     if params:
-        made = LAWS[law](**check_params(law, params, "params: ")) \
-            if law in LAWS else check_params(law, params, "params: ")
+        made = STEP_SOLVERS[law](**check_params(law, params, "params: ")) \
+            if law in STEP_SOLVERS else check_params(law, params, "params: ")
         return resolve(made, stiffness, restitution)
     e = Restitution(restitution).e
     if e > 0:
@@ -124,13 +135,13 @@ def resolve(law: str | ContactLaw = "auto", stiffness: float | None = None,
         return law
     if law == "auto":
         return Auto()
-    if law == "penalty":
-        raise InputError("solver='penalty' needs stiffness= (the spring stiffness 1/ε)")
-    if law == "restitution":
-        raise InputError("solver='restitution' needs restitution= (the coefficient e)")
-    if law not in LAWS:
+    if law in LAWS:          # a law is named by its parameter, not as a step solver
+        needs = {"penalty": "stiffness= (the spring stiffness 1/ε)",
+                 "restitution": "restitution= (the coefficient e)"}[law]
+        raise InputError(f"solver={law!r} needs {needs}")
+    if law not in STEP_SOLVERS:
         raise InputError(f"solver={law!r} is not one of: {', '.join(SOLVERS)}")
-    made = LAWS[law]()
+    made = STEP_SOLVERS[law]()
     if not isinstance(made, ContactLaw):
         raise InputError(f"solver={law!r}: its registered maker returned {made!r}, not a "
                          f"ContactLaw")

@@ -208,7 +208,7 @@ def penetration_samples(system):
 
 class BetaScheme:
     """The β-scheme of ``system`` on ``stepping`` with the contact law ``law`` (a name of
-    ``contact.LAWS``, "auto", or a law object)."""
+    ``contact.STEP_SOLVERS``, "auto", or a law object)."""
 
     # checkpoint key → state field: what a restored run needs to go on bit for bit
     CHECKPOINT = {"u_prev": "u_prev", "u_cur": "u_cur", "state": "law_state",

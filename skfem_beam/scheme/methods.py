@@ -3,7 +3,7 @@ pairs a one-step integrator with a non-smooth law.
 
 - :class:`PositionLevel` ``(solver="auto", restitution=0.0, massless="beta")``: the
   papers' contact-implicit β-scheme, exact contact at position level (the step's QP
-  solved by ``solver``: a name of ``contact.LAWS`` or a law object), with a Newton
+  solved by ``solver``: a name of ``contact.STEP_SOLVERS`` or a law object), with a Newton
   coefficient of restitution e > 0 if asked (Paoli–Schatzman);
 - :class:`Penalty` ``(stiffness)``: the same β-scheme with the obstacles as one-sided
   springs (normal compliance);

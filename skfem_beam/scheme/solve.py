@@ -22,7 +22,7 @@ def solve(system, dt: float, T: float, beta: float | None = None, method=None, *
 
     ``method``: a :mod:`skfem_beam.methods` object, the one way a run names its method
     (``PositionLevel(solver, restitution, massless)``: the solver a name of
-    ``contact.LAWS`` or a law object; ``Penalty(stiffness)`` in N/m, or in the units of the
+    ``contact.STEP_SOLVERS`` or a law object; ``Penalty(stiffness)`` in N/m, or in the units of the
     semi-discrete equation with ``equation_units=True``; ``MoreauJean(theta,
     restitution)``); None: ``PositionLevel()``, exact contact by the cheapest exact law.
     ``beta``: the β-scheme's β (default: the method's own, 1/2 for exact contact, 1/4 for

@@ -117,18 +117,19 @@ def check_law(args, p: Parser) -> None:
 
 def method(args) -> methods.Method:
     """The method the flags name (--law, --solver, --restitution, --stiffness N/m,
-    --massless)."""
+    --massless, --theta, --beta: the β-scheme's β, None its default)."""
     return methods.make(args.law, getattr(args, "solver", "auto"), args.restitution,
                         args.stiffness if args.law == "penalty" else None,
                         getattr(args, "massless", None),
                         params=law_params(getattr(args, "param", None),
-                                          theta=getattr(args, "theta", None)))
+                                          theta=getattr(args, "theta", None),
+                                          beta=getattr(args, "beta", None)))
 
 
-def law_params(given, theta: float | None = None) -> dict:
+def law_params(given, theta: float | None = None, beta: float | None = None) -> dict:
     """--param NAME=VALUE flags as {NAME: number} (the law checks names and ranges), and
-    --theta (Moreau–Jean's) when given."""
-    out = {} if theta is None else {"theta": theta}
+    --theta (Moreau–Jean's) and --beta (the β-scheme's) when given."""
+    out = {k: v for k, v in (("theta", theta), ("beta", beta)) if v is not None}
     for text in given or ():
         name, eq, value = text.partition("=")
         try:
@@ -142,11 +143,10 @@ def law_params(given, theta: float | None = None) -> dict:
 
 
 def spec(args, config: dict | None = None) -> RunSpec:
-    """The flags as one :class:`~skfem_beam.spec.RunSpec`: Stepping, method, output
-    options, and summary.json's config (``config`` and every flag but --resume)."""
+    """The flags as one :class:`~skfem_beam.spec.RunSpec`: Stepping, method (with its β),
+    output options, and summary.json's config (``config`` and every flag but --resume)."""
     m = method(args)
-    stepping = Stepping(args.dt, args.T, args.beta, args.save_every, args.frames,
-                        massless=m.massless)
+    stepping = Stepping(args.dt, args.T, args.save_every, args.frames, massless=m.massless)
     flags = {k: v for k, v in vars(args).items() if k != "resume"}
     return RunSpec(stepping, m, output_options(args), {**(config or {}), **flags},
                    mass=args.mass, probes=tuple(getattr(args, "probe", None) or ()))

@@ -4,17 +4,18 @@ The method classes (:class:`PositionLevel`, :class:`Penalty`, :class:`MoreauJean
 integrator and its contact law as one object) live with the integrators they build, in
 :mod:`skfem_beam.scheme.methods`, and are importable from here.  The command line and the
 scene file name a method by the words of :func:`make` (``law``, ``solver``,
-``restitution``, ``stiffness``, ``massless``, ``theta``).
+``restitution``, ``stiffness``, ``massless``, ``theta``, ``beta``).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .checks import check_choice, check_restitution
+from .checks import check_beta, check_choice, check_restitution
 from .contact import SOLVERS, resolve
 from .contact.registry import check_params
 from .errors import InputError
-from .scheme.methods import Method, MoreauJean, Penalty, PositionLevel, mass_scale  # noqa: F401
+from .scheme.methods import (Method, MoreauJean, Penalty, PositionLevel,  # noqa: F401
+                             mass_scale, with_beta)
 from .scheme.moreau_jean import NAME as MOREAU_JEAN, check_theta
 from .scheme.stepping import MASSLESS
 
@@ -51,12 +52,13 @@ def make(law: str = "position", solver: str = "auto", restitution: float = 0.0,
     """The method the words name: ``law`` one of LAWS, ``solver`` the position-level
     QP solver, ``stiffness`` and ``damping`` the penalty springs and their dashpots (N/m,
     N·s/m, see :class:`Penalty`), ``massless`` the massless rows' stepping; ``params``
-    the method's own parameters: ``theta``, Moreau–Jean's θ, and the position-level
-    solver's (its law's table, :func:`skfem_beam.contact.registry.check_params`); None:
-    the defaults."""
+    the method's own parameters: ``theta``, Moreau–Jean's θ, ``beta``, the β-scheme's β
+    (position, penalty; Moreau–Jean has none: checked and not used), and the
+    position-level solver's (its law's table,
+    :func:`skfem_beam.contact.registry.check_params`); None: the defaults."""
     check_choice(_name(words.law), law, LAWS)
     params = dict(params or {})
-    theta = params.pop("theta", None)
+    theta, beta = params.pop("theta", None), params.pop("beta", None)
     if params and law != "position":
         raise InputError(f"{words.param}{', '.join(params)}: parameters of a position-level "
                          f"solver; {words.law}{law} takes none")
@@ -71,13 +73,14 @@ def make(law: str = "position", solver: str = "auto", restitution: float = 0.0,
         if massless is not None:
             raise InputError(f"{words.massless}{massless} applies to the β-scheme "
                              f"({words.law}position); {words.law}{law} does not take it")
-        return MoreauJean(0.5 if theta is None else check_theta(theta, words.theta), e)
+        mj = MoreauJean(0.5 if theta is None else check_theta(theta, words.theta), e)
+        return with_beta(mj, beta)       # no β: checked, as the other front ends' words
     if law == "penalty":     # the registry's checks: no solver, no restitution with springs
         resolve("penalty" if solver == "auto" else solver, stiffness, e)
-        return Penalty(stiffness, massless=massless or "beta", damping=damping)
+        return Penalty(stiffness, massless=massless or "beta", damping=damping, beta=beta)
     check_choice(_name(words.solver), solver, SOLVERS)
     return PositionLevel(solver, e, massless or "beta",
-                         check_params(solver, params, words.param))
+                         check_params(solver, params, words.param), beta)
 
 
 def law_of(word: str, name: str = "--law") -> str:
@@ -113,9 +116,22 @@ def check_massless(massless: str | None, mass: str, name: str = "--massless") ->
 
 def default_beta(method: Method, kind: str = "beam") -> float:
     """β when none is given: the bar's scheme takes 1/4 (the third paper), a beam the
-    method's own (1/2 exact contact, 1/4 springs: the first two papers)."""
-    return BAR_BETA if kind == "bar" else method.default_beta
+    method's own (1/2 exact contact, 1/4 springs: the first two papers).  Moreau–Jean has
+    no β; the one its runs record (summary.json's config) is exact contact's, 1/2."""
+    if kind == "bar":
+        return BAR_BETA
+    return PositionLevel.default_beta if isinstance(method, MoreauJean) else method.default_beta
+
+
+def recorded_beta(method: Method, given: float | None = None, kind: str = "beam") -> float:
+    """The β summary.json records for a run of ``method``: the β-scheme method's own; for
+    Moreau–Jean, which has none, the β its front end was given (``given``, checked) or
+    :func:`default_beta`, as the runs have always recorded."""
+    if isinstance(method, MoreauJean):
+        return check_beta(default_beta(method, kind) if given is None else given)
+    return method.beta
 
 
 __all__ = ["ALIASES", "LAWS", "Method", "MoreauJean", "Penalty", "PositionLevel", "Words", "check_massless",
-           "default_beta", "law_of", "make", "mass_scale", "split_law", "summary_word"]
+           "default_beta", "law_of", "make", "mass_scale", "recorded_beta", "split_law",
+           "summary_word", "with_beta"]

@@ -6,14 +6,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from .methods import Method
+from .methods import Method, recorded_beta
 from .output.options import OutputOptions
 from .scheme.stepping import Stepping
 
 
 @dataclass(frozen=True)
 class RunSpec:
-    """``stepping``: Δt, T, β and what is kept; ``method``: :mod:`skfem_beam.methods`;
+    """``stepping``: Δt, T and what is kept; ``method``: :mod:`skfem_beam.methods` (the
+    β-scheme's carry β);
     ``options``: the output folder and streaming; ``config``: summary.json's record of
     what the user asked for, in the front end's own words (a resume compares it);
     ``mass``: the beam's mass matrix (consistent | redistributed); ``probes``: abscissae
@@ -26,3 +27,9 @@ class RunSpec:
     mass: str = "consistent"
     probes: tuple = ()
     wear: object = None
+
+    @property
+    def beta(self) -> float:
+        """The β-scheme method's β; Moreau–Jean has none: the β its front end was given
+        (config "beta"), which summary.json records, as it always has."""
+        return recorded_beta(self.method, self.config.get("beta"))

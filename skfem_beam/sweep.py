@@ -201,9 +201,8 @@ def run_value(settings: dict, value: float) -> dict:
         out["damping"] = damping_of(settings, value)
         system = beam_system(build_problem(settings, value, out["damping"]))
         # T half a step short of n·dt: the run takes ceil(T/dt) = n steps whatever the round-off
-        run = PositionLevel(settings["solver"]).build(
-            system, Stepping(dt, (n_total - 0.5) * dt, settings["beta"], save_every=spp,
-                             frames=1))
+        run = PositionLevel(settings["solver"], beta=settings["beta"]).build(
+            system, Stepping(dt, (n_total - 0.5) * dt, save_every=spp, frames=1))
         pre = {"impacts": 0, "contacts": 0}
         while not run.done and run.n < n_trans:
             run.advance(min(run.n + CHUNK, n_trans))

@@ -318,7 +318,7 @@ def test_python_engines_are_called_only_on_steps_in_contact(solver):
     system = beam_system(scenes.flat_obstacles(J=40))
     runs = {}
     for name in (solver, "active-set"):
-        runs[name] = methods.PositionLevel(name).build(system, Stepping(1e-3, 0.3, 0.5, frames=300))
+        runs[name] = methods.PositionLevel(name).build(system, Stepping(1e-3, 0.3, frames=300))
     engine, calls = runs[solver].pysolver, []
     engine_solve = engine.solve
     engine.solve = lambda *a: calls.append(1) or engine_solve(*a)
@@ -345,7 +345,7 @@ def test_a_python_law_with_a_force_inside_its_bounds_is_called_every_step():
     class Everywhere(DAQP):
         name = "daqp-everywhere"
         free_inside = False
-    run = Run(BetaScheme(beam_system(scenes.flat_obstacles(J=40)), Stepping(1e-3, 0.3, 0.5),
+    run = Run(BetaScheme(beam_system(scenes.flat_obstacles(J=40)), Stepping(1e-3, 0.3),
               Everywhere()))
     engine, calls = run.pysolver, []
     engine_solve = engine.solve

@@ -152,8 +152,9 @@ def test_impulses_are_the_contact_impulse_applied_along_the_span(tmp_path, law):
     # per node and per event, from the run's own forces (every state, every node)
     pb = scenes.flat_obstacles()
     stiffness = s["penalty_stiffness_N_per_m"]
-    run = Run(BetaScheme(beam_system(pb), Stepping(s["dt"], s["T"], s["beta"]),
-              resolve(law, stiffness / (pb.beam.rho_S or 1.0) if stiffness else None)))
+    run = Run(BetaScheme(beam_system(pb), Stepping(s["dt"], s["T"]),
+              resolve(law, stiffness / (pb.beam.rho_S or 1.0) if stiffness else None),
+              s["beta"]))
     drive(run)
     ev, dt, lam = run.impact_events(), run.dt, run.result().contact_force   # states × nodes
     assert ev["impulse"].sum() * (pb.beam.rho_S or 1.0) == pytest.approx(applied, rel=1e-12)

@@ -149,7 +149,7 @@ def test_the_tube_sticks_until_the_pull_reaches_mu_times_the_static_normal_force
     n = system.meta["n_plane"]
     e = system.C[0, :n].toarray().ravel()
     T_star = mu * (P - TUBE.rho_S * R / (e @ np.linalg.solve(system.K[:n, :n].toarray(), e)))
-    run = Run(BetaScheme(system, Stepping(dt, t0 + 0.002 * T_star / a, 0.5), RoundHoleFriction()))
+    run = Run(BetaScheme(system, Stepping(dt, t0 + 0.002 * T_star / a), RoundHoleFriction()))
     run.advance(int(t0 / dt))
 
     def cone_ratio():
@@ -169,6 +169,6 @@ def test_the_tube_sticks_until_the_pull_reaches_mu_times_the_static_normal_force
 
 def test_a_restored_position_level_friction_run_goes_on_bit_for_bit():
     system = beam_system(whirl(0.3))
-    a, c = resumed(lambda: Run(BetaScheme(system, Stepping(1e-4, 0.1, 0.5), RoundHoleFriction())), 555)
+    a, c = resumed(lambda: Run(BetaScheme(system, Stepping(1e-4, 0.1), RoundHoleFriction())), 555)
     assert np.array_equal(a.st.rowwork, c.st.rowwork)
     assert np.array_equal(a.result().work["friction"][556:], c.result().work["friction"][556:])

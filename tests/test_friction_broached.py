@@ -127,7 +127,7 @@ def test_a_rough_broached_hole_under_a_rotating_force_at_every_step(hole):
     the cone's edge to 4.5e-15, excess ≤ 1.2e-15 R."""
     mu = 0.3
     system = beam_system(whirl(mu, hole))
-    run = Run(BetaScheme(system, Stepping(1e-4, 0.3, 0.5), RoundHoleFriction()))
+    run = Run(BetaScheme(system, Stepping(1e-4, 0.3), RoundHoleFriction()))
     count = {"arc": 0, "line": 0, "corner": 0, "stick": 0}
     worst = {"cone": -np.inf, "dissipation": 0.0, "excess": -np.inf}
     for n in range(2, run.n_steps + 1):

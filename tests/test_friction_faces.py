@@ -113,7 +113,7 @@ def test_a_rough_polygon_under_a_rotating_force_at_every_contact_step(sides):
     system = beam_system(whirl(mu, sides))
     tangents = system.tangents
     assert tangents.shape == (sides // 2, 2) and system.C.shape[0] == sides
-    run = Run(BetaScheme(system, Stepping(1e-4, 0.3, 0.5), RoundHoleFriction()))
+    run = Run(BetaScheme(system, Stepping(1e-4, 0.3), RoundHoleFriction()))
     stick = slip = corners = 0
     worst = {"cone": 0.0, "dissipation": 0.0, "stick": 0.0, "penetration": -np.inf}
     for n in range(2, run.n_steps + 1):
@@ -203,7 +203,7 @@ def test_the_tube_sticks_on_a_face_until_the_pull_reaches_mu_times_the_normal_fo
     n = system.meta["n_plane"]
     e = system.C[0, :n].toarray().ravel()
     T_star = mu * (P - TUBE.rho_S * R / (e @ np.linalg.solve(system.K[:n, :n].toarray(), e)))
-    run = Run(BetaScheme(system, Stepping(dt, t0 + 2 * (1 - start) * T_star / a, 0.5),
+    run = Run(BetaScheme(system, Stepping(dt, t0 + 2 * (1 - start) * T_star / a),
                          RoundHoleFriction()))
     run.advance(int(t0 / dt) - 1)
     j, t = system.tangents[0]
@@ -220,7 +220,7 @@ def test_the_tube_sticks_on_a_face_until_the_pull_reaches_mu_times_the_normal_fo
 
 def test_a_restored_face_friction_run_goes_on_bit_for_bit():
     system = beam_system(whirl(0.3, 6))
-    a, c = resumed(lambda: Run(BetaScheme(system, Stepping(1e-4, 0.1, 0.5),
+    a, c = resumed(lambda: Run(BetaScheme(system, Stepping(1e-4, 0.1),
                                           RoundHoleFriction())), 444)
     assert np.array_equal(a.result().work["friction"][445:], c.result().work["friction"][445:])
 

@@ -25,11 +25,18 @@ PS = [sys.executable, "-m", "skfem_beam.cases.point_stops", "--dt", "1e-4",
 
 def test_defaults_and_checks():
     assert PositionLevel().default_beta == 0.5 and Penalty(1e6).default_beta == 0.25
+    assert PositionLevel().beta == 0.5 and Penalty(1e6).beta == 0.25     # None: the default
+    assert PositionLevel(beta=0.25).beta == 0.25 and not hasattr(MoreauJean(), "beta")
+    assert methods.make("position", params={"beta": 0.3}).beta == 0.3
+    assert methods.make("moreau-jean", params={"beta": 0.3}) == MoreauJean()   # no β
     assert methods.default_beta(MoreauJean(), "bar") == 0.25
     for bad, word in [(lambda: PositionLevel(restitution=1.5), "restitution=1.5 must lie"),
                       (lambda: PositionLevel("simplex"), "solver='simplex' is not one of"),
                       (lambda: Penalty(0.0), "stiffness=0 must be > 0"),
                       (lambda: MoreauJean(theta=0.2), "theta=0.2 must lie in [1/2, 1]"),
+                      (lambda: PositionLevel(beta=0.7), "beta=0.7 must lie in [0, 1/2]"),
+                      (lambda: Penalty(1.0, beta=-0.1), "beta=-0.1 must lie in [0, 1/2]"),
+                      (lambda: methods.make("moreau-jean", params={"beta": 0.6}), "beta=0.6"),
                       (lambda: methods.make("moreau-jean", "osqp"), "does not apply"),
                       (lambda: methods.make("penalty", restitution=0.5, stiffness=1.0),
                        "cannot be combined with stiffness")]:
@@ -42,8 +49,9 @@ def test_penalty_stiffness_in_newtons_is_converted_once():
     gives, bit for bit."""
     system = beam_system(scenes.point_stops())
     k = 1e7
-    a = solve(system, 5e-5, 0.15, 0.25, method=Penalty(k))
-    b = solve(system, 5e-5, 0.15, 0.25, Penalty(k / scenes.PIPE_RHO_S, equation_units=True))
+    a = solve(system, 5e-5, 0.15, 0.25, method=Penalty(k))      # beta: the method's, shorthand
+    b = solve(system, 5e-5, 0.15, method=Penalty(k / scenes.PIPE_RHO_S, equation_units=True,
+                                                 beta=0.25))
     assert a.impacts > 0 and np.array_equal(a.energy, b.energy)
     assert np.array_equal(a.contact_force, b.contact_force)
 
@@ -68,7 +76,7 @@ def test_a_restored_run_goes_on_bit_for_bit(method):
     row after the checkpoint, every impact event and the last state are the
     uninterrupted run's, to the bit."""
     system = beam_system(scenes.point_stops())
-    stepping = Stepping(5e-5, 0.15, 0.5)
+    stepping = Stepping(5e-5, 0.15)
     a = method.build(system, stepping)
     drive(a, chunk=150)
     b = method.build(system, stepping)

@@ -91,7 +91,7 @@ def test_point_stops_with_load_and_moving_support(massless):
     R = rigid_modes(s.space)
     assert s.loads.shape[1] == 2
     assert np.allclose(moments(s.M, R), moments(s0.M, R), rtol=1e-14, atol=0)  # 2e-16
-    run = Run(BetaScheme(s, Stepping(5e-5, 0.3, 0.5, massless=massless)))
+    run = Run(BetaScheme(s, Stepping(5e-5, 0.3, massless=massless)))
     drive(run)
     r = run.result()
     assert r.status == "success" and r.impacts > 20                  # 28 / 69 measured
@@ -127,7 +127,7 @@ def test_quasi_static_refusals(solver, massless, word):
     from skfem_beam.scheme.beta import BetaScheme
     s = bar_system(scenes.periodic_rod(20, mass="redistributed"))
     with pytest.raises(InputError, match=word):
-        Run(BetaScheme(s, Stepping(0.01, 1.0, 0.25, massless=massless), solver))
+        Run(BetaScheme(s, Stepping(0.01, 1.0, massless=massless), solver, 0.25))
 
 
 def test_command_line_massless_reaches_the_run(tmp_path):
@@ -179,7 +179,7 @@ def test_quasi_static_quarter_can_gain_energy_on_the_chattering_pipe(beta, dt, g
     from skfem_beam.scheme import Run, Stepping, drive
     from skfem_beam.scheme.beta import BetaScheme
     s = redistributed(beam_system(scenes.point_stops()))
-    run = Run(BetaScheme(s, Stepping(dt, 0.3, beta, massless="quasi-static")))
+    run = Run(BetaScheme(s, Stepping(dt, 0.3, massless="quasi-static"), beta=beta))
     drive(run, progress=False)
     r = run.result()
     assert r.status == "success" and r.max_nodal_violation == 0.0

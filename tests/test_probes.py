@@ -112,7 +112,7 @@ def test_interior_probe_adds_the_support_motion():
     pb = scenes.point_stops()
     s = beam_system(pb)
     add_probes(s, [0.8])
-    run = Run(BetaScheme(s, Stepping(1e-4, 0.2, 0.5, 1, 2000), resolve("auto", None)))
+    run = Run(BetaScheme(s, Stepping(1e-4, 0.2, 1, 2000), resolve("auto", None)))
     drive(run)
     cols, r = probe_columns(run, 0, run.n + 1), run.result()
     k = np.arange(0, run.n + 1, run.frame_every)

@@ -661,7 +661,7 @@ def test_modal_damping_gives_every_mode_its_log_decrement(tmp_path, k):
     add_probes(system, [x])
     steps_per_period = 400
     from skfem_beam import Stepping, methods
-    run = methods.PositionLevel("auto").build(system, Stepping(1 / (f * steps_per_period), 6.5 / f, 0.5,
+    run = methods.PositionLevel("auto").build(system, Stepping(1 / (f * steps_per_period), 6.5 / f,
                                                     frames=10))
     drive(run, progress=False)
     u = run.result().observed[f"probe_{x:g}_displacement"]

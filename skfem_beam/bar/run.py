@@ -85,15 +85,18 @@ def steps_to(T: float, dt: float) -> int:
 
 
 def bar_method(bar: Bar, method="contact", solver="auto", restitution: float = 0.0,
-               massless: str = "beta"):
+               massless: str = "beta", beta: float | None = None):
     """The bar's method: a method object (:mod:`skfem_beam.methods`) or a word of
-    ``methods.law_of`` with ``solver``, ``restitution`` and ``massless``.  An elastic
-    obstacle *is* the spring R = kU⁻ of stiffness ``bar.k``, whatever method steps it; a
-    rigid one with the penalty method is approximated by springs of ``bar.k``."""
+    ``methods.law_of`` with ``solver``, ``restitution`` and ``massless``; ``beta`` sets
+    the β-scheme's β (None: the method object's own, or the bar's 1/4 with a word).  An
+    elastic obstacle *is* the spring R = kU⁻ of stiffness ``bar.k``, whatever method steps
+    it; a rigid one with the penalty method is approximated by springs of ``bar.k``."""
     if isinstance(method, str):
         law = methods.law_of(method, "method")
         method = methods.make(law, solver, restitution, bar.k if law == "penalty" else None,
-                              None if massless == "beta" else massless, words=methods.KEYS)
+                              None if massless == "beta" else massless, words=methods.KEYS,
+                              params={"beta": methods.BAR_BETA if beta is None else beta})
+    method = methods.with_beta(method, beta)
     if bar.obstacle != "elastic":
         return method
     if isinstance(method, methods.MoreauJean):
@@ -101,14 +104,15 @@ def bar_method(bar: Bar, method="contact", solver="auto", restitution: float = 0
                          "obstacle is a spring (use --law position or penalty)")
     solver, e = (method.solver, method.restitution) \
         if isinstance(method, methods.PositionLevel) else ("auto", 0.0)
-    return methods.make("penalty", solver, e, bar.k, method.massless, words=methods.KEYS)
+    return methods.make("penalty", solver, e, bar.k, method.massless, words=methods.KEYS,
+                        params={"beta": method.beta})
 
 
-def bar_run(bar: Bar, dt: float, T: float, beta: float = 0.25, method="contact", *,
+def bar_run(bar: Bar, dt: float, T: float, beta: float | None = 0.25, method="contact", *,
             frames: int = 200, all_states_limit: int = 4_000_000, **words):
     """The bar's :class:`~skfem_beam.scheme.Run` (not yet driven), to T + Δt, with the
     method of :func:`bar_method` (``words``: its ``solver``, ``restitution``,
-    ``massless``).
+    ``massless``; ``beta`` the method's β, None: a method object's own).
 
     rigid + contact: the Signorini condition u(0) ≥ 0 (one constrained value, so the
     step is the projection of Lemma 4.1); rigid + penalty: a one-sided spring of
@@ -119,9 +123,9 @@ def bar_run(bar: Bar, dt: float, T: float, beta: float = 0.25, method="contact",
     ``all_states_limit`` values (the energy split needs them); else ``frames`` frames.
     """
     from ..scheme import Stepping
-    method = bar_method(bar, method, **words)
+    method = bar_method(bar, method, beta=beta, **words)     # the check of β
     system = bar_system(bar)
-    to_T = Stepping(dt, T, beta, massless=method.massless)   # the checks of Δt, T, β
+    to_T = Stepping(dt, T, massless=method.massless)   # the checks of Δt, T
     n_steps = to_T.steps
     every_state = (n_steps + 2) * system.n <= all_states_limit
     stepping = replace(to_T, T=n_steps * dt + dt, frames=n_steps + 1 if every_state else frames)

@@ -40,7 +40,7 @@ def best_run(system, solver: str, dt: float, T: float, repeat: int):
     from ..scheme import solve
     from ..scheme.methods import PositionLevel
     frames = int(round(T / dt))              # every step: for the comparison and replay
-    runs = [solve(system, dt=dt, T=T, beta=0.5, method=PositionLevel(solver), frames=frames,
+    runs = [solve(system, dt=dt, T=T, method=PositionLevel(solver, beta=0.5), frames=frames,
                   progress=False) for _ in range(repeat)]
     return min(runs, key=lambda r: r.wall_time_s)
 

@@ -20,11 +20,11 @@ from ..output.render import animate, render_beam
 
 
 def point_stops_run():
-    return solve(beam_system(scenes.point_stops()), dt=5e-5, T=0.6, beta=0.5, frames=120)
+    return solve(beam_system(scenes.point_stops()), dt=5e-5, T=0.6, frames=120)   # β = 1/2
 
 
 def flat_obstacles_run():
-    return solve(beam_system(scenes.flat_obstacles()), dt=1e-3, T=1.0, beta=0.5, frames=100)
+    return solve(beam_system(scenes.flat_obstacles()), dt=1e-3, T=1.0, frames=100)   # β = 1/2
 
 
 SCENES = {

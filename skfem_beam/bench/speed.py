@@ -79,10 +79,10 @@ def child(scene: str, p: dict, solver: str, repeat: int) -> dict:
     system = build(scene, p)
     system = beam_system(system) if scene != "bar" else system
     beta = p.get("beta", 0.5)
-    stepping = Stepping(p["dt"], p["T"], beta, save_every=p.get("save_every", 1), frames=50)
+    stepping = Stepping(p["dt"], p["T"], save_every=p.get("save_every", 1), frames=50)
     best = repairs = None
     for _ in range(repeat):
-        run = methods.PositionLevel(solver).build(system, stepping)
+        run = methods.PositionLevel(solver, beta=beta).build(system, stepping)
         drive(run, progress=False)
         r = run.result()
         if best is None or r.wall_time_s < best.wall_time_s:

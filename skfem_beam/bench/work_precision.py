@@ -82,15 +82,14 @@ def run_method(system, dt, T, kw, frames):
     stiffness (penalty), restitution e (e = 0: the papers' scheme, bit for bit) and
     massless ("beta" or "quasi-static": how a redistributed mass's massless rows step,
     see Stepping)."""
-    e = kw.get("restitution", 0.0)
+    e, beta = kw.get("restitution", 0.0), kw.get("beta", 0.5)
     if "theta" in kw:
         method = methods.MoreauJean(kw["theta"], e)
     elif "stiffness" in kw:     # per unit of the equation, as the studies give it
-        method = methods.Penalty(kw["stiffness"], equation_units=True)
+        method = methods.Penalty(kw["stiffness"], equation_units=True, beta=beta)
     else:
-        method = methods.PositionLevel("auto", e, kw.get("massless", "beta"))
-    return solve(system, dt, T, kw.get("beta", 0.5), frames=frames, progress=False,
-                 method=method)
+        method = methods.PositionLevel("auto", e, kw.get("massless", "beta"), beta=beta)
+    return solve(system, dt, T, frames=frames, progress=False, method=method)
 
 
 def field_errors(result, exact, points: int = 4) -> dict:
@@ -202,8 +201,8 @@ def beam_system_of(scene: str, mass: str = "consistent"):
 def run_beam(system, dt, T, kw):
     """run_method with the penalty's stiffness in N/m (converted by ρA)."""
     if "stiffness" in kw:
-        return solve(system, dt, T, kw["beta"], frames=2, progress=False,
-                     method=methods.Penalty(kw["stiffness"]))
+        return solve(system, dt, T, frames=2, progress=False,
+                     method=methods.Penalty(kw["stiffness"], beta=kw["beta"]))
     return run_method(system, dt, T, kw, frames=2)
 
 

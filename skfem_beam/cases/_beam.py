@@ -32,7 +32,7 @@ def run_beam_case(case: str, problem, spec: RunSpec, stops=(), extra=None) -> in
     prepare(spec.options)                         # fail before the run, not after it
     system = beam_system(problem)
     add_probes(system, list(spec.probes))
-    kh, limit = stability_warning(system, spec.stepping)
+    kh, limit = stability_warning(system, spec.stepping.dt, spec.beta)
     if spec.mass == "redistributed":
         system = redistributed(system)
     run = spec.method.build(system, spec.stepping)
@@ -118,13 +118,13 @@ def warn_no_contact(run, system) -> None:
                  "and x are in metres")
 
 
-def stability_warning(system, stepping):
+def stability_warning(system, dt: float, beta: float):
     """κ_h and the linear limit 2/√(κ_h(1−4β)); a warning line when Δt is above it."""
     kh = kappa_h(system)
-    limit = linear_limit(kh, stepping.beta)
-    if stepping.dt > limit:
-        cli.warn(f"dt={stepping.dt:g} s is above the linear stability limit "
-                 f"2/√(κ_h(1−4β)) = {limit:.4g} s for beta={stepping.beta:g} (κ_h={kh:.4g} "
+    limit = linear_limit(kh, beta)
+    if dt > limit:
+        cli.warn(f"dt={dt:g} s is above the linear stability limit "
+                 f"2/√(κ_h(1−4β)) = {limit:.4g} s for beta={beta:g} (κ_h={kh:.4g} "
                  "s⁻²); the run will likely go unstable")
     return kh, limit
 

@@ -34,8 +34,8 @@ def main(argv=None) -> int:
     def energy_files(folder, data, run):
         columns = {"t": data["t"], f"energy_{run.label.replace('=', '_')}": data["energy"]}
         if other is not None:
-            r2 = solve(beam_system(pb), args.dt, args.T, other, PositionLevel(args.solver),
-                       save_every=args.save_every, frames=2)
+            r2 = solve(beam_system(pb), args.dt, args.T, method=PositionLevel(args.solver,
+                       beta=other), save_every=args.save_every, frames=2)
             columns[f"energy_beta_{other:g}"] = r2.energy[:data["t"].size]
         write_timeseries(folder, columns, "energy.csv")
         draw(trajectory_chart, folder / "energy_decay.png", data["t"],

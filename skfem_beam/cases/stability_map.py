@@ -63,9 +63,10 @@ def run_map(system, grid, T, stiffness, step_of) -> list[dict]:
     rows = []
     for beta, ratio, method in grid:
         dt = ratio * step_of(beta)
-        law = Penalty(stiffness, equation_units=True) if law_of(method) == "penalty" \
-            else make(law_of(method))
-        r = solve(system, dt, T, beta, law, save_every=max(1, int(1e-4 / dt)), frames=2, progress=False)
+        law = Penalty(stiffness, equation_units=True, beta=beta) \
+            if law_of(method) == "penalty" else make(law_of(method), params={"beta": beta})
+        r = solve(system, dt, T, method=law, save_every=max(1, int(1e-4 / dt)), frames=2,
+                  progress=False)
         tip = r.observed["tip_displacement"]
         rows.append({"beta": beta, "ratio": ratio, "dt": dt, "method": method,
                      "status": r.status, "steps": r.steps, "t_end": float(r.t[-1]),

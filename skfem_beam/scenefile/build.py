@@ -1,7 +1,7 @@
 """A parsed scene → :class:`Scene`, the Python API's objects: the problem (a beam's or a
 bar's), and what the file leaves to inference: the contact law (from [contact], the
-obstacles' own stiffness and the holes' friction), the time grid and its β, the output
-options and [wear]."""
+obstacles' own stiffness and the holes' friction), the time grid, the method's β, the
+output options and [wear]."""
 from __future__ import annotations
 
 import tempfile
@@ -34,7 +34,8 @@ class Scene:
     ``problem``: a BeamProblem or a Bar; ``stepping``: the time grid; ``law``,
     ``stiffness`` (N/m), ``restitution``: the [contact] keys, ``damping`` (N·s/m): the
     supports' dashpots ([[obstacles]] damping) (``method`` builds the run's method from
-    them); ``stiffness`` and ``damping`` are tuples (one per obstacle) when the
+    them and [time] beta, the β-scheme's β; ``beta`` is the β summary.json records);
+    ``stiffness`` and ``damping`` are tuples (one per obstacle) when the
     [[obstacles]] stiffness or damping differ;
     ``output``: format, save_every, frames, flush_every, checkpoint_every; ``text``: the
     file as read and ``files`` the tables it read (path as written → text), so that a run
@@ -63,8 +64,20 @@ class Scene:
         contact = self.data.get("contact", {})
         # θ and the solver's parameters (the keys that are not [contact]'s own)
         params = {k: v for k, v in contact.items() if k == "theta" or k not in CONTACT_OWN}
+        params["beta"] = self._beta_given()
         return methods.make(law, solver, self.restitution or 0.0, self.stiffness, massless,
                             words=SCENE_WORDS, damping=self.damping, params=params)
+
+    def _beta_given(self) -> float | None:
+        """[time] beta; a bar's default, 1/4 whatever the law (None: the method's own)."""
+        given = self.data.get("time", {}).get("beta")
+        return methods.BAR_BETA if given is None and self.kind == "bar" else given
+
+    @property
+    def beta(self) -> float:
+        """The run's β as summary.json records it (methods.recorded_beta): the β-scheme
+        method's; for Moreau–Jean, which has none, [time] beta or its default."""
+        return methods.recorded_beta(self.method, self._beta_given(), self.kind)
 
 
 def load(path, overrides=(), files: dict | None = None, text: str | None = None,
@@ -161,11 +174,10 @@ def _scene(kind, problem, data, text, files) -> Scene:
                              "takes the consistent mass")
     rows = mesh.get("massless")
     methods.check_massless(rows, mesh.get("mass", "consistent"), "[mesh] massless")
-    scene = Scene(kind, problem, Stepping(t["dt"], t["T"], 0.5, massless=rows or "beta"), law, k,
+    scene = Scene(kind, problem, Stepping(t["dt"], t["T"], massless=rows or "beta"), law, k,
                   contact.get("restitution", 0.0), out, text, files, data, c)
-    method = scene.method          # the method's own checks (law, stiffness, restitution)
-    beta = t.get("beta", methods.default_beta(method, kind))
-    stepping = Stepping(t["dt"], t["T"], beta, out["save_every"], out["frames"],
+    scene.beta      # the method's own checks (law, stiffness, restitution, β)
+    stepping = Stepping(t["dt"], t["T"], out["save_every"], out["frames"],
                         t.get("load_window", "forward"), massless=rows or "beta")
     return replace(scene, stepping=stepping)
 

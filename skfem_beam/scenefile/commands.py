@@ -127,7 +127,7 @@ def _spec(scene: Scene, flags: dict, resume) -> RunSpec:
     probes = [float(x) for x in np.atleast_1d(scene.output.get("probes", []))] + \
         [x for x in given if x not in scene.output.get("probes", [])]
     config = {"command": "python -m skfem_beam run", "scene_text": scene.text,
-              "scene_files": scene.files, **flags, "dt": stepping.dt, "beta": stepping.beta,
+              "scene_files": scene.files, **flags, "dt": stepping.dt, "beta": scene.beta,
               "method": methods.summary_word(law),
               "law": law, "solver": "auto" if restitution else solver,
               "stiffness": scene.stiffness, "restitution": restitution, "mass": mass,
@@ -145,7 +145,7 @@ def _plate_spec(scene, flags: dict, resume) -> RunSpec:
     options, stepping = _grid(scene, flags, resume)
     config = {"command": "python -m skfem_beam run", "scene_text": scene.text,
               "scene_files": scene.files, **flags, "probe": None, "dt": stepping.dt,
-              "beta": stepping.beta, "law": scene.method.name}
+              "beta": scene.beta, "law": scene.method.name}
     if scene.meshes:    # a mesh file's bytes: --resume builds the plate from them
         config["scene_meshes"] = scene.meshes
     return RunSpec(stepping, scene.method, options, config)

@@ -43,7 +43,9 @@ class PlateScene:
     beam): ``problem`` a :class:`PlateSetup`, ``method`` the run's method, ``stepping``
     the time grid, ``output`` the [output] keys with their defaults, ``text``/``files``/
     ``data`` as a beam scene's; ``meshes`` the mesh file's bytes ([geometry] mesh: path
-    as written → {"sha256", "base64"}, :meth:`.read.Tables.mesh`), stored with the run."""
+    as written → {"sha256", "base64"}, :meth:`.read.Tables.mesh`), stored with the run;
+    ``beta``: the β summary.json records (the β-scheme method's, or for Moreau–Jean
+    [time] beta or its default)."""
     kind: str
     problem: PlateSetup
     stepping: Stepping | None
@@ -53,6 +55,10 @@ class PlateScene:
     files: dict = field(default_factory=dict)
     data: dict = field(default_factory=dict)
     meshes: dict = field(default_factory=dict)
+
+    @property
+    def beta(self) -> float:
+        return methods.recorded_beta(self.method, self.data.get("time", {}).get("beta"))
 
 
 def plate_of(data: dict, base=None):
@@ -231,7 +237,7 @@ def probes_of(data: dict, space) -> tuple:
 def method_of(data: dict) -> methods.Method:
     """[contact] law (position | moreau-jean | penalty, or a position-level solver's
     name as a beam scene's), solver, stiffness (N/m: the penalty law), restitution,
-    theta (Moreau–Jean)."""
+    theta (Moreau–Jean), and [time] beta (the β-scheme's)."""
     c = data.get("contact", {})
     law = c.get("law", "penalty" if "stiffness" in c else "position")
     solver = c.get("solver", "auto")
@@ -251,7 +257,8 @@ def method_of(data: dict) -> methods.Method:
     own = dict(PLATE_KEYS["contact"].items())      # θ and the others: the method's
     return methods.make(law, solver, c.get("restitution", 0.0), c.get("stiffness"),
                         words=PLATE_WORDS,
-                        params={k: v for k, v in c.items() if k == "theta" or k not in own})
+                        params={**{k: v for k, v in c.items() if k == "theta" or k not in own},
+                                "beta": data.get("time", {}).get("beta")})
 
 
 def plate_scene(parsed: Parsed, tables: Tables, dynamic: bool = True) -> PlateScene:
@@ -272,7 +279,6 @@ def plate_scene(parsed: Parsed, tables: Tables, dynamic: bool = True) -> PlateSc
     system = plate_system(space, obstacles_of(data, space), loads_of(data, space.plate, tables),
                           initial_of(data), probes)
     out = {**OUTPUT_DEFAULTS, **data.get("output", {})}
-    stepping = Stepping(t["dt"], t["T"], t.get("beta", method.default_beta),
-                        out["save_every"], out["frames"])
+    stepping = Stepping(t["dt"], t["T"], out["save_every"], out["frames"])
     return PlateScene("plate", PlateSetup(space, system, probes), stepping, method, out,
                       parsed.text, tables.read, data, tables.meshes)

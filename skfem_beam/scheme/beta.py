@@ -14,6 +14,7 @@ from numba.core import event
 from numba.core.dispatcher import LiftedCode
 
 from .. import aside
+from ..checks import check_beta
 from ..contact import ContactLaw, StepData, resolve
 from ..contact.base import NoContact, no_explicit
 from ..contact.registry import Auto
@@ -208,7 +209,8 @@ def penetration_samples(system):
 
 class BetaScheme:
     """The β-scheme of ``system`` on ``stepping`` with the contact law ``law`` (a name of
-    ``contact.STEP_SOLVERS``, "auto", or a law object)."""
+    ``contact.STEP_SOLVERS``, "auto", or a law object) and Newmark's ``beta`` (the β of the method
+    that builds it: :class:`.methods.PositionLevel`, :class:`.methods.Penalty`)."""
 
     # checkpoint key → state field: what a restored run needs to go on bit for bit
     CHECKPOINT = {"u_prev": "u_prev", "u_cur": "u_cur", "state": "law_state",
@@ -216,19 +218,20 @@ class BetaScheme:
                   "lo": "lo", "hi": "hi", "slo": "slo", "shi": "shi", "work_sums": "work",
                   "impact": "impact", "pos": "pos", "rowwork": "rowwork", "sectors": "sectors"}
 
-    def __init__(self, system, stepping: Stepping, law: str | ContactLaw = "auto"):
-        s, m = stepping, system.C.shape[0]
+    def __init__(self, system, stepping: Stepping, law: str | ContactLaw = "auto",
+                 beta: float = 0.5):
+        s, m, beta = stepping, system.C.shape[0], check_beta(beta)
         self.system, self.stepping = system, s
-        self.dt, self.beta, self.theta, self.n_steps = s.dt, s.beta, None, s.steps
+        self.dt, self.beta, self.theta, self.n_steps = s.dt, beta, None, s.steps
         self.save_every, self.frame_every = s.save_every, s.frame_every
         self.shift = 0.5 * s.dt if s.load_window == "centered" else 0.0
         law = resolve(law) if not isinstance(law, ContactLaw) else law
         x_space = law.x_space and m > 0   # no W, no D
         with _callees_aside():
-            self.op = op = step_operators(system, s.dt, s.beta, s.massless,
+            self.op = op = step_operators(system, s.dt, beta, s.massless,
                                           delassus=not x_space)
         self.step = StepData(op.A, op.C, op.D, np.ascontiguousarray(system.lo, dtype=float),
-                             np.ascontiguousarray(system.hi, dtype=float), s.dt, s.beta,
+                             np.ascontiguousarray(system.hi, dtype=float), s.dt, beta,
                              disk_rows(system), land_rows(system), friction_of(system),
                              obstacle_rows(system), tangent_rows(system))
         self.law = law = self._law(law, m)
@@ -249,7 +252,7 @@ class BetaScheme:
             raise InputError(f"massless='quasi-static' needs an exact compiled contact law "
                              f"(projection, active-set, restitution), not {law.name!r}")
         self.loads = np.ascontiguousarray(system.loads, dtype=float)
-        self.load_norm = load_norms(system, s.dt, s.beta)
+        self.load_norm = load_norms(system, s.dt, beta)
         self.Orows = observers(system)
         self.ops = self._ops(params)
         self.st = self._state()
@@ -271,7 +274,7 @@ class BetaScheme:
         shift = np.ascontiguousarray(system.bound_shift, dtype=float) if moving else np.zeros(0)
         sshift = np.ascontiguousarray(system.sample_shift, dtype=float) \
             if moving and slo.size else np.zeros(0)
-        return Ops(s.dt, s.beta, s.save_every, s.frame_every, op.Kb.rows, op.Bb, op.Ab.chol,
+        return Ops(s.dt, self.beta, s.save_every, s.frame_every, op.Kb.rows, op.Bb, op.Ab.chol,
                    op.Eb.rows, self.loads, *csr_arrays(op.C), step.lo, step.hi, shift, sshift,
                    op.W, op.D, *csr_arrays(self.Orows), *samples, slo, shi, params, op.Z,
                    *csr_arrays(system.K.tocsr()[op.Z]), *self._holes())

@@ -1,19 +1,21 @@
 """How a run steps in time: the integrator and its contact law as one object, as Siconos
 pairs a one-step integrator with a non-smooth law.
 
-- :class:`PositionLevel` ``(solver="auto", restitution=0.0, massless="beta")``: the
-  papers' contact-implicit β-scheme, exact contact at position level (the step's QP
-  solved by ``solver``: a name of ``contact.STEP_SOLVERS`` or a law object), with a Newton
-  coefficient of restitution e > 0 if asked (Paoli–Schatzman);
-- :class:`Penalty` ``(stiffness)``: the same β-scheme with the obstacles as one-sided
-  springs (normal compliance);
+- :class:`PositionLevel` ``(solver="auto", restitution=0.0, massless="beta", params=(),
+  beta=None)``: the papers' contact-implicit β-scheme, exact contact at position level
+  (the step's QP solved by ``solver``: a name of ``contact.STEP_SOLVERS`` or a law
+  object), with a Newton coefficient of restitution e > 0 if asked (Paoli–Schatzman);
+- :class:`Penalty` ``(stiffness, ..., beta=None)``: the same β-scheme with the obstacles as
+  one-sided springs (normal compliance);
 - :class:`MoreauJean` ``(theta=0.5, restitution=0.0)``: the θ-scheme with contact at
   velocity level (a Newton impact law), what Siconos and LMGC90 users run.
 
-Each owns its default β (the papers: 1/2 for exact contact, 1/4 for springs), its checks,
-its units and how it builds its run (``method.build(system, stepping)``: a :class:`.run.Run`
-of its one-step integrator, :class:`.beta.BetaScheme` or
-:class:`.moreau_jean.MoreauJeanScheme`); :func:`.solve.solve` takes one as ``method=``.
+The β-scheme's methods carry its Newmark β, as Moreau–Jean carries its θ (None: the
+method's default, the papers' 1/2 for exact contact and 1/4 for springs); Moreau–Jean has
+no β.  Each owns its checks, its units and how it builds its run
+(``method.build(system, stepping)``: a :class:`.run.Run` of its one-step integrator,
+:class:`.beta.BetaScheme` or :class:`.moreau_jean.MoreauJeanScheme`);
+:func:`.solve.solve` takes one as ``method=``.
 They are importable from :mod:`skfem_beam.methods` too, where the command line's and the
 scene file's words name them (``methods.make``).
 """
@@ -24,7 +26,8 @@ from typing import ClassVar, Union
 
 import numpy as np
 
-from ..checks import check_choice, check_nonnegative, check_positive, check_restitution
+from ..checks import (check_beta, check_choice, check_nonnegative, check_positive,
+                      check_restitution)
 from ..contact import ContactLaw, resolve
 from ..contact.penalty import Penalty as PenaltyLaw
 from ..contact.restitution import Restitution
@@ -45,11 +48,23 @@ def mass_scale(system) -> float:
     return 1.0
 
 
-def beta_run(system, stepping, law: ContactLaw) -> Run:
-    """A run of the β-scheme with ``law`` (PositionLevel's and Penalty's build)."""
+def beta_run(system, stepping, law: ContactLaw, beta: float) -> Run:
+    """A run of the β-scheme with ``law`` and ``beta`` (PositionLevel's and Penalty's
+    build)."""
     with Deferred():               # signals wait while the kernels compile or load
-        scheme = BetaScheme(system, stepping, law)
+        scheme = BetaScheme(system, stepping, law, beta)
     return Run(scheme)
+
+
+def with_beta(method, beta: float | None):
+    """``method`` with the β-scheme's β ``beta`` (None: as it is).  Moreau–Jean has no β:
+    ``beta`` is checked and not used."""
+    if beta is None:
+        return method
+    if isinstance(method, MoreauJean):
+        check_beta(beta)
+        return method
+    return replace(method, beta=beta)
 
 
 @dataclass(frozen=True)
@@ -57,11 +72,13 @@ class PositionLevel:
     """The β-scheme with exact contact at position level; ``massless``: how the massless
     rows of a redistributed mass step ("beta" or "quasi-static", see Stepping);
     ``params``: values of the solver's own parameters (its law's ``parameters`` table),
-    a dict or (name, value) pairs."""
+    a dict or (name, value) pairs; ``beta``: Newmark's β in [0, 1/2] (None: 1/2, the
+    papers' for exact contact)."""
     solver: Union[str, ContactLaw] = "auto"
     restitution: float = 0.0
     massless: str = "beta"
     params: tuple = ()
+    beta: float | None = None
     name: ClassVar[str] = "position"
     default_beta: ClassVar[float] = 0.5
     theta: ClassVar[None] = None
@@ -71,12 +88,14 @@ class PositionLevel:
         check_choice("massless", self.massless, MASSLESS)
         object.__setattr__(self, "params", tuple(dict(self.params).items()))
         self.law(None)      # the solver's name, its parameters, restitution beside it
+        object.__setattr__(self, "beta", _beta(self))
 
     def law(self, system) -> ContactLaw:
         return resolve(self.solver, None, self.restitution, dict(self.params))
 
     def build(self, system, stepping) -> Run:
-        return beta_run(system, replace(stepping, massless=self.massless), self.law(system))
+        return beta_run(system, replace(stepping, massless=self.massless), self.law(system),
+                        self.beta)
 
 
 @dataclass(frozen=True)
@@ -89,12 +108,14 @@ class Penalty:
     ``stiffness``), the supports' own damping; ``implicit``: the whole spring force at
     t_{n+1} (contact.penalty: the regularisation whose limit is the exact step).
     ``stiffness`` and ``damping`` are one number, or a tuple of one per obstacle (in the
-    order of ``Obstacles.parts``: a scene file's [[obstacles]]) for a one-plane beam."""
+    order of ``Obstacles.parts``: a scene file's [[obstacles]]) for a one-plane beam.
+    ``beta``: Newmark's β in [0, 1/2] (None: 1/4, the papers' for springs)."""
     stiffness: float | tuple[float, ...]
     equation_units: bool = False
     massless: str = "beta"
     damping: float | tuple[float, ...] = 0.0
     implicit: bool = False
+    beta: float | None = None
     name: ClassVar[str] = "penalty"
     default_beta: ClassVar[float] = 0.25
     theta: ClassVar[None] = None
@@ -105,6 +126,7 @@ class Penalty:
         object.__setattr__(self, "damping", _one_or_each("damping", self.damping,
                                                          check_nonnegative))
         check_choice("massless", self.massless, MASSLESS)
+        object.__setattr__(self, "beta", _beta(self))
 
     def law(self, system) -> ContactLaw:
         scale = 1.0 if self.equation_units or system is None else mass_scale(system)
@@ -112,7 +134,13 @@ class Penalty:
         return PenaltyLaw(k / scale, c / scale, self.implicit)     # the one conversion
 
     def build(self, system, stepping) -> Run:   # the quasi-static massless rows refuse springs
-        return beta_run(system, replace(stepping, massless=self.massless), self.law(system))
+        return beta_run(system, replace(stepping, massless=self.massless), self.law(system),
+                        self.beta)
+
+
+def _beta(method) -> float:
+    """The β-scheme method's β, checked (None: the method's default)."""
+    return check_beta(method.default_beta if method.beta is None else method.beta)
 
 
 def _one_or_each(name: str, value, check):
@@ -128,11 +156,10 @@ def _one_or_each(name: str, value, check):
 @dataclass(frozen=True)
 class MoreauJean:
     """Moreau–Jean: θ ∈ [1/2, 1], Newton restitution e ∈ [0, 1] (see
-    :mod:`.moreau_jean`); the Stepping's β is not used."""
+    :mod:`.moreau_jean`); it has θ where the β-scheme has β, and no β."""
     theta: float = 0.5
     restitution: float = 0.0
     name: ClassVar[str] = MOREAU_JEAN
-    default_beta: ClassVar[float] = 0.5
     massless: ClassVar[str] = "beta"
 
     def __post_init__(self):
@@ -148,4 +175,4 @@ class MoreauJean:
 Method = Union[PositionLevel, Penalty, MoreauJean]
 
 
-__all__ = ["Method", "MoreauJean", "Penalty", "PositionLevel", "mass_scale"]
+__all__ = ["Method", "MoreauJean", "Penalty", "PositionLevel", "mass_scale", "with_beta"]

@@ -1,4 +1,4 @@
-"""The one entry point: ``solve(system, dt, T, beta)`` → :class:`Result` (and
+"""The one entry point: ``solve(system, dt, T, method=...)`` → :class:`Result` (and
 ``moreau_jean(system, dt, T, theta, restitution)``, the same with Moreau–Jean)."""
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import math
 import sys
 
 from ..errors import InputError, SolverError
-from .methods import MoreauJean, Penalty, PositionLevel
+from .methods import MoreauJean, Penalty, PositionLevel, with_beta
 from .run import Run
 from .stepping import Result, Stepping
 
@@ -21,12 +21,14 @@ def solve(system, dt: float, T: float, beta: float | None = None, method=None, *
     """Integrate ``system`` over [0, T] with step ``dt``, in the style of ``solve_ivp``.
 
     ``method``: a :mod:`skfem_beam.methods` object, the one way a run names its method
-    (``PositionLevel(solver, restitution, massless)``: the solver a name of
-    ``contact.STEP_SOLVERS`` or a law object; ``Penalty(stiffness)`` in N/m, or in the units of the
-    semi-discrete equation with ``equation_units=True``; ``MoreauJean(theta,
+    (``PositionLevel(solver, restitution, massless, beta=...)``: the solver a name of
+    ``contact.STEP_SOLVERS`` or a law object; ``Penalty(stiffness, beta=...)`` in N/m, or in the
+    units of the semi-discrete equation with ``equation_units=True``; ``MoreauJean(theta,
     restitution)``); None: ``PositionLevel()``, exact contact by the cheapest exact law.
-    ``beta``: the β-scheme's β (default: the method's own, 1/2 for exact contact, 1/4 for
-    springs).  ``recording``: any of ``save_every`` (1), ``frames`` (200),
+    β is the β-scheme method's (default: the method's own, 1/2 for exact contact, 1/4 for
+    springs); ``beta``: a shorthand that sets it (``replace(method, beta=beta)``); None:
+    the method's as it is.  Moreau–Jean has no β: with it ``beta`` is checked and not
+    used.  ``recording``: any of ``save_every`` (1), ``frames`` (200),
     ``load_window`` ("forward"), ``growth_limit`` (10): see :class:`Stepping`.
 
     The run stops with status "unstable" when the discrete energy exceeds
@@ -43,9 +45,8 @@ def solve(system, dt: float, T: float, beta: float | None = None, method=None, *
     if unknown:
         raise TypeError(f"solve() got an unexpected keyword argument {unknown[0]!r} "
                         f"(it takes {', '.join(RECORDING)} and progress)")
-    if beta is None:
-        beta = method.default_beta
-    stepping = Stepping(dt, T, beta, **recording, massless=method.massless)
+    method = with_beta(method, beta)
+    stepping = Stepping(dt, T, **recording, massless=method.massless)
     rows = stepping.steps // stepping.save_every + 1
     values = rows * (2 * len(system.observe) + system.C.shape[0] + 4)
     if values > MAX_VALUES:   # a Result holds every saved row; the commands stream them

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
-from ..checks import check_beta, check_choice, check_count, check_positive
+from ..checks import check_choice, check_count, check_positive
 
 MAX_STEPS = 10**10        # beyond this a run is a hang, not a computation
 LOAD_WINDOWS = ("forward", "centered")
@@ -16,7 +16,8 @@ MASSLESS = ("beta", "quasi-static")
 
 @dataclass(frozen=True)
 class Stepping:
-    """Δt, T and β of the scheme, and what is kept of the run.
+    """Δt and T of the run, and what is kept of it (β is the β-scheme method's:
+    :class:`.methods.PositionLevel`, :class:`.methods.Penalty`).
 
     ``save_every``: keep every n-th state in the series; ``frames``: field frames kept
     (about); ``load_window``: fⁿ averages f over [tₙ, tₙ+Δt] ("forward", the papers'
@@ -29,7 +30,6 @@ class Stepping:
     """
     dt: float
     T: float
-    beta: float = 0.5
     save_every: int = 1
     frames: int = 200
     load_window: str = "forward"
@@ -40,7 +40,6 @@ class Stepping:
         dt, T = check_positive("dt", self.dt), check_positive("T", self.T)
         object.__setattr__(self, "dt", dt)
         object.__setattr__(self, "T", T)
-        object.__setattr__(self, "beta", check_beta(self.beta))
         object.__setattr__(self, "save_every", check_count("save_every", self.save_every))
         object.__setattr__(self, "frames", check_count("frames", self.frames))
         object.__setattr__(self, "growth_limit", check_positive("growth_limit",

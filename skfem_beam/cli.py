@@ -28,10 +28,22 @@ from .scheme.stepping import MASSLESS, Stepping
 from .spec import RunSpec
 
 
-def parser(prog: str, description: str, *, J=None, dt=None, T=None, beta=None,
-           element=True, solver=True, mass=("consistent", "redistributed")) -> Parser:
-    """The flags every scene takes; a scene adds its own.  ``mass``: the mass options
-    its space allows, the first the default."""
+# the defaults of the flags every scene shares, as parser() takes them: J (None: no --J,
+# --mesh, --probe), dt, T, beta, element and solver (False: no such flag), mass (the mass
+# options the scene's space allows, the first the default)
+SHARED = {"J": None, "dt": None, "T": None, "beta": None, "element": True, "solver": True,
+          "mass": ("consistent", "redistributed")}
+
+
+def parser(prog: str, description: str, **defaults) -> Parser:
+    """The flags every scene takes; a scene adds its own.  ``defaults``: any of
+    :data:`SHARED`, which gives the others."""
+    unknown = sorted(set(defaults) - set(SHARED))
+    if unknown:
+        raise TypeError(f"parser() got an unexpected default {unknown[0]!r} "
+                        f"(one of {', '.join(SHARED)})")
+    d = {**SHARED, **defaults}
+    J, dt, T, beta, mass = d["J"], d["dt"], d["T"], d["beta"], d["mass"]
     p = Parser(prog=prog, description=description,
                formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     if J is not None:
@@ -48,9 +60,9 @@ def parser(prog: str, description: str, *, J=None, dt=None, T=None, beta=None,
     p.add_argument("--beta", type=float, default=beta,
                    help="Newmark β in [0, 1/2]" if beta is not None else
                    "Newmark β in [0, 1/2] (default 1/2; 1/4 with --method penalty, the papers' choice)")
-    if element:
+    if d["element"]:
         p.add_argument("--element", default="hermite", help="hermite | bspline")
-    if solver:
+    if d["solver"]:
         p.add_argument("--solver", default="auto", help=" | ".join(SOLVERS))
         p.add_argument("--param", action="append", default=None, metavar="NAME=VALUE",
                        help="repeatable: a parameter of the --solver's law (its table: "
@@ -72,6 +84,11 @@ def parser(prog: str, description: str, *, J=None, dt=None, T=None, beta=None,
                        "in equilibrium at the new time (use it at β = 1/4)")
     p.add_argument("--stiffness", type=float, default=1e8,
                    help="penalty stiffness 1/ε (N/m) for --method penalty")
+    return output_flags(p, prog)
+
+
+def output_flags(p: Parser, prog: str) -> Parser:
+    """The flags of what a run writes and where (parser()'s tail)."""
     p.add_argument("--save-every", type=int, default=1,
                    help="keep every n-th step in timeseries.csv")
     p.add_argument("--frames", type=int, default=200, help="field snapshots kept")

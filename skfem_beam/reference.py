@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import bisect
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.polynomial import polynomial as _P
@@ -310,16 +311,33 @@ class BarWaves:
         return np.where(inside, R, 0.0)
 
 
+@dataclass(frozen=True)
+class BarData:
+    """An elastic bar's uniform physical data, as :class:`BarExact` takes them: stiffness
+    a, density ρ, length L, initial velocity v0, ``obstacle`` 'rigid' or 'elastic'
+    (spring k), load f and gap u0, the obstacle at x = 0."""
+    a: float
+    rho: float
+    L: float
+    v0: float
+    obstacle: str = "rigid"
+    k: float | None = None
+    f: float = 0.0
+    u0: float = 0.0
+
+
 class BarExact:
-    """Exact solution of an elastic bar (b = 0) with uniform data, in physical units.
+    """Exact solution of an elastic bar (b = 0) with uniform data (:class:`BarData`) up
+    to T, in physical units.
 
     u(x, t) = L·w(x/L, ct/L); R(t) = −a u_x(0, t) the obstacle reaction per unit area.
-    ``obstacle``: 'rigid' or 'elastic' (spring k).  Valid for any a, ρ, L, k > 0, f,
-    v0 and gap u0 ≥ 0 (u0 < 0 is allowed for the elastic obstacle).
+    Valid for any a, ρ, L, k > 0, f, v0 and gap u0 ≥ 0 (u0 < 0 is allowed for the
+    elastic obstacle).
     """
 
-    def __init__(self, a, rho, L, v0, T, obstacle="rigid", k=None, f=0.0, u0=0.0):
-        self.a, self.rho, self.L = float(a), float(rho), float(L)
+    def __init__(self, bar: BarData, T):
+        obstacle, k, f, u0, v0 = bar.obstacle, bar.k, bar.f, bar.u0, bar.v0
+        self.a, self.rho, self.L = float(bar.a), float(bar.rho), float(bar.L)
         self.c = np.sqrt(self.a / self.rho)
         kappa = None if obstacle == "rigid" else float(k) * self.L / self.a
         if obstacle == "rigid" and u0 < 0:
@@ -549,8 +567,8 @@ def exact_of(bar, T: float):
     if bar.far_end == "free":
         if not (isinstance(bar.u0, float) and isinstance(bar.v0, float)):
             return None
-        ex = BarExact(bar.a, bar.rho, bar.L, sign * bar.v0, T, bar.obstacle, bar.k / A,
-                      sign * bar.f, sign * bar.u0)
+        ex = BarExact(BarData(bar.a, bar.rho, bar.L, sign * bar.v0, bar.obstacle, bar.k / A,
+                              sign * bar.f, sign * bar.u0), T)
     else:
         d = _rod_gap(bar, sign)
         if d is None or bar.obstacle != "rigid" or bar.f != 0 or bar.v0 != 0.0:

@@ -26,18 +26,28 @@ PIPE_RHO_S = 8000.0 * math.pi / 4 * (0.01**2 - 0.009**2)  # ≈ 0.1194 kg/m
 PIPE10_L = 10.0                                           # the second paper's length (m)
 
 
-def point_stops(*, J=19, element="hermite", L=1.501, k2=PIPE_K2, gap=0.1, amplitude=0.2,
-                omega=10.0, rho_S=PIPE_RHO_S, nodes=None, damping=None) -> BeamProblem:
+# the mesh keywords point_stops forwards to BeamProblem, and their defaults
+POINT_STOPS_MESH = {"J": 19, "element": "hermite", "nodes": None}
+
+
+def point_stops(*, L=1.501, k2=PIPE_K2, gap=0.1, amplitude=0.2, omega=10.0,
+                rho_S=PIPE_RHO_S, damping=None, **mesh) -> BeamProblem:
     """Clamped to a support moving as A sin ωt, stops ±gap at the tip.  u0 = 0,
     v0 = −Aω h(x): the beam is at rest in the fixed frame (ũ = ũ_t = 0) at t = 0.
-    ``damping``: a :class:`~skfem_beam.problem.Damping` (the papers' pipe has none)."""
+    ``damping``: a :class:`~skfem_beam.problem.Damping` (the papers' pipe has none).
+    ``mesh``: J, element, nodes as :class:`~skfem_beam.problem.BeamProblem` takes them
+    (defaults :data:`POINT_STOPS_MESH`)."""
+    unknown = sorted(set(mesh) - set(POINT_STOPS_MESH))
+    if unknown:
+        raise TypeError(f"point_stops() got an unexpected keyword argument {unknown[0]!r} "
+                        f"(its mesh keywords: {', '.join(POINT_STOPS_MESH)})")
     gap = check_positive("gap", gap)
     beam = Beam(L, k2, rho_S)
     return BeamProblem(
         beam=beam, obstacles=Obstacles.point_stops(beam.L, -gap, gap),
         support=Support(amplitude, omega),
         initial=InitialState(v0=lambda x: -amplitude * omega * lifting(x, beam.L)),
-        J=J, element=element, nodes=nodes,
+        **{**POINT_STOPS_MESH, **mesh},
         damping=Damping() if damping is None else damping)
 
 

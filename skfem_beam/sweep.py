@@ -110,29 +110,37 @@ def parse_values(spec: str) -> list[float]:
     return values
 
 
-def make_settings(scene="point_stops", param="omega", transient=2.0, periods=50,
-                  dt=5e-5, J=19, beta=0.5, element="hermite", solver="auto", zeta=0.0,
-                  **fixed) -> dict:
-    """Everything a run depends on except the swept value (checked; JSON-able)."""
+# the sweep's settings other than the scene, the swept parameter and the scene's fixed
+# parameters: one JSON key (and one command-line flag) each, with its default
+SETTINGS = {"transient": 2.0, "periods": 50, "dt": 5e-5, "J": 19, "beta": 0.5,
+            "element": "hermite", "solver": "auto", "zeta": 0.0}
+
+
+def make_settings(scene="point_stops", param="omega", **given) -> dict:
+    """Everything a run depends on except the swept value (checked; JSON-able).
+    ``given``: any of :data:`SETTINGS` and fixed values of the scene's parameters."""
     defaults = scene_defaults(scene)
     if param not in defaults:
         raise InputError(f"--param {param!r} is not one of: {', '.join(defaults)}")
-    unknown = set(fixed) - set(defaults)
+    unknown = sorted(set(given) - set(SETTINGS) - set(defaults))
     if unknown:
-        raise InputError(f"{sorted(unknown)[0]!r} is not a parameter of scene {scene!r}")
-    fixed = {k: float(v if fixed.get(k) is None else fixed[k])
+        raise InputError(f"{unknown[0]!r} is not a setting or a parameter of scene "
+                         f"{scene!r}: one of {', '.join([*SETTINGS, *defaults])}")
+    s = {k: given.get(k, v) for k, v in SETTINGS.items()}
+    fixed = {k: float(v if given.get(k) is None else given[k])
              for k, v in defaults.items() if k != param}
-    transient = float(transient)
+    transient = float(s["transient"])
     if not (math.isfinite(transient) and transient >= 0):
         raise InputError(f"transient={transient:g} must be a finite number ≥ 0")
+    periods, J = s["periods"], s["J"]
     if isinstance(periods, bool) or int(periods) != periods or periods < 1:
         raise InputError(f"periods={periods!r} must be a whole number ≥ 1")
     if isinstance(J, bool) or int(J) != J or J < 1:
         raise InputError(f"J={J!r} must be a whole number ≥ 1")
     return {"scene": scene, "param": param, "fixed": fixed, "transient": transient,
-            "periods": int(periods), "dt_target": check_positive("dt", dt), "J": int(J),
-            "beta": check_beta(beta), "element": str(element), "solver": str(solver),
-            "zeta": check_nonnegative("zeta", zeta)}
+            "periods": int(periods), "dt_target": check_positive("dt", s["dt"]),
+            "J": int(J), "beta": check_beta(s["beta"]), "element": str(s["element"]),
+            "solver": str(s["solver"]), "zeta": check_nonnegative("zeta", s["zeta"])}
 
 
 def damping_of(settings: dict, value: float) -> dict:
@@ -409,16 +417,17 @@ def parser():
                    + " | ".join(SCENES["point_stops"][1]))
     p.add_argument("--values", required=True, default=argparse.SUPPRESS,
                    help="'linspace(a, b, n)' (n values from a to b inclusive) or v1,v2,...")
-    p.add_argument("--transient", type=float, default=2.0,
+    p.add_argument("--transient", type=float, default=SETTINGS["transient"],
                    help="seconds skipped before sampling (rounded up to whole periods)")
-    p.add_argument("--periods", type=int, default=50, help="forcing periods sampled")
-    p.add_argument("--dt", type=float, default=5e-5,
+    p.add_argument("--periods", type=int, default=SETTINGS["periods"],
+                   help="forcing periods sampled")
+    p.add_argument("--dt", type=float, default=SETTINGS["dt"],
                    help="target time step (s); the period is a whole number of steps")
-    p.add_argument("--J", type=int, default=19, help="number of elements")
-    p.add_argument("--beta", type=float, default=0.5, help="Newmark β in [0, 1/2]")
-    p.add_argument("--element", default="hermite", help="hermite | bspline")
-    p.add_argument("--solver", default="auto", help="contact solver")
-    p.add_argument("--zeta", type=float, default=0.0,
+    p.add_argument("--J", type=int, default=SETTINGS["J"], help="number of elements")
+    p.add_argument("--beta", type=float, default=SETTINGS["beta"], help="Newmark β in [0, 1/2]")
+    p.add_argument("--element", default=SETTINGS["element"], help="hermite | bspline")
+    p.add_argument("--solver", default=SETTINGS["solver"], help="contact solver")
+    p.add_argument("--zeta", type=float, default=SETTINGS["zeta"],
                    help="damping ratio (e.g. 0.02), Rayleigh, at the beam's first two natural "
                         "frequencies; 0: undamped, as the papers")
     for name, default in scene_defaults("point_stops").items():
@@ -437,10 +446,8 @@ def parser():
 def main(argv=None) -> int:
     args = parser().parse_args(argv)
     fixed = {n: getattr(args, n) for n in SCENES["point_stops"][1] if hasattr(args, n)}
-    settings = make_settings(args.scene, args.param, transient=args.transient,
-                             periods=args.periods, dt=args.dt, J=args.J, beta=args.beta,
-                             element=args.element, solver=args.solver, zeta=args.zeta,
-                             **fixed)
+    settings = make_settings(args.scene, args.param,
+                             **{k: getattr(args, k) for k in SETTINGS}, **fixed)
     values = parse_values(args.values)
     check_values(settings, values)
     scheduler, workers = getattr(args, "scheduler", None), getattr(args, "workers", None)

@@ -31,14 +31,6 @@ WIDE = {
     ("contact/active_set.py", "exact_finish"): "QP calling convention (D, yf, lo, hi, "
                                                "duals, state, mu, scale, engine, tol)",
     ("contact/active_set.py", "repair"): "QP calling convention (exact_finish's tail)",
-    # public keyword APIs whose keywords are the clearest form
-    ("scenes.py", "point_stops"): "a scene builder: keyword-only physical and mesh "
-                                  "parameters, as every scene in scenes.py",
-    ("sweep.py", "make_settings"): "the sweep's settings, one checked keyword per "
-                                   "JSON key, named so by the tests and benchmarks",
-    ("cli.py", "parser"): "the defaults of a scene's shared flags, one keyword per flag",
-    ("reference.py", "BarExact.__init__"): "the bar's physical data (a, ρ, L, v0, T, "
-                                  "obstacle, k, f, u0), the public exact solution",
 }
 
 

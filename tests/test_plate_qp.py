@@ -17,6 +17,12 @@ from skfem_beam.scheme import solve
 DT, T = 1e-4, 0.03
 
 
+@pytest.fixture(autouse=True)
+def _fingerprint_first(machine_pins):
+    """This machine's fingerprint (conftest, cached for the process) is taken before the
+    CHOLMOD tests load cvxopt: it lists every BLAS loaded, and cvxopt brings its own."""
+
+
 def closure(r):
     """energy − energy[0] + damping work − input work − contact work (0 by the identity)."""
     w = r.work
@@ -135,5 +141,6 @@ def test_the_kept_factor_solves_as_a_fresh_factorisation(chol):
         assert np.array_equal(y[state_fast < 0], lo[state_fast < 0])
     # the set moved, and both the Schur complement and refactorisations were used
     fast, fresh = used["fast"], used["fresh"]
-    assert changes > 50 and fast["columns"] > 0 and fast["factors"] > 1 and fast["guesses"] > 0
+    assert changes > 50 and fast["columns"] > 0 and fast["factors"] > 1
+    assert (fast["guesses"] > 0) == (chol == "band")     # inexact sweeps: the band's only
     assert fast["factors"] < fresh["factors"]

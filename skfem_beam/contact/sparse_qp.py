@@ -36,7 +36,8 @@ and
    (only where a factorisation costs many solves: a banded factor of at most
    GUESS_MAX_BYTES, past which dpbtrs streams the factor from memory, a factorisation
    costs 13 solves instead of 45, and they do not pay: measured at 80 × 80, 2.1 s a step
-   with them against 1.2 s without; with CHOLMOD, at most GUESS_MAX_N unknowns);
+   with them against 1.2 s without; never with CHOLMOD, whose numeric factorisation
+   costs 10–20 of its solves);
 2. then exact sweeps from that set: with P = S ∖ S0 (newly pinned), Q = S0 ∖ S (freed),
    the block elimination of A_S over the kept factor needs G⁻¹z_j for j ∈ P ∪ Q
    (z_j = e_j or A's column j), one solve each, cached until S0 changes, and a
@@ -77,7 +78,6 @@ EPS = 1e-6         # OSQP's / Clarabel's tolerance in scaled units: enough to fi
 GUESS_SWEEPS = 10  # inexact sweeps (PCG with the kept factor) before the exact ones
 GUESS_ITERATIONS = 4   # PCG iterations of an inexact sweep
 GUESS_MAX_BYTES = 32e6   # inexact sweeps only where the banded factor has at most these
-GUESS_MAX_N = 10000      # ... or, with CHOLMOD, where A has at most these unknowns
 CHOLMOD_MIN_N = 4000     # unknowns from which A_S is factored by CHOLMOD, not the band
 # the one tally of every SelectorQP's factorisations, banded solves (columns), exact and
 # inexact sweeps, finished steps and cached columns G⁻¹z_j so far in this process
@@ -222,9 +222,10 @@ class SelectorQP:
 
     ``update=True`` (the default): the sets are solved with a kept factor of A_{S0} of an
     earlier set S0 and a Schur complement on the difference S Δ S0 (`solve_on_set`);
-    ``update=False``: a fresh banded Cholesky of A_S for every new set (the reference
-    the tests compare with).  ``max_columns``: the cached columns G⁻¹z_j after which the
-    next set becomes the new S0 (refactored)."""
+    ``update=False``: a fresh Cholesky of A_S for every new set (the reference the tests
+    compare with).  ``max_columns``: the cached columns G⁻¹z_j after which the next set
+    becomes the new S0 (refactored).  ``chol``: G's kind, "band", "cholmod" or "auto"
+    (`cholesky_kind`: CHOLMOD from CHOLMOD_MIN_N unknowns)."""
 
     def __init__(self, A, C, update: bool = True, max_columns: int = MAX_COLUMNS,
                  guess_sweeps: int = GUESS_SWEEPS, chol: str = "auto"):
@@ -246,10 +247,11 @@ class SelectorQP:
     def guesses_pay(self) -> bool:
         """Inexact sweeps pay where a factorisation costs many solves: the band while its
         factor stays in cache (dpbtrf = 45 dpbtrs at 40 × 40, 8.6 MB; 13 at 80 × 80,
-        68 MB); CHOLMOD up to GUESS_MAX_N unknowns (docs/plate.md)."""
+        68 MB); not with CHOLMOD (a numeric factorisation costs 10–20 of its solves;
+        measured at 40 × 40: 259 ms a step without them against 334 with; docs/plate.md)."""
         if isinstance(self.G, BandCholesky):
             return 8.0 * self.n * (self.G.kd + 1) <= GUESS_MAX_BYTES
-        return self.n <= GUESS_MAX_N
+        return False
 
     def factor(self, pinned: np.ndarray) -> None:
         """G ← the Cholesky factor of A_S for the pinned unknowns (kept for the last set,

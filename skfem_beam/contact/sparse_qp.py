@@ -2,14 +2,15 @@
 
 The step QP  min ½uᵀAu − Fᵀu,  lo ≤ Cu ≤ hi  (F = A x_free) is solved for u itself.  Where
 each row of C selects one unknown (the plate: w at a vertex), an active set S pins those
-unknowns at their bounds b_S, and the step on S is one banded solve with
+unknowns at their bounds b_S, and the step on S is one solve with
 
     A_S = A with the rows and columns of S replaced by the identity,
     A_S u = F − A[:, S] b_S  off S,   u_S = b_S,
 
-whose Cholesky factor has A's band; then μ = C(A u − F) (Δt² × the nodal forces, the
-scheme's multipliers: A u = A x_free + Cᵀμ).  This is exact to round-off on S; the KKT
-check and the set's update are those of the primal-dual active set method (Hintermüller,
+whose Cholesky factor, in any fixed ordering, lies in the pattern of A's (A's band, or
+CHOLMOD's fill of A); then μ = C(A u − F) (Δt² × the nodal forces, the scheme's
+multipliers: A u = A x_free + Cᵀμ).  This is exact to round-off on S; the KKT check and
+the set's update are those of the primal-dual active set method (Hintermüller,
 Ito & Kunisch 2003): with c = diag(A) on S's rows (so that c·gap is a force)
 
     lower active  if  μ_j + c_j (lo_j − u_j) > 0,   upper active  if  μ_j + c_j (hi_j − u_j) < 0,
@@ -17,24 +18,35 @@ Ito & Kunisch 2003): with c = diag(A) on S's rows (so that c·gap is a force)
 iterated until S repeats.
 
 How a set is solved (`SelectorQP`; docs/plate.md, "Which engine at which size"): the
-Cholesky factor of A_{S0} of an earlier set S0 is kept (LAPACK dpbtrf/dpbtrs on one
-thread), and
+Cholesky factor G of A_{S0} of an earlier set S0 is kept, and G is either
+
+- CHOLMOD's (through cvxopt.cholmod, `SparseCholesky`) from CHOLMOD_MIN_N unknowns: the
+  symbolic factorisation (AMD ordering, supernodal) once per run on A's lower triangle,
+  a set's pinned rows and columns kept as explicit zeros so the pattern never changes,
+  one numeric factorisation per set (40 × 40: 14 ms against dpbtrf's 61; 80 × 80: 122
+  against 1,854), cholmod.solve for the solves; or
+- the band's below (`BandCholesky`: LAPACK dpbtrf/dpbtrs on one thread), where it is as
+  fast and has no symbolic step;
+
+and
 
 1. inexact sweeps first: GUESS_ITERATIONS iterations of CG on A_S, preconditioned by the
    kept factor (A_{S0}⁻¹A_S is the identity plus a rank ≤ 2|S Δ S0|), from the last
    iterate, give μ and the next set; up to GUESS_SWEEPS of them, until the set repeats
-   (only where the factor has at most GUESS_MAX_BYTES: past that dpbtrs streams the
-   factor from memory, a factorisation costs 13 solves instead of 45, and they do not
-   pay: measured at 80 × 80, 2.1 s a step with them against 1.2 s without);
+   (only where a factorisation costs many solves: a banded factor of at most
+   GUESS_MAX_BYTES, past which dpbtrs streams the factor from memory, a factorisation
+   costs 13 solves instead of 45, and they do not pay: measured at 80 × 80, 2.1 s a step
+   with them against 1.2 s without; never with CHOLMOD, whose numeric factorisation
+   costs 10–20 of its solves);
 2. then exact sweeps from that set: with P = S ∖ S0 (newly pinned), Q = S0 ∖ S (freed),
    the block elimination of A_S over the kept factor needs G⁻¹z_j for j ∈ P ∪ Q
-   (z_j = e_j or A's column j), one banded solve each, cached until S0 changes, and a
+   (z_j = e_j or A's column j), one solve each, cached until S0 changes, and a
    dense |P ∪ Q| Schur complement; when the cache would pass MAX_COLUMNS columns the set
-   becomes the new S0 (one dpbtrf).  u_S = b_S is then set exactly.
+   becomes the new S0 (one factorisation).  u_S = b_S is then set exactly.
 
 In the bench's scene (a plate bouncing on a flat obstacle) the set changes by 50–200 of
 1,521 vertices a step at 40 × 40: the inexact sweeps bring the factorisations from 3.7 a
-step (one per exact sweep) to about 1, the rest is banded solves.
+step (one per exact sweep) to about 1, the rest is solves.
 
 Engines (registered laws, ``x_space = True``: the scheme builds neither W nor D for them
 and takes u^{n+1} from the engine, contact/registry.py):
@@ -59,7 +71,6 @@ import scipy.linalg
 import scipy.sparse as sp
 
 from ..errors import InputError, SolverError
-from ..linalg import band_solve
 from .base import ContactLaw
 
 MAX_SWEEPS = 100   # active-set updates of one step before it gives up (SolverError)
@@ -67,6 +78,7 @@ EPS = 1e-6         # OSQP's / Clarabel's tolerance in scaled units: enough to fi
 GUESS_SWEEPS = 10  # inexact sweeps (PCG with the kept factor) before the exact ones
 GUESS_ITERATIONS = 4   # PCG iterations of an inexact sweep
 GUESS_MAX_BYTES = 32e6   # inexact sweeps only where the banded factor has at most these
+CHOLMOD_MIN_N = 4000     # unknowns from which A_S is factored by CHOLMOD, not the band
 # the one tally of every SelectorQP's factorisations, banded solves (columns), exact and
 # inexact sweeps, finished steps and cached columns G⁻¹z_j so far in this process
 # (plate.bench resets and reads it; a test takes one call's share by difference)
@@ -86,17 +98,109 @@ def selected_unknowns(C) -> np.ndarray:
     return cols.astype(np.int64)
 
 
-def band_cholesky(band: np.ndarray) -> np.ndarray:
-    """The Cholesky factor of the matrix whose upper band is ``band`` (Banded layout),
-    in the layout `band_solve` takes (reciprocal diagonal).  LAPACK's dpbtrf on ONE
-    thread (threadpoolctl): OpenBLAS's threads took 0.2–1.2 s at 40 × 40 on
-    two busy cores against 45 ms on one (measured; a numba loop took 0.3 s)."""
-    from threadpoolctl import threadpool_limits
-    with threadpool_limits(1, user_api="blas"):
-        chol = scipy.linalg.cholesky_banded(np.ascontiguousarray(band.T), check_finite=False)
-    chol = np.ascontiguousarray(chol.T)
-    chol[:, -1] = 1.0 / chol[:, -1]
-    return chol
+class BandCholesky:
+    """G = A_S's banded Cholesky: LAPACK dpbtrf for a set, dpbtrs for each solve (on the
+    caller's one thread, `_one_thread`; OpenBLAS's threads took 0.2–1.2 s at 40 × 40 on
+    two busy cores against 45 ms on one).  A_S = A with the pinned rows and columns
+    replaced by the identity has A's band."""
+    name = "band"
+
+    def __init__(self, A):
+        coo = sp.triu(A).tocoo()                 # A's upper band in LAPACK's layout
+        self.n = A.shape[0]
+        self.kd = int((coo.col - coo.row).max()) if coo.nnz else 0
+        self.lap = np.zeros((self.kd + 1, self.n))   # lap[kd − o, j] = A[j − o, j]
+        self.lap[self.kd + coo.row - coo.col, coo.col] = coo.data
+        self.L = None
+
+    def pinned_band(self, pinned: np.ndarray) -> np.ndarray:
+        """The upper band of A_S in LAPACK's layout (kd + 1, n)."""
+        kd, n = self.kd, self.n
+        lap = self.lap.copy()
+        lap[:, pinned] = 0.0                          # column j pinned
+        o = np.arange(1, kd + 1)
+        rows = pinned[:, None] + o[None, :]           # row i pinned: A[i, i + o]
+        offs = np.broadcast_to(kd - o, rows.shape)
+        keep = rows < n
+        lap[offs[keep], rows[keep]] = 0.0
+        lap[kd, pinned] = 1.0
+        return lap
+
+    def factor(self, pinned: np.ndarray) -> None:
+        self.L, info = scipy.linalg.lapack.dpbtrf(self.pinned_band(pinned), lower=0,
+                                                  overwrite_ab=1)
+        if info != 0:
+            raise SolverError(f"the banded Cholesky of A_S failed (dpbtrf info {info})")
+        self.L = np.asfortranarray(self.L)
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        x, info = scipy.linalg.lapack.dpbtrs(self.L, b, lower=0)
+        if info != 0:
+            raise SolverError(f"dpbtrs info {info}")
+        return x
+
+
+class SparseCholesky:
+    """G = A_S's sparse Cholesky: CHOLMOD (supernodal, its AMD ordering) through
+    cvxopt.cholmod.  The symbolic factorisation is made once, on A's lower triangle; a
+    set's pinned rows and columns keep their entries as explicit zeros (1 on the
+    diagonal), so the pattern never changes and each set is one numeric factorisation;
+    cholmod.solve for the solves."""
+    name = "cholmod"
+
+    def __init__(self, A):
+        import cvxopt
+        from cvxopt import cholmod
+        self.cvxopt, self.cholmod = cvxopt, cholmod
+        low = sp.tril(A, format="csc")
+        low.sort_indices()
+        self.n = A.shape[0]
+        self.data = low.data.copy()
+        self.rows = low.indices.astype(np.int64)
+        self.cols = np.repeat(np.arange(self.n, dtype=np.int64), np.diff(low.indptr))
+        self.diag = self.rows == self.cols
+        m = cvxopt.matrix
+        self.M = cvxopt.spmatrix(m(self.data), m(self.rows), m(self.cols), (self.n, self.n))
+        if not np.array_equal(np.asarray(self.M.CCS[1]).ravel(), low.indices):
+            raise SolverError("cvxopt reordered A's lower triangle")   # (values by position)
+        self.F = cholmod.symbolic(self.M)
+
+    def factor(self, pinned: np.ndarray) -> None:
+        mask = np.zeros(self.n, dtype=bool)
+        mask[pinned] = True
+        values = self.data.copy()
+        row_pinned = mask[self.rows]
+        values[row_pinned | mask[self.cols]] = 0.0
+        values[row_pinned & self.diag] = 1.0
+        self.M.V = self.cvxopt.matrix(values)
+        try:
+            self.cholmod.numeric(self.M, self.F)
+        except ArithmeticError as e:
+            raise SolverError(f"the sparse Cholesky of A_S failed (CHOLMOD: {e})") from e
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        x = self.cvxopt.matrix(b)
+        self.cholmod.solve(self.F, x)
+        x = np.array(x)
+        return x.ravel() if b.ndim == 1 else x
+
+
+def cholesky_kind(n: int, kind: str = "auto") -> str:
+    """"band" or "cholmod"; "auto": CHOLMOD from CHOLMOD_MIN_N unknowns, the band below
+    (docs/plate.md, "Which engine at which size")."""
+    if kind == "auto":
+        return "cholmod" if n >= CHOLMOD_MIN_N else "band"
+    return kind
+
+
+def cholesky(A, kind: str = "auto"):
+    """A_S's Cholesky for SelectorQP (`cholesky_kind`)."""
+    kind = cholesky_kind(A.shape[0], kind)
+    if kind == "band":
+        return BandCholesky(A)
+    if kind == "cholmod":
+        return SparseCholesky(A)
+    raise InputError(f"unknown Cholesky '{kind}' (band, cholmod or auto)")
 
 
 _CONTROLLER = None
@@ -118,81 +222,61 @@ class SelectorQP:
 
     ``update=True`` (the default): the sets are solved with a kept factor of A_{S0} of an
     earlier set S0 and a Schur complement on the difference S Δ S0 (`solve_on_set`);
-    ``update=False``: a fresh banded Cholesky of A_S for every new set (the reference
-    the tests compare with).  ``max_columns``: the cached columns G⁻¹z_j after which the
-    next set becomes the new S0 (refactored)."""
+    ``update=False``: a fresh Cholesky of A_S for every new set (the reference the tests
+    compare with).  ``max_columns``: the cached columns G⁻¹z_j after which the next set
+    becomes the new S0 (refactored).  ``chol``: G's kind, "band", "cholmod" or "auto"
+    (`cholesky_kind`: CHOLMOD from CHOLMOD_MIN_N unknowns)."""
 
     def __init__(self, A, C, update: bool = True, max_columns: int = MAX_COLUMNS,
-                 guess_sweeps: int = GUESS_SWEEPS):
+                 guess_sweeps: int = GUESS_SWEEPS, chol: str = "auto"):
         self.A = sp.csr_matrix(A, dtype=float)
         self.A.sort_indices()
-        coo = sp.triu(self.A).tocoo()           # A's upper band in LAPACK's layout
-        self.kd = int((coo.col - coo.row).max()) if coo.nnz else 0
-        self.lap = np.zeros((self.kd + 1, self.A.shape[0]))  # lap[kd − o, j] = A[j − o, j]
-        self.lap[self.kd + coo.row - coo.col, coo.col] = coo.data
         self.dof = selected_unknowns(C)
         self.c = self.A.diagonal()[self.dof]
         self.n = self.A.shape[0]
         self.update, self.max_columns = update, int(max_columns)
-        # inexact sweeps pay where a factorisation costs many solves: while the factor
-        # stays in cache (dpbtrf = 45 dpbtrs at 40 × 40, 8.6 MB; 13 at 80 × 80, 68 MB)
-        small = 8.0 * self.n * (self.kd + 1) <= GUESS_MAX_BYTES
-        self.guess_sweeps = int(guess_sweeps) if update and small else 0
-        self.key, self.chol = None, None        # the last set's factor (update=False)
+        self.G = cholesky(self.A, chol)         # the factor of A_S for a set
+        self.guess_sweeps = int(guess_sweeps) if update and self.guesses_pay() else 0
+        self.key = None                         # the set G factors (update=False)
         # the kept base S0 (update=True)
         self.side0 = None                       # S0 as a state (int8 per row)
-        self.L = None                           # LAPACK upper Cholesky factor of A_{S0}
         self.Y = None                           # (n, max_columns): G⁻¹ z_j, Fortran order
         self.col = {}                           # row j → its column of Y
         self.y0 = None                          # G⁻¹(F − A u_{S0})|F0 of this step
 
-    def pinned_band(self, pinned: np.ndarray, lapack: bool = False) -> np.ndarray:
-        """The upper band of A_S: A with rows and columns ``pinned`` replaced by the
-        identity; in the Banded layout (n, kd + 1), or LAPACK's (kd + 1, n)."""
-        kd, n = self.kd, self.n
-        lap = self.lap.copy()
-        lap[:, pinned] = 0.0                          # column j pinned
-        o = np.arange(1, kd + 1)
-        rows = pinned[:, None] + o[None, :]           # row i pinned: A[i, i + o]
-        offs = np.broadcast_to(kd - o, rows.shape)
-        keep = rows < n
-        lap[offs[keep], rows[keep]] = 0.0
-        lap[kd, pinned] = 1.0
-        return lap if lapack else np.ascontiguousarray(lap.T)
+    def guesses_pay(self) -> bool:
+        """Inexact sweeps pay where a factorisation costs many solves: the band while its
+        factor stays in cache (dpbtrf = 45 dpbtrs at 40 × 40, 8.6 MB; 13 at 80 × 80,
+        68 MB); not with CHOLMOD (a numeric factorisation costs 10–20 of its solves;
+        measured at 40 × 40: 259 ms a step without them against 334 with; docs/plate.md)."""
+        if isinstance(self.G, BandCholesky):
+            return 8.0 * self.n * (self.G.kd + 1) <= GUESS_MAX_BYTES
+        return False
 
-    def factor(self, pinned: np.ndarray) -> np.ndarray:
-        """The Cholesky factor (Banded layout) of A_S for the pinned unknowns, cached
-        for the last set (update=False)."""
+    def factor(self, pinned: np.ndarray) -> None:
+        """G ← the Cholesky factor of A_S for the pinned unknowns (kept for the last set,
+        update=False)."""
         key = pinned.tobytes()
-        if key == self.key:
-            return self.chol
-        self.key, self.chol = key, band_cholesky(self.pinned_band(pinned))
-        COUNTS["factors"] += 1
-        return self.chol
+        if key != self.key:
+            self.G.factor(pinned)
+            self.key = key
+            COUNTS["factors"] += 1
 
     # -- the kept factor and the Schur complement on S Δ S0 (update=True) ------------
     def rebase(self, state: np.ndarray) -> None:
-        """S0 ← the set ``state``: factor A_{S0} (LAPACK dpbtrf, one thread), empty the
-        cache of columns."""
+        """S0 ← the set ``state``: factor A_{S0}, empty the cache of columns."""
         self.side0 = state.copy()
-        band = self.pinned_band(self.dof[state != 0], lapack=True)
-        self.L, info = scipy.linalg.lapack.dpbtrf(band, lower=0, overwrite_ab=1)
-        if info != 0:
-            raise SolverError(f"the banded Cholesky of A_S failed (dpbtrf info {info})")
-        self.L = np.asfortranarray(self.L)
+        self.key = None
+        self.factor(self.dof[state != 0])
         if self.Y is None:
             self.Y = np.zeros((self.n, self.max_columns), order="F")
         self.col = {}
         self.y0 = None
-        COUNTS["factors"] += 1
 
     def gsolve(self, b: np.ndarray) -> np.ndarray:
-        """G⁻¹b with G = A_{S0} (b: a vector or Fortran-ordered columns)."""
-        x, info = scipy.linalg.lapack.dpbtrs(self.L, b, lower=0)
+        """G⁻¹b with G = A_S's factor (b: a vector or Fortran-ordered columns)."""
         COUNTS["solves"] += 1 if b.ndim == 1 else b.shape[1]
-        if info != 0:
-            raise SolverError(f"dpbtrs info {info}")
-        return x
+        return self.G.solve(b)
 
     def base_values(self, lo, hi) -> np.ndarray:
         """This step's values of S0's rows on their sides (0 off S0 and where infinite)."""
@@ -291,10 +375,9 @@ class SelectorQP:
         ub[pinned] = b
         rhs = F - self.A @ ub
         rhs[pinned] = b
-        band_solve(self.factor(pinned), rhs)
-        COUNTS["solves"] += 1
-        rhs[pinned] = b                         # exactly on the bounds
-        u[:] = rhs
+        self.factor(pinned)
+        u[:] = self.gsolve(rhs)
+        u[pinned] = b                           # exactly on the bounds
 
     def solve_on_set(self, F, lo, hi, state, u) -> np.ndarray:
         """u ← the minimiser with the set ``state`` pinned; returns μ = C(Au − F)."""
@@ -345,7 +428,7 @@ class SelectorQP:
         F = self.A @ x
         COUNTS["steps"] += 1
         if self.update:
-            if self.L is None:
+            if self.side0 is None:
                 self.rebase(state)
             self.y0 = None                      # a new F: a new base solve
             if self.guess_sweeps:               # inexact sweeps find a set first

@@ -8,7 +8,8 @@ quarter period and stays pressed on it.  Printed per mesh: the half bandwidth, t
 (the banded Cholesky of A = M + βΔt²K alone, and the whole of scheme.operators:
 step_operators, with W = A⁻¹Cᵀ and D = C W, when W fits in W_LIMIT bytes) and the bytes
 of W and D; per step, one banded solve with A's factor (the scheme's, linalg.band_solve,
-and LAPACK's dpbtrs on one thread, which the x-space laws use), the scheme's step without
+LAPACK's dpbtrf and dpbtrs on one thread, and CHOLMOD's numeric factorisation and solve:
+the x-space laws' two Cholesky factors, contact.sparse_qp), the scheme's step without
 obstacles, and the step pressed on the obstacle with each exact law (its mean over the
 run, with the fraction of steps in contact, and its ratio to the scheme's banded solve
 and to dpbtrs); the process's peak memory after each mesh.  The laws that need W and D (active-set, daqp,
@@ -24,7 +25,7 @@ import time
 import numpy as np
 import scipy.linalg
 
-from ..contact.sparse_qp import COUNTS, _one_thread
+from ..contact.sparse_qp import COUNTS, SparseCholesky, _one_thread, cholesky_kind
 from ..linalg import Banded, band_solve
 from ..methods import PositionLevel
 from ..scheme import solve
@@ -74,12 +75,27 @@ def setup_row(system) -> dict:
     b = np.ones(system.n)
     solve_s = timed(lambda: band_solve(ops.Ab.chol, b), 50)
     with _one_thread():
+        lapack_f = timed(lambda: scipy.linalg.lapack.dpbtrf(ops.Ab.lapack_band(), lower=0), 3)
         lap, _ = scipy.linalg.lapack.dpbtrf(ops.Ab.lapack_band(), lower=0)
         lapack_s = timed(lambda: scipy.linalg.lapack.dpbtrs(lap, b, lower=0), 50)
-    return {"n": system.n, "m": system.C.shape[0], "kd": half_bandwidth(A),
+    return {**cholmod_row(A, b), "lapack_factor_ms": 1e3 * lapack_f,
+            "n": system.n, "m": system.C.shape[0], "kd": half_bandwidth(A),
             "factor_s": factor, "operators_s": total, "W_MB": ops.W.nbytes / 1e6,
             "D_MB": ops.D.nbytes / 1e6, "band_solve_ms": 1e3 * solve_s,
             "lapack_solve_ms": 1e3 * lapack_s, "delassus": delassus}
+
+
+def cholmod_row(A, b) -> dict:
+    """CHOLMOD's times on A (cvxopt.cholmod, as SelectorQP uses it): the symbolic
+    factorisation (once a run), a numeric one (once a set), a solve (ms)."""
+    import cvxopt.cholmod  # noqa: F401  (its first import is not the symbolic step's time)
+    t0 = time.perf_counter()
+    G = SparseCholesky(A)
+    symbolic = time.perf_counter() - t0
+    none = np.zeros(0, dtype=np.int64)
+    numeric = timed(lambda: G.factor(none), 3)
+    return {"cholmod_symbolic_ms": 1e3 * symbolic, "cholmod_numeric_ms": 1e3 * numeric,
+            "cholmod_solve_ms": 1e3 * timed(lambda: G.solve(b), 50)}
 
 
 def step_ms(system, solver: str, steps: int) -> tuple[float, float]:
@@ -111,8 +127,9 @@ def law_rows(pressed, laws, solve_ms: float, lapack_ms: float, steps: int = STEP
               f"contact)", flush=True)
         if law in X_SPACE_LAWS and COUNTS["steps"]:
             c = {k: v / COUNTS["steps"] for k, v in COUNTS.items()}
-            print(f"    per contact step: {c['factors']:.2f} factorisations, "
-                  f"{c['solves']:.1f} banded solves, {c['guesses']:.1f} inexact and "
+            kind = cholesky_kind(pressed.n)
+            print(f"    per contact step: {c['factors']:.2f} factorisations ({kind}), "
+                  f"{c['solves']:.1f} solves, {c['guesses']:.1f} inexact and "
                   f"{c['sweeps']:.1f} exact sweeps", flush=True)
 
 
@@ -134,7 +151,10 @@ def main(argv=None) -> None:
         print(f"  setup: Cholesky of A {row['factor_s']:.3f} s, step_operators {what} "
               f"{row['operators_s']:.2f} s; W {row['W_MB']:.1f} MB, D {row['D_MB']:.1f} MB")
         print(f"  one banded solve: {row['band_solve_ms']:.3f} ms (LAPACK dpbtrs: "
-              f"{row['lapack_solve_ms']:.3f} ms)", flush=True)
+              f"{row['lapack_solve_ms']:.3f} ms, dpbtrf {row['lapack_factor_ms']:.1f} ms)")
+        print(f"  CHOLMOD (cvxopt): symbolic {row['cholmod_symbolic_ms']:.1f} ms, numeric "
+              f"{row['cholmod_numeric_ms']:.1f} ms, solve {row['cholmod_solve_ms']:.3f} ms",
+              flush=True)
         ms, _ = step_ms(free, "auto", steps)
         print(f"  step without obstacles: {ms:.2f} ms = {ms / row['band_solve_ms']:.1f} "
               f"solves", flush=True)

@@ -17,12 +17,6 @@ from skfem_beam.scheme import solve
 DT, T = 1e-4, 0.03
 
 
-@pytest.fixture(autouse=True)
-def _fingerprint_first(machine_pins):
-    """This machine's fingerprint (conftest, cached for the process) is taken before the
-    CHOLMOD tests load cvxopt: it lists every BLAS loaded, and cvxopt brings its own."""
-
-
 def closure(r):
     """energy − energy[0] + damping work − input work − contact work (0 by the identity)."""
     w = r.work

@@ -12,6 +12,8 @@ from __future__ import annotations
 import hashlib
 import json
 import platform
+import subprocess
+import sys
 from importlib.metadata import version
 
 PACKAGES = ("numpy", "scipy", "numba", "llvmlite", "scikit-fem", "osqp", "daqp", "meshio")
@@ -36,12 +38,20 @@ def _numba_target() -> dict:
             else ll.get_host_cpu_features().flatten()}
 
 
+# numpy's and scipy's BLAS as a fresh interpreter loads them: not whatever else this
+# process has loaded by now (cvxopt brings an OpenBLAS of its own) or limited since
+_BLAS = """
+import json, numpy, scipy.linalg
+from threadpoolctl import threadpool_info
+print(json.dumps(sorted(f"{i['internal_api']} {i.get('version')} {i.get('architecture')} "
+                        f"threads={i['num_threads']}" for i in threadpool_info())))
+"""
+
+
 def _blas() -> list:
-    import numpy  # noqa: F401  (both libraries' BLAS loaded, so both are listed)
-    import scipy.linalg  # noqa: F401
-    from threadpoolctl import threadpool_info
-    return sorted(f"{i['internal_api']} {i.get('version')} {i.get('architecture')} "
-                  f"threads={i['num_threads']}" for i in threadpool_info())
+    out = subprocess.run([sys.executable, "-c", _BLAS], capture_output=True, text=True,
+                         check=True)
+    return json.loads(out.stdout)
 
 
 def _numpy_dispatch() -> list:

@@ -92,3 +92,14 @@ def assert_exact_with_friction(r, clearance: float) -> None:
     assert np.abs(gap).max() <= 1e-9 * np.abs(r.energy).max()
     assert w["friction"][-1] < 0 and w["contact"][-1] < 0
     assert np.diff(w["friction"]).max() <= 1e-15 * abs(w["friction"][-1])
+
+
+def random_broached(rng, widths, ridge: float):
+    """A random broached hole of radius 1 (2 to 5 lands, each ``widths`` (a, b) × its
+    share of the turn wide, at a random angle) and a random SPD 2 × 2 block D
+    (AAᵀ + ridge·I): one local problem of the broached-hole laws."""
+    n = int(rng.integers(2, 6))
+    from skfem_beam.holes import Hole
+    hole = Hole.broached(n, rng.uniform(*widths) * 2 * np.pi / n, 1.0, rng.uniform(-3, 3))
+    A = rng.normal(size=(2, 2))
+    return hole, A @ A.T + ridge * np.eye(2)

@@ -7,7 +7,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from conftest import assert_refused, exit_code
+from conftest import assert_refused, exit_code, random_broached
 from skfem_beam.contact.round_hole import land_cone_solve, land_project
 from skfem_beam.errors import InputError
 from skfem_beam.holes import Hole, hole_from_table, land_excess
@@ -54,11 +54,7 @@ def test_one_block_is_the_projection_onto_k_in_the_d_metric():
     root, mu = np.empty(3), np.empty(2)
     pieces = set()
     for _ in range(120):
-        n = int(rng.integers(2, 6))
-        hole = Hole.broached(n, rng.uniform(0.01, 1.0) * 2 * math.pi / n, 1.0,
-                             rng.uniform(-3, 3))
-        A = rng.normal(size=(2, 2))
-        D = A @ A.T + 0.1 * np.eye(2)
+        hole, D = random_broached(rng, (0.01, 1.0), 0.1)
         z = rng.normal(size=2) * 2.5
         code = land_project(D[0, 0], D[0, 1], D[1, 1], z[0], z[1], 1.0, *hole.land_row(),
                             root, mu)

@@ -9,7 +9,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from conftest import assert_exact_with_friction
+from conftest import assert_exact_with_friction, random_broached
 from skfem_beam import methods
 from skfem_beam.contact.lands import land_split
 from skfem_beam.contact.round_hole_friction import (CORNER, FALLBACK, FRICTIONLESS, SEPARATE,
@@ -61,11 +61,7 @@ def test_one_contact_is_in_k_on_its_wall_in_the_cone_and_slips_against_the_force
     out = np.empty(4)
     seen = {"arc": 0, "line": 0, "corner": 0, "stick": 0}
     for _ in range(3000):
-        n = int(rng.integers(2, 6))
-        hole = Hole.broached(n, rng.uniform(0.05, 0.9) * 2 * math.pi / n, 1.0,
-                             rng.uniform(-3, 3))
-        A = rng.normal(size=(2, 2))
-        D = A @ A.T + 0.3 * np.eye(2)
+        hole, D = random_broached(rng, (0.05, 0.9), 0.3)
         f = rng.uniform(0.05, 0.5)
         z, q = rng.normal(size=2) * 2.0, rng.normal(size=2) * 0.5
         case = coulomb_lands((D[0, 0], D[0, 1], D[1, 1]), z, q, 1.0, f, hole.land_row(), out)

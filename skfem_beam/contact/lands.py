@@ -29,13 +29,21 @@ PIECE_ARC, PIECE_LINE, PIECE_CORNER = 1, 2, 3
 
 
 @njit(cache=True)
+def nearest_land(pa, pb, lands, angle):
+    """(k, off): the land nearest p's direction and p's angle from its centre, in
+    [−π/lands, π/lands]."""
+    step = 2.0 * np.pi / lands
+    off = np.arctan2(pb, pa) - angle
+    k = math.floor(off / step + 0.5)
+    return k, off - step * k
+
+
+@njit(cache=True)
 def land_excess(pa, pb, r, lands, half, angle):
     """max over the lands' φ of p·e(φ) − r: how far p lies beyond K (≤ 0: inside; in a
     land's direction it is |p| − r).  holes.land_excess is the same arithmetic."""
     rho = np.hypot(pa, pb)
-    step = 2.0 * np.pi / lands
-    off = np.arctan2(pb, pa) - angle
-    off -= step * math.floor(off / step + 0.5)     # from the nearest land's centre
+    off = nearest_land(pa, pb, lands, angle)[1]
     return rho * np.cos(max(abs(off) - half, 0.0)) - r
 
 
@@ -101,9 +109,7 @@ def piece_holds(code, pa, pb, mua, mub, r, lands, half, angle, tol):
     μ = −se with s > 0, p on the segment; a corner: μ = −(s₁e₁ + s₂e₂), s₁, s₂ > 0)."""
     kind, x, y, t_lo, t_hi = piece_of(code, r, lands, half, angle)
     if kind == PIECE_ARC:
-        step = 2.0 * np.pi / lands
-        off = np.arctan2(pb, pa) - angle
-        off -= step * math.floor(off / step + 0.5)
+        off = nearest_land(pa, pb, lands, angle)[1]
         return mua * pa + mub * pb < 0.0 and abs(off) <= half + tol / r
     if kind == PIECE_LINE:
         t = -y * pa + x * pb
@@ -123,9 +129,7 @@ def land_normal(pa, pb, lands, half, angle):
     line of the nearest land's end (the lobe's corner lies on its bisector, so the
     nearest land's line is the one p faces)."""
     step = 2.0 * np.pi / lands
-    off = np.arctan2(pb, pa) - angle
-    k = math.floor(off / step + 0.5)
-    off -= step * k
+    k, off = nearest_land(pa, pb, lands, angle)
     if abs(off) <= half:
         rho = np.hypot(pa, pb)
         if rho == 0.0:
@@ -138,11 +142,13 @@ def land_normal(pa, pb, lands, half, angle):
 @njit(cache=True)
 def on_land(pa, pb, lands, half, angle):
     """Whether p's direction lies on a land (1e-12 rad of slack)."""
-    step = 2.0 * np.pi / lands
-    off = np.arctan2(pb, pa) - angle
-    off -= step * math.floor(off / step + 0.5)
-    return abs(off) <= half + 1e-12
+    return abs(nearest_land(pa, pb, lands, angle)[1]) <= half + 1e-12
 
+
+@njit(cache=True)
+def lobe_slips(phi1, phi2, va, vb):
+    """(t₁·v, t₂·v): v along the tangents t_i = (−sin φ_i, cos φ_i) of a lobe's two lines."""
+    return (-np.sin(phi1) * va + np.cos(phi1) * vb, -np.sin(phi2) * va + np.cos(phi2) * vb)
 
 
 @njit(cache=True)
@@ -175,17 +181,13 @@ def land_split(mu2, p, slip, r, f, land):
     corner (p within 1e-9 r) two faces (corner_forces), else one with the normal
     land_normal(p).  Returns (contacts: 1 or 2, λ_n, λ_t, s of the first, of the second)."""
     lands, half, angle = land
-    step = 2.0 * np.pi / lands
-    off = np.arctan2(p[1], p[0]) - angle
-    k = math.floor(off / step + 0.5)
-    off -= step * k
+    k, off = nearest_land(p[0], p[1], lands, angle)
     if abs(off) > half:
         phi1, phi2, delta = lobe_geometry(k if off > 0.0 else k - 1, lands, half, angle)
         reach = r / np.cos(delta)
         mid = 0.5 * (phi1 + phi2)
         if np.hypot(p[0] - reach * np.cos(mid), p[1] - reach * np.sin(mid)) <= 1e-9 * r:
-            s1 = -np.sin(phi1) * slip[0] + np.cos(phi1) * slip[1]
-            s2 = -np.sin(phi2) * slip[0] + np.cos(phi2) * slip[1]
+            s1, s2 = lobe_slips(phi1, phi2, slip[0], slip[1])
             ok, l1, t1, l2, t2 = corner_forces(mu2[0], mu2[1], (s1, s2), f, (phi1, phi2),
                                                1e-12 * r)
             if ok:

@@ -52,7 +52,7 @@ from numba import njit
 
 from ..errors import InputError
 from .base import ContactLaw, compiled_law
-from .lands import (PIECE_LINE, corner_forces, corner_candidate, land_excess, lobe_geometry,
+from .lands import (corner_forces, corner_candidate, land_excess, lobe_geometry, lobe_slips,
                     on_land, piece_of)
 from .round_hole import (MAX_SWEEPS, SWEEP_TOL, box_row, check_radii, contact_flags,
                          disk_params, disk_root, kinds_of, land_cone_solve, land_params,
@@ -124,26 +124,11 @@ def coulomb_disk(D2, z, q, r, f, out):
         out[0], out[1], out[2], out[3] = 0.0, 0.0, za, zb
         return SEPARATE
     nq = np.hypot(qa, qb)
+    if f > 0.0 and nq > 0.0:                                # stick, then slip either way
+        for case in (STICK, SLIP_FORWARD, SLIP_BACKWARD):
+            if _disk_case(D2, z, q, r, f, case, out):
+                return case
     root = np.empty(3)
-    if f > 0.0 and nq > 0.0:
-        pa, pb = r * qa / nq, r * qb / nq                   # stick: p ∥ q
-        det = a * d - b * b
-        ma = (d * (pa - za) - b * (pb - zb)) / det
-        mb = (-b * (pa - za) + a * (pb - zb)) / det
-        ln = -(pa * ma + pb * mb) / r
-        lt = (-pb * ma + pa * mb) / r
-        if ln >= 0.0 and abs(lt) <= f * ln:
-            out[0], out[1], out[2], out[3] = ma, mb, pa, pb
-            return STICK
-        for sigma in (1.0, -1.0):                           # slip with s of sign σ
-            g = sigma * f
-            tau = slip_root(a, b, d, za, zb, r, g, root)
-            pa, pb = root[0], root[1]
-            s = (pb * qa - pa * qb) / r                     # t·(p − q) = −t·q
-            if sigma * s >= 0.0:
-                out[0], out[1] = -tau * (pa - g * pb), -tau * (pb + g * pa)
-                out[2], out[3] = pa, pb
-                return SLIP_FORWARD if sigma > 0.0 else SLIP_BACKWARD
     disk_root(a, b, d, za, zb, r, root)                     # frictionless
     out[0], out[1], out[2], out[3] = -root[2] * root[0], -root[2] * root[1], root[0], root[1]
     return FRICTIONLESS if f == 0.0 or nq == 0.0 else FALLBACK
@@ -181,30 +166,33 @@ def coulomb_face(D2, yj, yt, qt, lo, hi, f, out):
     return FRICTIONLESS if f == 0.0 else FALLBACK
 
 
-
 @njit(cache=True)
 def _disk_case(D2, z, q, r, f, case, out):
-    """coulomb_disk's candidate of ``case`` alone (STICK, SLIP_FORWARD, SLIP_BACKWARD),
-    μ_p into out[0:2], p into out[2:4]; returns whether its conditions hold (on a broached
-    hole's arc a later case may hold where the first one's point is off the lands)."""
+    """The contact's candidate of ``case`` alone (STICK: p ∥ q; SLIP_FORWARD,
+    SLIP_BACKWARD: slip with s of sign ±), μ_p into out[0:2], p into out[2:4]; returns
+    whether its conditions hold (on a broached hole's arc a later case may hold where the
+    first one's point is off the lands)."""
     a, b, d = D2
     za, zb = z
-    nq = np.hypot(q[0], q[1])
+    qa, qb = q
     if case == STICK:
-        pa, pb = r * q[0] / nq, r * q[1] / nq
+        nq = np.hypot(qa, qb)
+        pa, pb = r * qa / nq, r * qb / nq
         det = a * d - b * b
         ma = (d * (pa - za) - b * (pb - zb)) / det
         mb = (-b * (pa - za) + a * (pb - zb)) / det
-        ln, lt = -(pa * ma + pb * mb) / r, (-pb * ma + pa * mb) / r
+        ln = -(pa * ma + pb * mb) / r
+        lt = (-pb * ma + pa * mb) / r
         out[0], out[1], out[2], out[3] = ma, mb, pa, pb
         return ln >= 0.0 and abs(lt) <= f * ln
-    g = f if case == SLIP_FORWARD else -f
+    sigma = 1.0 if case == SLIP_FORWARD else -1.0
+    g = sigma * f
     root = np.empty(3)
     tau = slip_root(a, b, d, za, zb, r, g, root)
     pa, pb = root[0], root[1]
     out[0], out[1] = -tau * (pa - g * pb), -tau * (pb + g * pa)
     out[2], out[3] = pa, pb
-    return g * (pb * q[0] - pa * q[1]) >= 0.0
+    return sigma * ((pb * qa - pa * qb) / r) >= 0.0          # s = t·(p − q) = −t·q
 
 
 @njit(cache=True)
@@ -248,26 +236,22 @@ def coulomb_corner(D2, z, q, r, f, k, land, out):
     _, cx, cy, _, _ = piece_of(4 + 3 * k, r, lands, half, angle)
     corner_candidate(D2[0], D2[1], D2[2], z[0], z[1], cx, cy, out)
     phi1, phi2, _ = lobe_geometry(k, lands, half, angle)
-    s1 = -np.sin(phi1) * (cx - q[0]) + np.cos(phi1) * (cy - q[1])
-    s2 = -np.sin(phi2) * (cx - q[0]) + np.cos(phi2) * (cy - q[1])
+    s1, s2 = lobe_slips(phi1, phi2, cx - q[0], cy - q[1])
     return corner_forces(out[0], out[1], (s1, s2), f, (phi1, phi2), 1e-12 * r)[0]
 
 
 @njit(cache=True)
 def coulomb_lands(D2, z, q, r, f, land, out):
     """One broached contact's μ_p into out[0:2] (module docstring): separation if z is in
-    K; else the first piece whose Coulomb law holds: the arc (coulomb_disk, its point on
-    a land), a lobe's line (coulomb_line), a lobe's corner (coulomb_corner); none: the
-    frictionless projection (land_project; FRICTIONLESS when f = 0, else FALLBACK)."""
+    K; else the first piece whose Coulomb law holds: the arc (coulomb_disk's cases, each
+    on its own, the first whose point is on a land), a lobe's line (coulomb_line), a
+    lobe's corner (coulomb_corner); none: the frictionless projection (land_project; FRICTIONLESS when f = 0, else FALLBACK)."""
     lands, half, angle = land
     if land_excess(z[0], z[1], r, lands, half, angle) <= 0.0:
         out[0], out[1] = 0.0, 0.0
         return SEPARATE
     if f > 0.0:
-        case = coulomb_disk(D2, z, q, r, f, out)
-        if case != FALLBACK and on_land(out[2], out[3], lands, half, angle):
-            return case
-        for case in (STICK, SLIP_FORWARD, SLIP_BACKWARD):
+        for case in (STICK, SLIP_FORWARD, SLIP_BACKWARD):   # the arc: the first on a land
             if np.hypot(q[0], q[1]) > 0.0 and _disk_case(D2, z, q, r, f, case, out) \
                     and on_land(out[2], out[3], lands, half, angle):
                 return case

@@ -385,6 +385,10 @@ class SelectorQP:
             self.solve_updated(F, lo, hi, state, u)
         else:
             self.solve_fresh(F, lo, hi, state, u)
+        return self.multipliers(F, state, u)
+
+    def multipliers(self, F, state, u) -> np.ndarray:
+        """μ = C(Au − F) on the set ``state``'s rows, 0 off it."""
         mu = (self.A @ u - F)[self.dof]
         mu[state == 0] = 0.0
         return mu
@@ -419,6 +423,8 @@ class SelectorQP:
             p = z + (rz / rz_old) * p
 
     def update_set(self, mu, y, lo, hi, state) -> np.ndarray:
+        """The next set (primal-dual rule, module docstring) from μ and y = u[dof], of
+        ``state``'s type."""
         new = np.zeros_like(state)
         new[mu + self.c * (lo - y) > 0] = -1
         new[mu + self.c * (hi - y) < 0] = 1
@@ -436,8 +442,7 @@ class SelectorQP:
                 seen = {state.tobytes()}
                 for _ in range(self.guess_sweeps):
                     self.guess(F, lo, hi, state, u)
-                    mu = (self.A @ u - F)[self.dof]
-                    mu[state == 0] = 0.0
+                    mu = self.multipliers(F, state, u)
                     new = self.update_set(mu, u[self.dof], lo, hi, state)
                     if new.tobytes() in seen:
                         break

@@ -115,10 +115,9 @@ def resolve(law: str | ContactLaw = "auto", stiffness: float | None = None,
     law for the scene) or a law object of the user's; ``stiffness`` means penalty,
     ``restitution`` e > 0 the position-level scheme with Newton restitution; ``params``:
     values of the named law's parameters (its table)."""
-    if params:
-        made = STEP_SOLVERS[law](**check_params(law, params, "params: ")) \
-            if law in STEP_SOLVERS else check_params(law, params, "params: ")
-        return resolve(made, stiffness, restitution)
+    if params:      # check_params refuses them for a law without that table
+        checked = check_params(law, params, "params: ")
+        return resolve(STEP_SOLVERS[law](**checked), stiffness, restitution)
     e = Restitution(restitution).e
     if e > 0:
         if law not in ("auto", "restitution") or stiffness is not None:

@@ -21,7 +21,6 @@ from .schema import CONTACT, OUTPUT_DEFAULTS
 
 
 BEAM_MASSES = ("consistent", "redistributed")        # [mesh] mass of a beam
-CONTACT_OWN = tuple(dict(CONTACT.items()))    # [contact]'s own keys; the others: the law's
 SCENE_WORDS = methods.Words(solver="[contact] law = ", massless="[mesh] massless = ",
                             law="[contact] law = ", restitution="[contact] restitution = ",
                             theta="[contact] theta = ", param="[contact] ")
@@ -62,8 +61,7 @@ class Scene:
             raise InputError("[contact] law='penalty' needs stiffness (N/m)")
         massless = self.data.get("mesh", {}).get("massless")    # as written: None if not
         contact = self.data.get("contact", {})
-        # θ and the solver's parameters (the keys that are not [contact]'s own)
-        params = {k: v for k, v in contact.items() if k == "theta" or k not in CONTACT_OWN}
+        params = CONTACT.method_params(contact)
         params["beta"] = self._beta_given()
         return methods.make(law, solver, self.restitution or 0.0, self.stiffness, massless,
                             words=SCENE_WORDS, damping=self.damping, params=params)

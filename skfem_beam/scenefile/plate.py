@@ -254,10 +254,9 @@ def method_of(data: dict) -> methods.Method:
                          "take it")
     if solver != "auto":
         check_choice("[contact] solver", solver, SOLVERS)
-    own = dict(PLATE_KEYS["contact"].items())      # θ and the others: the method's
     return methods.make(law, solver, c.get("restitution", 0.0), c.get("stiffness"),
                         words=PLATE_WORDS,
-                        params={**{k: v for k, v in c.items() if k == "theta" or k not in own},
+                        params={**PLATE_KEYS["contact"].method_params(c),
                                 "beta": data.get("time", {}).get("beta")})
 
 

@@ -87,6 +87,12 @@ class ContactKeys(dict):
     the law's table checks their range, scenefile.build that the law named has them), so
     that a law of the user's with a parameter needs no edit here."""
 
+    def method_params(self, contact: dict) -> dict:
+        """The method's parameters among a [contact] table's values: θ, and the keys that
+        are not this table's own (a step solver's, checked by its table)."""
+        own = dict(self.items())
+        return {k: v for k, v in contact.items() if k == "theta" or k not in own}
+
     def _all(self) -> dict:
         from ..contact.registry import all_parameters
         own = dict(self.items())

@@ -30,7 +30,6 @@ from ..checks import (check_beta, check_choice, check_nonnegative, check_positiv
                       check_restitution)
 from ..contact import ContactLaw, resolve
 from ..contact.penalty import Penalty as PenaltyLaw
-from ..contact.restitution import Restitution
 from ..errors import Deferred, InputError
 from .beta import BetaScheme
 from .moreau_jean import NAME as MOREAU_JEAN, MoreauJeanScheme, check_theta
@@ -48,11 +47,12 @@ def mass_scale(system) -> float:
     return 1.0
 
 
-def beta_run(system, stepping, law: ContactLaw, beta: float) -> Run:
-    """A run of the β-scheme with ``law`` and ``beta`` (PositionLevel's and Penalty's
-    build)."""
+def beta_run(method, system, stepping) -> Run:
+    """A run of the β-scheme with ``method``'s law, β and massless rows' stepping
+    (PositionLevel's and Penalty's build)."""
+    stepping = replace(stepping, massless=method.massless)
     with Deferred():               # signals wait while the kernels compile or load
-        scheme = BetaScheme(system, stepping, law, beta)
+        scheme = BetaScheme(system, stepping, method.law(system), method.beta)
     return Run(scheme)
 
 
@@ -94,8 +94,7 @@ class PositionLevel:
         return resolve(self.solver, None, self.restitution, dict(self.params))
 
     def build(self, system, stepping) -> Run:
-        return beta_run(system, replace(stepping, massless=self.massless), self.law(system),
-                        self.beta)
+        return beta_run(self, system, stepping)
 
 
 @dataclass(frozen=True)
@@ -134,8 +133,7 @@ class Penalty:
         return PenaltyLaw(k / scale, c / scale, self.implicit)     # the one conversion
 
     def build(self, system, stepping) -> Run:   # the quasi-static massless rows refuse springs
-        return beta_run(system, replace(stepping, massless=self.massless), self.law(system),
-                        self.beta)
+        return beta_run(self, system, stepping)
 
 
 def _beta(method) -> float:

@@ -14,5 +14,5 @@ from .semidiscrete import SemiDiscrete, beam_system
 from ._version import __version__
 
 __all__ = ["Beam", "BeamProblem", "Damping", "InitialState", "InputError", "Load",
-           "Material", "Modes", "Obstacles", "Plane", "Result", "SavedRun", "Section", "SemiDiscrete",
-           "SolverError", "Stepping", "Support", "beam_system", "modes", "read_run", "solve"]
+           "Material", "Modes", "Obstacles", "Plane", "Result", "SavedRun", "Section",
+           "SemiDiscrete", "SolverError", "Stepping", "Support", "beam_system", "modes", "read_run", "solve"]

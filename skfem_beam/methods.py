@@ -132,6 +132,6 @@ def recorded_beta(method: Method, given: float | None = None, kind: str = "beam"
     return method.beta
 
 
-__all__ = ["ALIASES", "LAWS", "Method", "MoreauJean", "Penalty", "PositionLevel", "Words", "check_massless",
-           "default_beta", "law_of", "make", "mass_scale", "recorded_beta", "split_law",
+__all__ = ["ALIASES", "LAWS", "Method", "MoreauJean", "Penalty", "PositionLevel", "Words",
+           "check_massless", "default_beta", "law_of", "make", "mass_scale", "recorded_beta", "split_law",
            "summary_word", "with_beta"]

@@ -599,8 +599,8 @@ def whirl_force(plane, b, row, r: float, omega: float, dt: float, beta: float) -
     """The contact force |λ| of the β-scheme's steady whirl in a round hole.
 
     A beam bending alike in two planes (``plane`` = (M, K, B): mass, stiffness and
-    damping of one plane; B may be None), loaded by the rotating force b·(cos ωt, sin ωt) (b the load vector of
-    one plane, in the system's units) and held at one node (``row``, the node's value
+    damping of one plane; B may be None), loaded by the rotating force b·(cos ωt, sin ωt)
+    (b the load vector of one plane, in the system's units) and held at one node (``row``, the node's value
     row) in the round hole of radius r centred on the axis, whirls on the wall: in
     complex form v + iw = A·e^{iωtₙ} at every step, and the nodal contact force is
     λⁿ = −(Λ/r)·(v, w)ⁿ at the node, of constant magnitude Λ.  Substituted in the

@@ -27,5 +27,5 @@ law)`` makes a law of one's own a solver of every front end.
 from .base import LAW_SIGNATURE, ContactLaw, StepData, compiled_law
 from .registry import LAWS, SOLVERS, STEP_SOLVERS, register, resolve
 
-__all__ = ["LAW_SIGNATURE", "LAWS", "SOLVERS", "STEP_SOLVERS", "ContactLaw", "StepData", "compiled_law",
-           "register", "resolve"]
+__all__ = ["LAW_SIGNATURE", "LAWS", "SOLVERS", "STEP_SOLVERS", "ContactLaw", "StepData",
+           "compiled_law", "register", "resolve"]

@@ -12,8 +12,8 @@ LAPACK's dpbtrf and dpbtrs on one thread, and CHOLMOD's numeric factorisation an
 the x-space laws' two Cholesky factors, contact.sparse_qp), the scheme's step without
 obstacles, and the step pressed on the obstacle with each exact law (its mean over the
 run, with the fraction of steps in contact, and its ratio to the scheme's banded solve
-and to dpbtrs); the process's peak memory after each mesh.  The laws that need W and D (active-set, daqp,
-osqp) run only where W fits; the x-space laws (contact.sparse_qp) build neither.  Only
+and to dpbtrs); the process's peak memory after each mesh.  The laws that need W and D
+(active-set, daqp, osqp) run only where W fits; the x-space laws (contact.sparse_qp) build neither.  Only
 measured, nothing tuned (docs/plate.md, "Which engine at which size").
 """
 from __future__ import annotations

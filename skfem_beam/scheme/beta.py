@@ -209,8 +209,8 @@ def penetration_samples(system):
 
 class BetaScheme:
     """The β-scheme of ``system`` on ``stepping`` with the contact law ``law`` (a name of
-    ``contact.STEP_SOLVERS``, "auto", or a law object) and Newmark's ``beta`` (the β of the method
-    that builds it: :class:`.methods.PositionLevel`, :class:`.methods.Penalty`)."""
+    ``contact.STEP_SOLVERS``, "auto", or a law object) and Newmark's ``beta`` (the β of
+    the method that builds it: :class:`.methods.PositionLevel`, :class:`.methods.Penalty`)."""
 
     # checkpoint key → state field: what a restored run needs to go on bit for bit
     CHECKPOINT = {"u_prev": "u_prev", "u_cur": "u_cur", "state": "law_state",

@@ -22,8 +22,8 @@ def solve(system, dt: float, T: float, beta: float | None = None, method=None, *
 
     ``method``: a :mod:`skfem_beam.methods` object, the one way a run names its method
     (``PositionLevel(solver, restitution, massless, beta=...)``: the solver a name of
-    ``contact.STEP_SOLVERS`` or a law object; ``Penalty(stiffness, beta=...)`` in N/m, or in the
-    units of the semi-discrete equation with ``equation_units=True``; ``MoreauJean(theta,
+    ``contact.STEP_SOLVERS`` or a law object; ``Penalty(stiffness, beta=...)`` in N/m, or
+    in the units of the semi-discrete equation with ``equation_units=True``; ``MoreauJean(theta,
     restitution)``); None: ``PositionLevel()``, exact contact by the cheapest exact law.
     β is the β-scheme method's (default: the method's own, 1/2 for exact contact, 1/4 for
     springs); ``beta``: a shorthand that sets it (``replace(method, beta=beta)``); None:

@@ -64,6 +64,20 @@ def assert_refused(main, argv, word, capsys, folder) -> None:
     assert not list(folder.iterdir())
 
 
+def assert_scene_refused(tmp_path, capsys, files: dict, scene: str, word: str) -> None:
+    """The scene file ``scene`` among ``files`` (name → text or bytes, written into a
+    folder of their own) is refused by ``python -m skfem_beam run`` as assert_refused
+    says: exit 2, one line naming ``word``, nothing written."""
+    from skfem_beam.scenefile import run_main
+    src = tmp_path / "src"
+    src.mkdir()
+    for name, content in files.items():
+        (src / name).write_bytes(content if isinstance(content, bytes) else content.encode())
+    out = tmp_path / "out"
+    out.mkdir()
+    assert_refused(run_main, [str(src / scene), "--out", str(out / "run")], word, capsys, out)
+
+
 def resumed(make, cut: int):
     """(a run driven to its end, the same run restored from a checkpoint at state ``cut``
     and driven to its end); ``make()`` builds a fresh run.  Asserts that the restored one

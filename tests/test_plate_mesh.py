@@ -8,7 +8,7 @@ import meshio
 import numpy as np
 import pytest
 
-from conftest import assert_refused
+from conftest import assert_scene_refused
 from skfem_beam.errors import InputError
 from skfem_beam.plate import (Plate, deflection_at_vertex, load_vector, natural_frequencies,
                               plate_space, static_deflection)
@@ -115,15 +115,9 @@ DISK = example("plate_disk").read_text()
 ])
 def test_bad_mesh_plate_scene_one_line_nothing_written(tmp_path, capsys, old, new, word):
     assert old in DISK
-    src = tmp_path / "src"
-    src.mkdir()
-    (src / "plate_disk.msh").write_bytes(example("plate_disk").with_suffix(".msh").read_bytes())
-    (src / "garbage.msh").write_text("not a mesh\n")
-    (src / "disk.toml").write_text(DISK.replace(old, new))
-    out = tmp_path / "out"
-    out.mkdir()
-    assert_refused(run_main, [str(src / "disk.toml"), "--out", str(out / "run")], word,
-                   capsys, out)
+    files = {"plate_disk.msh": example("plate_disk").with_suffix(".msh").read_bytes(),
+             "garbage.msh": "not a mesh\n", "disk.toml": DISK.replace(old, new)}
+    assert_scene_refused(tmp_path, capsys, files, "disk.toml", word)
 
 
 def test_an_unknown_boundary_lists_the_mesh_names(tmp_path):
@@ -135,11 +129,8 @@ def test_an_unknown_boundary_lists_the_mesh_names(tmp_path):
 
 def test_a_rectangle_edge_name_is_still_refused_by_name(tmp_path, capsys):
     text = example("plate_on_stops").read_text().replace('left = "clamped"', 'rim = "clamped"')
-    (tmp_path / "p.toml").write_text(text)
-    out = tmp_path / "out"
-    out.mkdir()
-    assert_refused(run_main, [str(tmp_path / "p.toml"), "--out", str(out / "run")],
-                   "left, right, bottom, top", capsys, out)
+    assert_scene_refused(tmp_path, capsys, {"p.toml": text}, "p.toml",
+                         "left, right, bottom, top")
 
 
 # --resume and the mesh file: the run stores its bytes (summary.json config

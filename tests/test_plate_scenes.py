@@ -11,7 +11,7 @@ import meshio
 import numpy as np
 import pytest
 
-from conftest import assert_refused, exit_code
+from conftest import assert_scene_refused, exit_code
 from skfem_beam.output.plate import MOMENTS, vertex_fields
 from skfem_beam.scenefile import example, load, modes_main, run_main
 from skfem_beam.scheme import drive
@@ -125,13 +125,8 @@ GOOD = example("plate_on_stops").read_text()
 ])
 def test_bad_plate_scene_one_line_exit_2_nothing_written(tmp_path, capsys, old, new, word):
     assert old in GOOD
-    src = tmp_path / "src"
-    src.mkdir()
-    (src / "plate.toml").write_text(GOOD.replace(old, new))
-    out = tmp_path / "out"
-    out.mkdir()
-    assert_refused(run_main, [str(src / "plate.toml"), "--out", str(out / "run")], word,
-                   capsys, out)
+    assert_scene_refused(tmp_path, capsys, {"plate.toml": GOOD.replace(old, new)},
+                         "plate.toml", word)
 
 
 def test_bad_value_line_names_the_file(tmp_path, capsys):

@@ -155,14 +155,12 @@ def write_impacts(folder: Path, run, units: dict, scale: float = 1.0, sign: floa
     impulse units (``{"force": "N", "impulse": "N·s"}``), see :func:`impact_table`.
     ``last``: the last state the loop computed when it is not ``run.n`` (a failed step
     stops the loop inside a chunk)."""
-    out = _write_impacts(folder, run, units, scale, sign, obstacles, last, wear)
-    out.pop("_table", None)
-    return out
+    return _write_impacts(folder, run, units, scale, sign, obstacles, last, wear)[0]
 
 
 def _add_spring_supports(out: dict, table: dict, obstacles, springs: tuple,
                          force_unit: str) -> None:
-    """Add to ``out`` (of :func:`_write_impacts`, with its impact ``table``) the entry
+    """Add to ``out`` (of :func:`_write_impacts`, with its impacts ``table``) the entry
     ``spring_supports`` (:func:`spring_supports`) of the supports' springs ``springs`` =
     (stiffness, damping), N/m and N·s/m (a penalty run on ``obstacles``)."""
     out["spring_supports"] = spring_supports(table, obstacles, *springs)
@@ -172,7 +170,8 @@ def _add_spring_supports(out: dict, table: dict, obstacles, springs: tuple,
         "peak_force)")
 
 
-def _write_impacts(folder, run, units, scale, sign, obstacles, last, wear) -> dict:
+def _write_impacts(folder, run, units, scale, sign, obstacles, last, wear) -> tuple:
+    """(:func:`write_impacts`' summary entry, the impacts table it wrote)."""
     s = run.system
     last = run.n if last is None else int(last)
     events = run.impact_events(last)
@@ -217,11 +216,11 @@ def _write_impacts(folder, run, units, scale, sign, obstacles, last, wear) -> di
         residual = run.record.friction_residual
         if residual is None:               # position level: each block exact, no NSGS
             return {"impact_statistics": stats, "friction": {"coefficients": coefficients,
-                                                             "law": run.solver}}
+                                                             "law": run.solver}}, table
         return {"impact_statistics": stats, "friction": {
             "coefficients": coefficients,
-            "nsgs_tolerance": NSGS_TOL, "nsgs_max_residual": residual}}
-    return {"impact_statistics": stats, "_table": table}
+            "nsgs_tolerance": NSGS_TOL, "nsgs_max_residual": residual}}, table
+    return {"impact_statistics": stats}, table
 
 
 def beam_impacts(folder: Path, run, problem, last: int | None = None, wear=None,
@@ -232,9 +231,9 @@ def beam_impacts(folder: Path, run, problem, last: int | None = None, wear=None,
     rho_S = problem.beam.rho_S
     units = {"force": "N", "impulse": "N·s"} if rho_S else \
         {"force": "m²/s² (N per kg/m)", "impulse": "m²/s (N·s per kg/m)"}
-    out = _write_impacts(folder, run, units, rho_S or 1.0, 1.0, problem.obstacles, last, wear)
-    table = out.pop("_table", None)
-    if springs is not None and problem.obstacles is not None and table is not None:
+    out, table = _write_impacts(folder, run, units, rho_S or 1.0, 1.0, problem.obstacles,
+                                last, wear)
+    if springs is not None and problem.obstacles is not None:   # (springs: no friction)
         _add_spring_supports(out, table, problem.obstacles, springs, units["force"])
     return out
 

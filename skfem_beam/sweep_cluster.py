@@ -7,6 +7,7 @@ run; a sweep without it runs its values in its own process (``--workers 0``).
 from __future__ import annotations
 
 import contextlib
+import time
 
 from .errors import InputError
 
@@ -46,37 +47,84 @@ def dask_client(workers: int | None = None, scheduler: str | None = None):
 
 
 RETRIES = 2     # a value whose worker dies is tried again this many times
+# seconds a task may wait in a cluster that has no worker at all before its value is given
+# up: a nanny that cannot restart its dead worker (its start timed out on a loaded machine)
+# leaves the cluster empty, and the task would wait forever
+NO_WORKERS_PATIENCE = 120.0
+POLL = 2.0      # seconds between two looks at the cluster while waiting
 
 
-def on_cluster(client, task, settings: dict, todo: list[float], give_up):
+class NoWorkers(RuntimeError):
+    """The cluster has had no worker for NO_WORKERS_PATIENCE seconds."""
+
+
+def _finished(client, futures, patience: float):
+    """``futures`` as they finish (a batch at a time); NoWorkers once the cluster has had no
+    worker for ``patience`` seconds while some are still pending."""
+    from distributed import wait
+    pending, empty_since = list(futures), None
+    while pending:
+        try:
+            wait(pending, timeout=POLL, return_when="FIRST_COMPLETED")
+        except TimeoutError:
+            if client.scheduler_info()["workers"]:
+                empty_since = None
+            elif empty_since is None:
+                empty_since = time.monotonic()
+            elif time.monotonic() - empty_since >= patience:
+                raise NoWorkers(f"no Dask worker for {patience:g} s: every worker died and "
+                                "none came back") from None
+            continue
+        done = [f for f in pending if f.done()]
+        pending = [f for f in pending if f not in done]
+        yield from done
+
+
+def on_cluster(client, task, settings: dict, todo: list[float], give_up,
+               patience: float | None = None):
     """Results as they finish; a task that raises (a killed worker: KilledWorker) is tried
     again, alone, up to RETRIES times after the others, then given up: its result is
     ``give_up(settings, value, error, attempts)`` (the sweep's :func:`~skfem_beam.sweep.lost`).
     Alone: a worker that dies takes the tasks queued on it along, so a value retried
-    beside the one that kills it could be lost with it (seen once in CI)."""
-    from distributed import as_completed
+    beside the one that kills it could be lost with it (seen once in CI).  A cluster left
+    without any worker for ``patience`` seconds (default NO_WORKERS_PATIENCE) gives up every
+    value not yet finished, at once."""
+    patience = NO_WORKERS_PATIENCE if patience is None else patience
     attempts = {v: 1 for v in todo}
-    key = {}
+    key, finished = {}, set()
 
     def submit(v):
         f = client.submit(task, settings, v, key=f"sweep-{v!r}-{attempts[v]}", pure=False)
         key[f.key] = v
         return f
 
+    def result(f):
+        r = f.result()
+        finished.add(key[f.key])
+        return r
+
+    def lost(v, error):
+        finished.add(v)
+        return give_up(settings, v, error, attempts[v])
+
     failed = {}
-    for f in as_completed([submit(v) for v in todo]):
-        v = key[f.key]
-        try:
-            yield f.result()
-        except Exception as e:     # the worker died (KilledWorker) or the task broke
-            failed[v] = e
-    for v, e in failed.items():
-        while attempts[v] <= RETRIES:
-            attempts[v] += 1
+    try:
+        for f in _finished(client, [submit(v) for v in todo], patience):
             try:
-                yield submit(v).result()
-                break
-            except Exception as err:
-                e = err
-        else:
-            yield give_up(settings, v, e, attempts[v])
+                yield result(f)
+            except Exception as e:     # the worker died (KilledWorker) or the task broke
+                failed[key[f.key]] = e
+        for v, e in failed.items():
+            while attempts[v] <= RETRIES:
+                attempts[v] += 1
+                f = submit(v)
+                next(_finished(client, [f], patience))
+                try:
+                    yield result(f)
+                    break
+                except Exception as err:
+                    e = err
+            else:
+                yield lost(v, e)
+    except NoWorkers as e:
+        yield from (lost(v, e) for v in todo if v not in finished)

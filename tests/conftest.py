@@ -18,6 +18,13 @@ def _machine_pins():
     return machine_pins()
 
 
+def pytest_sessionstart(session):
+    # the fingerprint before any test runs (here and in each xdist worker): a test that
+    # starts a Dask cluster leaves OPENBLAS_NUM_THREADS=1 in os.environ (its nannies run
+    # in this process), which a fingerprint read after it would see as another machine
+    _machine_pins()
+
+
 def pytest_report_header(config):
     return _machine_pins()[1]
 

@@ -3,6 +3,7 @@ the damped sweep's periodic windows."""
 import csv
 import json
 import math
+import os
 import signal
 import subprocess
 import sys
@@ -25,6 +26,17 @@ OUTPUTS = ("poincare.csv", "runs.csv", "bifurcation.png")
 # the damped bifurcation diagram of docs/methods.md: ζ = 2 %, 60 s transient, 50 periods
 DAMPED_RUNS = Path(__file__).parents[1] / "docs" / "bifurcation_point_stops_damped_runs.csv"
 DAMPED = dict(transient=60.0, periods=50, zeta=0.02)
+
+
+@pytest.fixture(autouse=True)
+def _environ():
+    """os.environ as it was: a local Dask cluster's nannies run in this process and set
+    OPENBLAS_NUM_THREADS=1 etc. in it (pre-spawn-environ), which the tests this worker
+    runs next would inherit (their subprocesses' BLAS, the machine's fingerprint)."""
+    saved = dict(os.environ)
+    yield
+    os.environ.clear()
+    os.environ.update(saved)
 
 
 def results_without_timing(out):
@@ -206,6 +218,26 @@ def test_killed_worker_is_retried_then_marked_failed(tmp_path):
     assert runs[2].endswith(",failed") and runs[1].endswith(",success") \
         and runs[3].endswith(",success")
     assert sorted(f.name for f in (out / "runs").iterdir()) == ["omega=17.0.json", "omega=9.0.json"]
+
+
+def test_a_cluster_left_without_workers_gives_up_instead_of_waiting(tmp_path, monkeypatch):
+    """A nanny that cannot restart its dead worker leaves the cluster empty (seen once under
+    load: the suite waited 20 min): after NO_WORKERS_PATIENCE s with no worker the values
+    not finished are "failed" (retried by the next run), not waited for forever."""
+    distributed = pytest.importorskip("distributed")
+    from skfem_beam import sweep_cluster
+    monkeypatch.setattr(sweep_cluster, "NO_WORKERS_PATIENCE", 1.0)
+    settings = make_settings("point_stops", "omega", transient=0.2, periods=2)
+    out = tmp_path / "sweep"
+    t0 = time.monotonic()
+    with distributed.LocalCluster(n_workers=0, host="127.0.0.1", dashboard_address=None) \
+            as cluster, distributed.Client(cluster) as client:
+        s = sweep(settings, [9.0, 13.0], out, client=client, progress=False, warm=False)
+    assert time.monotonic() - t0 < 30
+    assert s["failed"] == 2 and s["timing"]["values_lost"] == 2
+    runs = (out / "runs.csv").read_text().splitlines()
+    assert all(r.endswith(",failed") for r in runs[1:]) and len(runs) == 3
+    assert not any((out / "runs").iterdir())
 
 
 @pytest.mark.parametrize("omega, period", [(21.0, 1), (34.2, 2)])

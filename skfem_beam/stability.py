@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import scipy.linalg
 import scipy.sparse.linalg
 
@@ -33,11 +34,17 @@ def kappa_h(system) -> float:
     Dense below 100 dofs, sparse Lanczos (eigsh) above: the largest eigenvalue is well
     separated and well conditioned (it is the smallest ones that dense eigh(K, M) loses).
     """
-    n = system.n
+    M, K = system.M.tocsr(), system.K.tocsr()
+    mass = np.asarray(abs(M).sum(axis=1)).ravel() > 0
+    if not mass.all():
+        # a redistributed mass: the massless dofs held (contact) leave K on the others, and
+        # free (in equilibrium) a softer Schur complement, so (K, M) there bounds both
+        M, K = M[mass][:, mass], K[mass][:, mass]
+    n = M.shape[0]
     if n < 100:
-        return float(scipy.linalg.eigh(system.K.toarray(), system.M.toarray(), eigvals_only=True,
+        return float(scipy.linalg.eigh(K.toarray(), M.toarray(), eigvals_only=True,
                                        subset_by_index=[n - 1, n - 1])[0])
-    return float(scipy.sparse.linalg.eigsh(system.K.tocsc(), k=1, M=system.M.tocsc(),
+    return float(scipy.sparse.linalg.eigsh(K.tocsc(), k=1, M=M.tocsc(),
                                            which="LM", return_eigenvectors=False,
                                            tol=1e-10)[0])
 

@@ -64,6 +64,31 @@ def test_beta_below_one_quarter_refused(beta):
         run_bar(scenes.periodic_rod(20, mass="redistributed"), 0.01, 1.0, beta=beta)
 
 
+def test_quasi_static_rows_at_zero_beta_refused():
+    with pytest.raises(InputError, match="beta=0 with massless='quasi-static': its massless "
+                                         "rows are written times beta"):
+        run_bar(scenes.periodic_rod(20, mass="redistributed"), 0.01, 1.0, beta=0.0,
+                massless="quasi-static")
+
+
+def test_quasi_static_small_beta_is_stable_up_to_the_limit_of_the_dofs_with_mass():
+    """Quasi-static massless rows run at β < 1/4 (the semi-explicit limit at β = 1/100),
+    stable below 2/√(κ_h(1−4β)) with κ_h of the dofs with mass: the rod at N = 40 runs
+    at 0.98 of it and goes unstable at 1.02, the message naming the limit."""
+    from skfem_beam import methods
+    from skfem_beam.scheme import solve
+    from skfem_beam.stability import kappa_h, linear_limit
+    system = bar_system(scenes.periodic_rod(40, mass="redistributed"))
+    limit = linear_limit(kappa_h(system), 0.01)
+    assert limit * 40 == pytest.approx(0.4808, abs=1e-3)     # Δt/h = 0.48 at c = 1
+    method = methods.PositionLevel("auto", 0.0, "quasi-static", beta=0.01)
+    runs = {f: solve(system, f * limit, 12.0, frames=2, progress=False, method=method)
+            for f in (0.98, 1.02)}
+    assert runs[0.98].status == "success" and runs[0.98].max_nodal_violation <= 1e-15
+    assert runs[1.02].status == "unstable"
+    assert f"= {limit:.4g} s" in runs[1.02].message
+
+
 def test_bar_half_beta_no_penetration_and_energy_kept():
     bar = scenes.impacting_bar(N=80, mass="redistributed")
     r = run_bar(bar, 0.04 / 80, 3.0, beta=0.5)

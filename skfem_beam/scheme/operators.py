@@ -13,7 +13,10 @@ Massless rows (a redistributed mass) step in one of two ways (``massless``):
   own row (M is zero there), so A stays M + βΔt²K, symmetric and banded; the rest of the
   row goes to the right-hand side as the explicit force of kernels.massless_force.  The
   constraint acts on massless dofs only, so the contact term is βΔt²Cᵀλ: W and D carry
-  the β and the law's μ is Δt²λ^{n+1}, the nodal reaction at t_{n+1}.
+  the β and the law's μ is Δt²λ^{n+1}, the nodal reaction at t_{n+1}.  Any β > 0 works:
+  with nothing to recur, small β is the semi-explicit scheme (central differences on the
+  dofs with mass, exact contact on the massless ones), stable below the linear limit of
+  the dofs with mass (stability.kappa_h).
 """
 from __future__ import annotations
 
@@ -71,12 +74,17 @@ def step_operators(system, dt: float, beta: float, massless: str = "beta",
     M, K, B = system.M, system.K, system.B
     Z = massless_rows(M)
     quasi_static, massless = massless == "quasi-static", Z.size
-    if massless and beta < 0.25:
+    if massless and not quasi_static and beta < 0.25:
         # a dof without inertia steps by the β-weighted K row alone, whose recursion has
         # a root of modulus > 1 for β < 1/4 (and A = M is singular at β = 0)
         raise InputError(f"beta={beta:g} with a mass matrix that has no inertia at {massless} "
-                         f"dof(s) (mass='redistributed'): their quasi-static step is unstable "
-                         f"for beta < 1/4; use beta=0.5")
+                         f"dof(s) (mass='redistributed'): their β-weighted step is unstable "
+                         f"for beta < 1/4; use beta=0.5, or massless='quasi-static'")
+    if massless and quasi_static and beta <= 0:
+        # the quasi-static rows are written times β (module docstring): A is singular at 0
+        raise InputError(f"beta={beta:g} with massless='quasi-static': its massless rows are "
+                         f"written times beta, so beta must be > 0; beta=0.01 is the "
+                         f"central-difference limit")
     try:
         with np.errstate(over="raise", invalid="raise"):
             A = M + dt**2 * beta * K + (0.5 * dt * B if B is not None else 0)

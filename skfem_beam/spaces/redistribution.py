@@ -25,9 +25,10 @@ The step of a massless dof is quasi-static.  By default (``Stepping(massless="be
 its row of the scheme is the β-weighted K row, β u^{n+1} + (1−2β) uⁿ + β u^{n−1}.  At
 β = 1/4 that recursion has the double root −1 and the discrete energy does not control
 it (its M/Δt² + (β−1/4)K part is zero there): the massless node oscillates step to
-step.  At β = 1/2 the energy holds it (roots ±i, E_β ⊇ ¼δᵀKδ), and β = 0 makes the
-step matrix A = M singular (refused).  ``massless="quasi-static"`` writes the row as
-equilibrium at the new time, K u^{n+1} = f^{n+1} + Cᵀλ^{n+1} (scheme.operators).
+step.  At β = 1/2 the energy holds it (roots ±i, E_β ⊇ ¼δᵀKδ), and β < 1/4 is refused
+(β = 0 makes the step matrix A = M singular).  ``massless="quasi-static"`` writes the row
+as equilibrium at the new time, K u^{n+1} = f^{n+1} + Cᵀλ^{n+1} (scheme.operators): no
+recursion, so any β > 0, down to the central-difference limit (β = 0.01).
 """
 from __future__ import annotations
 

@@ -23,7 +23,7 @@ from ..errors import InputError, SolverError
 from ..linalg import band_solve, rows_matvec
 from .kernels import (CALLEES, EVENT_COLUMNS, FRICTION_COLUMN, IMPACT_FIELDS, NC_COLUMNS,
                       SECTORS, TANGENT_COLUMN, Inputs, Ops, PythonLaw, Series, State,
-                      csr_product, energy_beta, move_bounds, record, run_steps,
+                      csr_product, energy_beta, lands_of, move_bounds, record, run_steps,
                       run_steps_python)
 from .operators import csr_arrays, load_norms, step_operators
 from .stepping import Stepping
@@ -259,6 +259,7 @@ class BetaScheme:
         # the loop's code for holes and massless rows: compiled for a run that has them
         self.holes = self.st.hk if self.ops.Nc.shape[0] else None
         self.massless = self.st.ez if self.ops.Zr.size else None
+        self.lands = lands_of(self.ops)       # ... and for broached holes
 
     def _law(self, law: ContactLaw, m: int) -> ContactLaw:
         """The law to run: none without constraints; "auto" decided for this step."""
@@ -328,7 +329,7 @@ class BetaScheme:
         loop = (types.FunctionType(kernel.signature), types.FunctionType(explicit.signature))
         args = (self.ops, self.st, out, 1, 1,
                 Inputs(np.zeros((0, self.loads.shape[1])), np.zeros(0)), 0.0, self.holes,
-                self.massless)
+                self.massless, self.lands)
         loop += tuple(typeof(a) for a in args)
         if loop in run_steps.overloads:
             return
@@ -416,7 +417,7 @@ class BetaScheme:
         out.obs[0] = Orows @ st.u_prev
         out.obsv[0] = Orows @ system.v0
         rows_matvec(op.Kb.rows, st.u_prev, st.Ku, 1.0, False)   # K uⁿ⁻¹ for the energy
-        record.py_func(1, self.ops, st, out)
+        record.py_func(1, self.ops, st, out, self.lands)
         out.frames_u[0], out.frames_v[0] = st.u_prev, system.v0
         self.E1 = 0.5 * energy_beta(op.Eb.rows, st.u_prev, st.u_cur, st.Ku, st.d)
         if not (np.isfinite(st.u_cur).all() and math.isfinite(self.E1)):
@@ -475,7 +476,7 @@ class BetaScheme:
         if self.pysolver is None:
             try:
                 return run_steps(*self._kernels, self.ops, self.st, out, n0, n1, inputs,
-                                 Ebound, self.holes, self.massless)
+                                 Ebound, self.holes, self.massless, self.lands)
             except TypeError as e:
                 # numba 0.68: a Ctrl-C landing while the dispatcher unboxes the law's C
                 # callback surfaces as this TypeError (seen once in CI): it is the interrupt
@@ -486,7 +487,7 @@ class BetaScheme:
         try:
             return run_steps_python(self.ops, self.st, out, n0, n1, inputs, Ebound,
                                     bool(getattr(self.law, "free_inside", True)), self.holes,
-                                    self.massless)
+                                    self.massless, self.lands)
         finally:
             PythonLaw.solver = PythonLaw.state = None
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 import sys
 from contextlib import contextmanager
+from types import FunctionType
 
 import numpy as np
 import scipy.sparse
@@ -79,6 +80,22 @@ def _callees_aside():
         yield
     finally:
         event.unregister("numba:compile", listener)
+
+
+def uncompiled(kernel):
+    """``kernel``'s Python function, its inlined helpers (``inline="always"``) called as
+    Python functions too, recursively: the start step runs the loop's helpers uncompiled
+    (BetaScheme.start), and a helper it called compiled on its own, apart from the loop
+    that inlines it (`violation`, in a scene with holes: 0.4 CPU s of a first run).  What
+    is compiled out of line (energy_beta, csr_product, ...) stays compiled: the loop's."""
+    func = kernel.py_func
+    names = func.__code__.co_names
+    inlined = {n: uncompiled(v) for n, v in func.__globals__.items()
+               if n in names and getattr(v, "targetoptions", {}).get("inline") == "always"}
+    if not inlined:
+        return func
+    return FunctionType(func.__code__, {**func.__globals__, **inlined}, func.__name__,
+                        func.__defaults__, func.__closure__)
 
 
 def observers(system) -> scipy.sparse.csr_matrix:
@@ -379,7 +396,7 @@ class BetaScheme:
         if op.Z.size:   # quasi-static massless rows: K u¹ = f¹ + Cᵀλ¹ there, times β
             F0[op.Z] = beta * dt**2 * (self.loads[op.Z] @ self.load_averages(1, 1)[1])
         csr_product(self.ops.Cp, self.ops.Ci, self.ops.Cx, u0, st.y_prev)
-        move_bounds.py_func(self.ops, st, self.motion(np.array([dt]))[0])   # bounds at t₁
+        uncompiled(move_bounds)(self.ops, st, self.motion(np.array([dt]))[0])   # bounds at t₁
         if self.law.explicit is not None:   # its force at u⁰ as load, implicit at u¹ (as K)
             self.law.explicit.func(st.y_prev, st.y_prev, st.lo, st.hi, first_params, st.r_e)
             F0 += dt**2 * (op.C.T @ st.r_e)
@@ -417,7 +434,7 @@ class BetaScheme:
         out.obs[0] = Orows @ st.u_prev
         out.obsv[0] = Orows @ system.v0
         rows_matvec(op.Kb.rows, st.u_prev, st.Ku, 1.0, False)   # K uⁿ⁻¹ for the energy
-        record.py_func(1, self.ops, st, out, self.lands)
+        uncompiled(record)(1, self.ops, st, out, self.lands)
         out.frames_u[0], out.frames_v[0] = st.u_prev, system.v0
         self.E1 = 0.5 * energy_beta(op.Eb.rows, st.u_prev, st.u_cur, st.Ku, st.d)
         if not (np.isfinite(st.u_cur).all() and math.isfinite(self.E1)):

@@ -373,15 +373,22 @@ def friction_lands(params, m):
     return lands
 
 
+# Four kernels, one chosen by setup, so that a run compiles the solve it calls only: with
+# friction somewhere (μ > 0 at a disk or a face) friction_cone_solve, else the frictionless
+# law's land_cone_solve (the same numbers as the round-hole law); broached holes or round
+# ones only (lands None: none of the lands' code).  One kernel with both solves behind a
+# branch on the params compiled both: land_cone_solve's polish and its np.linalg.solve
+# cost a friction scene's first run ~10 CPU s of a ~22 s law (bench.cold_compile).
 @compiled_law
 def round_hole_friction_kernel(D, yf, y_cur, y_prev, lo, hi, params, state, mu, active):
-    m = yf.size
-    kind, fric, tangent = friction_rows(params, m)
-    for j in range(m):
-        if fric[j] > 0.0:
-            return friction_cone_solve(D, yf, y_prev, lo, hi, kind, fric, mu, active,
-                                       tangent, None)
+    kind, fric, tangent = friction_rows(params, yf.size)
+    return friction_cone_solve(D, yf, y_prev, lo, hi, kind, fric, mu, active, tangent, None)
+
+
+@compiled_law
+def round_hole_frictionless_kernel(D, yf, y_cur, y_prev, lo, hi, params, state, mu, active):
     # no friction anywhere: the frictionless law's own solve (the same numbers)
+    kind, _, _ = friction_rows(params, yf.size)
     return land_cone_solve(D, yf, lo, hi, kind, None, mu, active)
 
 
@@ -389,13 +396,16 @@ def round_hole_friction_kernel(D, yf, y_cur, y_prev, lo, hi, params, state, mu, 
 def broached_friction_kernel(D, yf, y_cur, y_prev, lo, hi, params, state, mu, active):
     m = yf.size
     kind, fric, tangent = friction_rows(params, m)
-    lands = friction_lands(params, m)
-    for j in range(m):
-        if fric[j] > 0.0:
-            return friction_cone_solve(D, yf, y_prev, lo, hi, kind, fric, mu, active,
-                                       tangent, lands)
+    return friction_cone_solve(D, yf, y_prev, lo, hi, kind, fric, mu, active, tangent,
+                               friction_lands(params, m))
+
+
+@compiled_law
+def broached_frictionless_kernel(D, yf, y_cur, y_prev, lo, hi, params, state, mu, active):
     # no friction anywhere: the broached round-hole law's own solve (the same numbers)
-    return land_cone_solve(D, yf, lo, hi, kind, lands, mu, active)
+    m = yf.size
+    kind, _, _ = friction_rows(params, m)
+    return land_cone_solve(D, yf, lo, hi, kind, friction_lands(params, m), mu, active)
 
 
 class RoundHoleFriction(ContactLaw):
@@ -419,8 +429,12 @@ class RoundHoleFriction(ContactLaw):
         params = np.concatenate([disk_params(step.disks), fric[step.disks[:, 0]],
                                  [float(tangents.shape[0])], tangents.ravel().astype(float),
                                  fric[tangents[:, 0]]])
+        # μ > 0 at some disk or face: friction_rows' fric > 0 at some row (the kernels)
+        frictional = bool(np.any(fric[step.disks[:, 0]] > 0) or np.any(fric[tangents[:, 0]] > 0))
         if step.lands.size and np.any(step.lands[:, 0] > 0):
-            self.kernel = broached_friction_kernel    # round holes only: no lands' code
+            self.kernel = broached_friction_kernel if frictional \
+                else broached_frictionless_kernel     # round holes only: no lands' code
             return np.concatenate([params, land_params(step.lands)])
-        self.kernel = round_hole_friction_kernel
+        self.kernel = round_hole_friction_kernel if frictional \
+            else round_hole_frictionless_kernel
         return params

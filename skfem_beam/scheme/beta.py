@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 import sys
 from contextlib import contextmanager
+from types import FunctionType
 
 import numpy as np
 import scipy.sparse
@@ -23,7 +24,7 @@ from ..errors import InputError, SolverError
 from ..linalg import band_solve, rows_matvec
 from .kernels import (CALLEES, EVENT_COLUMNS, FRICTION_COLUMN, IMPACT_FIELDS, NC_COLUMNS,
                       SECTORS, TANGENT_COLUMN, Inputs, Ops, PythonLaw, Series, State,
-                      csr_product, energy_beta, move_bounds, record, run_steps,
+                      csr_product, energy_beta, lands_of, move_bounds, record, run_steps,
                       run_steps_python)
 from .operators import csr_arrays, load_norms, step_operators
 from .stepping import Stepping
@@ -79,6 +80,22 @@ def _callees_aside():
         yield
     finally:
         event.unregister("numba:compile", listener)
+
+
+def uncompiled(kernel):
+    """``kernel``'s Python function, its inlined helpers (``inline="always"``) called as
+    Python functions too, recursively: the start step runs the loop's helpers uncompiled
+    (BetaScheme.start), and a helper it called compiled on its own, apart from the loop
+    that inlines it (`violation`, in a scene with holes: 0.4 CPU s of a first run).  What
+    is compiled out of line (energy_beta, csr_product, ...) stays compiled: the loop's."""
+    func = kernel.py_func
+    names = func.__code__.co_names
+    inlined = {n: uncompiled(v) for n, v in func.__globals__.items()
+               if n in names and getattr(v, "targetoptions", {}).get("inline") == "always"}
+    if not inlined:
+        return func
+    return FunctionType(func.__code__, {**func.__globals__, **inlined}, func.__name__,
+                        func.__defaults__, func.__closure__)
 
 
 def observers(system) -> scipy.sparse.csr_matrix:
@@ -259,6 +276,7 @@ class BetaScheme:
         # the loop's code for holes and massless rows: compiled for a run that has them
         self.holes = self.st.hk if self.ops.Nc.shape[0] else None
         self.massless = self.st.ez if self.ops.Zr.size else None
+        self.lands = lands_of(self.ops)       # ... and for broached holes
 
     def _law(self, law: ContactLaw, m: int) -> ContactLaw:
         """The law to run: none without constraints; "auto" decided for this step."""
@@ -328,7 +346,7 @@ class BetaScheme:
         loop = (types.FunctionType(kernel.signature), types.FunctionType(explicit.signature))
         args = (self.ops, self.st, out, 1, 1,
                 Inputs(np.zeros((0, self.loads.shape[1])), np.zeros(0)), 0.0, self.holes,
-                self.massless)
+                self.massless, self.lands)
         loop += tuple(typeof(a) for a in args)
         if loop in run_steps.overloads:
             return
@@ -378,7 +396,7 @@ class BetaScheme:
         if op.Z.size:   # quasi-static massless rows: K u¹ = f¹ + Cᵀλ¹ there, times β
             F0[op.Z] = beta * dt**2 * (self.loads[op.Z] @ self.load_averages(1, 1)[1])
         csr_product(self.ops.Cp, self.ops.Ci, self.ops.Cx, u0, st.y_prev)
-        move_bounds.py_func(self.ops, st, self.motion(np.array([dt]))[0])   # bounds at t₁
+        uncompiled(move_bounds)(self.ops, st, self.motion(np.array([dt]))[0])   # bounds at t₁
         if self.law.explicit is not None:   # its force at u⁰ as load, implicit at u¹ (as K)
             self.law.explicit.func(st.y_prev, st.y_prev, st.lo, st.hi, first_params, st.r_e)
             F0 += dt**2 * (op.C.T @ st.r_e)
@@ -416,7 +434,7 @@ class BetaScheme:
         out.obs[0] = Orows @ st.u_prev
         out.obsv[0] = Orows @ system.v0
         rows_matvec(op.Kb.rows, st.u_prev, st.Ku, 1.0, False)   # K uⁿ⁻¹ for the energy
-        record.py_func(1, self.ops, st, out)
+        uncompiled(record)(1, self.ops, st, out, self.lands)
         out.frames_u[0], out.frames_v[0] = st.u_prev, system.v0
         self.E1 = 0.5 * energy_beta(op.Eb.rows, st.u_prev, st.u_cur, st.Ku, st.d)
         if not (np.isfinite(st.u_cur).all() and math.isfinite(self.E1)):
@@ -475,7 +493,7 @@ class BetaScheme:
         if self.pysolver is None:
             try:
                 return run_steps(*self._kernels, self.ops, self.st, out, n0, n1, inputs,
-                                 Ebound, self.holes, self.massless)
+                                 Ebound, self.holes, self.massless, self.lands)
             except TypeError as e:
                 # numba 0.68: a Ctrl-C landing while the dispatcher unboxes the law's C
                 # callback surfaces as this TypeError (seen once in CI): it is the interrupt
@@ -486,7 +504,7 @@ class BetaScheme:
         try:
             return run_steps_python(self.ops, self.st, out, n0, n1, inputs, Ebound,
                                     bool(getattr(self.law, "free_inside", True)), self.holes,
-                                    self.massless)
+                                    self.massless, self.lands)
         finally:
             PythonLaw.solver = PythonLaw.state = None
 

@@ -239,8 +239,9 @@ def energy_beta(Eb, u_prev, u_cur, Ku, d):
 
 
 @njit(cache=True, inline="always")
-def record(n, ops, st, out):
-    """Diagnostics after state n: penetration (every step), saved series, frames."""
+def record(n, ops, st, out, lands):
+    """Diagnostics after state n: penetration (every step), saved series, frames.
+    ``lands``: None, or Ops.Nc in a run with a broached hole (see run_steps)."""
     dt, disks, pair, Sp, Si, Sx, Op, Oi, Ox, Eb = ops.dt, ops.disks, ops.pair, ops.Sp, \
         ops.Si, ops.Sx, ops.Op, ops.Oi, ops.Ox, ops.Eb
     save_every, frame_every = ops.save_every, ops.frame_every
@@ -250,13 +251,13 @@ def record(n, ops, st, out):
     obs, obsv, energy, out_work, lam, frames_u, frames_v, frames_f = out.obs, out.obsv, \
         out.energy, out.work, out.lam, out.frames_u, out.frames_v, out.frames_f
     for r in range(y_cur.size):
-        if broached(pair, ops.Nc, r):   # its box is not its bound: violation's
+        if lands is not None and broached(pair, lands, r):   # its box is no bound: violation's
             continue
         v = max(lo[r] - y_cur[r], y_cur[r] - hi[r])
         if v > stats[0]:
             stats[0] = v
     for r in disks:           # round holes: beyond the circle (a loop of its own: 1 µs a
-        v = violation(pair, ops.Nc, lo, hi, y_cur, r)   # step on 40 box rows)
+        v = violation(pair, lands, lo, hi, y_cur, r)   # step on 40 box rows)
         if v > stats[0]:
             stats[0] = v
     for r in range(slo.size):
@@ -321,17 +322,18 @@ def broached(pair, Nc, j):
 
 
 @njit(cache=True, inline="always")
-def violation(pair, Nc, lo, hi, y, j):
+def violation(pair, lands, lo, hi, y, j):
     """How far the value y[j] is beyond its bounds (≤ 0: within); a round hole's first
     row: its pair's distance beyond the circle (the box [lo, hi] is the disk's square);
     a broached hole's: max over its lands' φ of p·e(φ) − r (contact.lands.land_excess;
-    its box is no bound: the lobes reach beyond it).
+    its box is no bound: the lobes reach beyond it).  ``lands``: Ops.Nc in a run with a
+    broached hole, else None (no broached code compiled).
     (Arrays, not the State: passing the tuple costs its reference counts, 5 µs a step
     in run_steps_python, measured.)"""
-    if broached(pair, Nc, j):
+    if lands is not None and broached(pair, lands, j):
         b = pair[j]
         return land_excess(y[j] - 0.5 * (lo[j] + hi[j]), y[b] - 0.5 * (lo[b] + hi[b]),
-                           0.5 * (hi[j] - lo[j]), Nc[j, 6], Nc[j, 7], Nc[j, 8])
+                           0.5 * (hi[j] - lo[j]), lands[j, 6], lands[j, 7], lands[j, 8])
     v = max(lo[j] - y[j], y[j] - hi[j])
     if pair[j] > 0:
         b = pair[j]
@@ -379,10 +381,11 @@ def node_position(ops, st, j, out):
 
 
 @njit(cache=True, inline="always")
-def normal_of(ops, j, px, py):
-    """The unit normal of the value j's wall at the offset (px, py) from the centre."""
+def normal_of(ops, j, px, py, lands):
+    """The unit normal of the value j's wall at the offset (px, py) from the centre
+    (``lands``: as hole_kinematics')."""
     nx, ny = ops.Nc[j, 4], ops.Nc[j, 5]
-    if ops.Nc[j, 6] > 0.0:               # a broached hole: its arc's or its line's
+    if lands is not None and ops.Nc[j, 6] > 0.0:     # a broached hole: its arc's or line's
         return land_normal(px, py, ops.Nc[j, 6], ops.Nc[j, 7], ops.Nc[j, 8])
     if nx == 0.0 and ny == 0.0:          # a round hole: radial
         r = np.hypot(px, py)
@@ -454,15 +457,16 @@ def _to_friction(mt, s, work, rowwork, ev, row, dt):
 
 
 @internal
-def hole_kinematics(ops, st, step, dt, p):
+def hole_kinematics(ops, st, step, dt, p, lands):
     """Two planes, after state step+1: every row's node position, its impact angle and
     velocities when a contact starts, and its work rates' sums (State.pos, rowwork,
     sectors: |F_n||v_t|Δt with F_n the force's normal part, in the sector of the node's
-    angle)."""
+    angle).  ``lands``: None (no broached hole: their code is not compiled), or Ops.Nc."""
     for j in range(st.active.size):
         if ops.pair[j] < 0:
             continue
-        if ops.pair[j] > 0 and ops.Nc[j, FRICTION_COLUMN] > 0.0 and ops.Nc[j, 6] > 0.0:
+        if lands is not None and ops.pair[j] > 0 and ops.Nc[j, FRICTION_COLUMN] > 0.0 \
+                and ops.Nc[j, 6] > 0.0:
             land_friction_split(ops, st, j, dt)
         elif ops.pair[j] > 0 and ops.Nc[j, FRICTION_COLUMN] > 0.0:
             friction_split(st.mu, st.dy, (st.y_cur, st.lo, st.hi), st.work, st.rowwork,
@@ -472,7 +476,7 @@ def hole_kinematics(ops, st, step, dt, p):
                                 int(ops.Nc[j, TANGENT_COLUMN]), dt)
         node_position(ops, st, j, p)
         ev = st.impact[j]
-        nx, ny = normal_of(ops, j, p[2], p[3])
+        nx, ny = normal_of(ops, j, p[2], p[3], lands)
         if ev[0] == step + 1:            # a contact starts: where and how fast before it
             vx = (st.pos[j, 2] - st.pos[j, 0]) / dt
             vy = (st.pos[j, 3] - st.pos[j, 1]) / dt
@@ -492,7 +496,7 @@ def hole_kinematics(ops, st, step, dt, p):
 
 
 @njit(cache=True, inline="always")
-def track_impacts(ops, st, out, step):
+def track_impacts(ops, st, out, step, lands):
     """Contact bookkeeping after state step+1: impacts counted when a value enters
     contact; an event (State.impact) owns its value's contact force λ (the total: a
     law's explicit part included) from its first state to the second state off the
@@ -500,7 +504,7 @@ def track_impacts(ops, st, out, step):
     Why two states: a law's explicit force reads yⁿ and yⁿ⁻¹, so a spring's β-weighted
     force trails the contact by up to two states; Σ impulse is then Σ λΔt of the run
     (exact laws: λ = 0 off contact, the same rows).  Returns EVENTS_FULL when the event
-    buffer has no room left for another row."""
+    buffer has no room left for another row.  ``lands``: as violation's."""
     dt, pair = ops.dt, ops.pair
     counters, ev, active, active_prev, y_prev, y_cur, dy, mu, fc, lo, hi = st.counters, \
         st.impact, st.active, st.active_prev, st.y_prev, st.y_cur, st.dy, st.mu, st.fc, \
@@ -536,7 +540,7 @@ def track_impacts(ops, st, out, step):
                 ev[j, 9] += abs(fc[j, 3]) * dt
                 ev[j, 10] += abs(fc[j, 1])
             if a:
-                ev[j, 4] = max(ev[j, 4], violation(pair, ops.Nc, lo, hi, y_cur, j))
+                ev[j, 4] = max(ev[j, 4], violation(pair, lands, lo, hi, y_cur, j))
             elif step + 1 > ev[j, 5]:    # the second state off: no force can trail further
                 write_event(events, counters, j, ev[j])
         active_prev[j] = a
@@ -566,14 +570,16 @@ def stop_code(ops, st, out, step, Ebound, full):
 # nogil: the output pipeline writes the last chunk's rows while this computes the next.
 # No C entry wrapper: it is never passed as a first-class function.
 @njit(cache=True, _nrt=False, nogil=True, no_cfunc_wrapper=True)
-def run_steps(law, explicit, ops, st, out, n0, n1, inputs, Ebound, holes, massless):
+def run_steps(law, explicit, ops, st, out, n0, n1, inputs, Ebound, holes, massless, lands):
     """Steps n = n0..n1−1 (computing uⁿ⁺¹) with a compiled law: the bounds at t_{n+1},
     the law's explicit force, the free step, the law, then `finish_step`, the impact
     events, the diagnostics and `stop_code`.  ``inputs`` (Inputs) hold Gⁿ and φ(t_{n+1})
     at row n − n0.  ``holes``: None, or the scratch of `hole_kinematics` (two planes with
-    holes); ``massless``: None, or State.ez (quasi-static massless rows).  numba prunes the
-    branch of a None argument before typing it, so a run without holes or massless rows
-    does not compile their code (0.5 and 0.15 s of a first run).
+    holes); ``massless``: None, or State.ez (quasi-static massless rows); ``lands``: None,
+    or Ops.Nc when a broached hole is among the holes (`lands_of`).  numba prunes the
+    branch of a None argument before typing it, so a run without holes, massless rows or
+    broached holes does not compile their code (0.5, 0.15 and, with friction, 3 CPU s of
+    a first run).
 
     Returns 0, FAILED (the law failed at step counters[3]), UNSTABLE (the energy saved
     at state counters[3] is non-finite or above Ebound) or EVENTS_FULL (stopped after
@@ -590,10 +596,10 @@ def run_steps(law, explicit, ops, st, out, n0, n1, inputs, Ebound, holes, massle
             return FAILED
         st.counters[2] += its
         finish_step(ops, st, Gn, massless)
-        full = track_impacts(ops, st, out, step)
+        full = track_impacts(ops, st, out, step, lands)
         if holes is not None:
-            hole_kinematics(ops, st, step, ops.dt, holes)
-        record(step + 1, ops, st, out)
+            hole_kinematics(ops, st, step, ops.dt, holes, lands)
+        record(step + 1, ops, st, out, lands)
         code = stop_code(ops, st, out, step, Ebound, full)
         if code:
             return code
@@ -608,6 +614,14 @@ _v, _M, _i = types.float64[::1], types.float64[:, ::1], types.int64[::1]
 CALLEES = ((rows_matvec, (_M, _v, _v, types.float64, types.boolean)),
            (csr_product, (_i, _i, _v, _v, _v)), (rows_dot, (_M, _v, _v)),
            (write_event, (_M, _i, types.int64, _v)), (energy_beta, (_M, _v, _v, _v, _v)))
+
+
+def lands_of(ops):
+    """The loop's ``lands`` argument (run_steps): Ops.Nc when some row belongs to a broached
+    hole (Nc's column 6, its lands, > 0; contact.lands), else None: a run without one
+    compiles none of their code."""
+    Nc = ops.Nc
+    return Nc if Nc.shape[0] and bool((Nc[:, 6] > 0.0).any()) else None
 
 
 @njit(cache=True)
@@ -653,7 +667,7 @@ def python_law() -> int:
 
 @njit(cache=True)
 def run_steps_python(ops, st, out, n0, n1, inputs, Ebound, free_inside, holes,
-                     massless):
+                     massless, lands):
     """The same steps as `run_steps` with the law solved in Python (`PythonLaw.solver`,
     e.g. OSQP or daqp, given the step's bounds): the compiled loop calls it for μ when
     the free step leaves its bounds.  When it does not and ``free_inside`` (the law's:
@@ -676,10 +690,10 @@ def run_steps_python(ops, st, out, n0, n1, inputs, Ebound, free_inside, holes,
             st.active[j] = st.mu[j] != 0.0
         st.counters[2] += its
         finish_step(ops, st, Gn, massless)
-        full = track_impacts(ops, st, out, step)
+        full = track_impacts(ops, st, out, step, lands)
         if holes is not None:
-            hole_kinematics(ops, st, step, ops.dt, holes)
-        record(step + 1, ops, st, out)
+            hole_kinematics(ops, st, step, ops.dt, holes, lands)
+        record(step + 1, ops, st, out, lands)
         code = stop_code(ops, st, out, step, Ebound, full)
         if code:
             return code

@@ -231,9 +231,9 @@ def mj_steps(ops, st, out, n0, n1, inputs, Ebound):
                 if st.rowwork.shape[0]:
                     st.rowwork[a, 0] -= f
                     st.rowwork[a, 2] += f
-        full = track_impacts(ops, st, out, step)
+        full = track_impacts(ops, st, out, step, None)      # no broached hole (refused)
         if ops.Nc.shape[0]:
-            hole_kinematics(ops, st, step, dt, st.hk)
+            hole_kinematics(ops, st, step, dt, st.hk, None)
         mj_record(step + 1, ops, st, out)
         if (step + 1) % ops.save_every == 0 \
                 and not abs(out.energy[(step + 1) // ops.save_every - st.counters[ROW0]]) <= Ebound:

@@ -30,6 +30,7 @@ from .operators import csr_arrays, load_norms, step_operators
 from .stepping import Stepping
 
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(4)
+BAND_SOLVE = (types.float64[:, ::1], types.float64[::1])   # (Banded.chol, a vector)
 
 
 class _CompileNotice(event.Listener):
@@ -73,7 +74,10 @@ def _callees_aside():
     """While the step operators are built: should they compile `band_solve` (a fresh
     install), a child compiles the loop's out-of-line callees (kernels.CALLEES) meanwhile,
     so that `run_steps`' compile, ~1 s later, loads them from the cache (0.8 CPU s of its
-    own compile; the law's child starts only once the law is known, too late for them)."""
+    own compile; the law's child starts only once the law is known, too late for them).
+    A plate builds W without `band_solve` (operators.multi_rhs_W): BetaScheme compiles it
+    here itself, else a plate's first run compiled everything on one core (nothing had
+    compiled before `start`, so its law was not sent aside either: 21 s → 13 s)."""
     listener = _CalleesAside()
     event.register("numba:compile", listener)
     try:
@@ -247,6 +251,10 @@ class BetaScheme:
         with _callees_aside():
             self.op = op = step_operators(system, s.dt, beta, s.massless,
                                           delassus=not x_space)
+            # the start step's and the loop's `band_solve`, should step_operators not have
+            # compiled it (a plate's W is one LAPACK solve; an x-space law has no W): a
+            # fresh install then sends the callees aside here too (a warm one loads it)
+            band_solve.compile(BAND_SOLVE)
         self.step = StepData(op.A, op.C, op.D, np.ascontiguousarray(system.lo, dtype=float),
                              np.ascontiguousarray(system.hi, dtype=float), s.dt, beta,
                              disk_rows(system), land_rows(system), friction_of(system),

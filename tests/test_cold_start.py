@@ -86,9 +86,9 @@ print(" ".join(sum(started[1:], [])), r.solver)
 
 def test_a_plate_run_sends_the_callees_and_its_law_aside(tmp_path):
     """A plate builds W without `band_solve` (operators.multi_rhs_W): BetaScheme compiles
-    it while the operators are built, for the one signature the start step and the loop
-    call it with, so that a fresh install sends kernels.CALLEES aside there and the law
-    aside before the loop's compile, as a beam's does (else all compiled on one core)."""
+    it once the law is set up, for the one signature the start step and the loop call it
+    with, so that a fresh install sends kernels.CALLEES and the law aside there, before
+    the loop's compile (else all compiled on one core); a beam's run compiles no other."""
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
     p = subprocess.run([sys.executable, "-c", PLATE_CHILD], env=env, capture_output=True,
                        text=True)

@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 import skfem_beam
+from skfem_beam.scheme.kernels import CALLEES
 
 NOTICE = "compiling numerical kernels (first run only)"
 
@@ -60,3 +61,39 @@ def test_the_callees_compiled_aside_are_the_loops(tmp_path):
     assert [r[0] for r in rows] == ["rows_matvec", "csr_product", "rows_dot", "write_event",
                                     "energy_beta"], p.stdout
     assert all(r[1:] == ["1", "0", "1"] for r in rows), p.stdout
+
+
+
+PLATE_CHILD = """
+from skfem_beam import aside
+from skfem_beam.linalg import band_solve
+from skfem_beam.plate import Plate, plate_space
+from skfem_beam.plate.system import PlateInitial, PlateObstacle, Pressure, plate_system
+from skfem_beam.scheme import solve
+started, start = [], aside.start
+def recorded(kernels):
+    started.append([getattr(k, "py_func", getattr(k, "func", None)).__name__ for k, _ in kernels])
+    return start(kernels)
+aside.start = recorded
+system = plate_system(plate_space(Plate(nx=4, ny=4)), obstacles=[PlateObstacle(g1=-1e-4)],
+                      initial=PlateInitial(static=Pressure(1e4)))
+r = solve(system, 1e-4, 2e-3)
+print(len(band_solve.signatures), sum(band_solve.stats.cache_misses.values()))
+print(" ".join(started[0]))
+print(" ".join(sum(started[1:], [])), r.solver)
+"""
+
+
+def test_a_plate_run_sends_the_callees_and_its_law_aside(tmp_path):
+    """A plate builds W without `band_solve` (operators.multi_rhs_W): BetaScheme compiles
+    it once the law is set up, for the one signature the start step and the loop call it
+    with, so that a fresh install sends kernels.CALLEES and the law aside there, before
+    the loop's compile (else all compiled on one core); a beam's run compiles no other."""
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+    p = subprocess.run([sys.executable, "-c", PLATE_CHILD], env=env, capture_output=True,
+                       text=True)
+    assert p.returncode == 0, p.stderr
+    compiled, callees, law = p.stdout.splitlines()
+    assert compiled == "1 1", p.stdout
+    assert callees.split() == [f.py_func.__name__ for f, _ in CALLEES], p.stdout
+    assert law == "active_set_kernel active-set", p.stdout

@@ -5,7 +5,8 @@
     python -m skfem_beam.bench.cold_compile --scene NAME.toml [--scene ...] | --scenes
 
 ``--scene`` measures ``python -m skfem_beam run NAME.toml`` instead of a job (a shipped
-scene by file name, or a path); ``--scenes`` every shipped scene file in turn, then a table.
+scene by file name, or a path); ``--scenes`` every shipped scene file in turn, then a table
+(with ``--against``, a row per scene and checkout).
 
 Each repeat copies the package's sources to a fresh temporary folder and byte-compiles them,
 as ``pip install`` does, so that no numba cache exists, and runs ``python -m JOB`` there
@@ -186,25 +187,35 @@ def _cold_then_warm(package: str, job: str, one_core: bool) -> tuple:
 def _scene_path(name: str) -> str:
     """A shipped scene by file name, or a path (absolute: the runs' folder is a temporary
     one)."""
-    shipped = PACKAGE / "scene_files" / name
+    found = sorted((PACKAGE / "scene_files").glob(f"**/{name}"))   # plates/ too
+    shipped = found[0] if found else PACKAGE / "scene_files" / name
     path = shipped if shipped.exists() and not Path(name).exists() else Path(name)
     if not path.exists():
-        raise SystemExit(f"--scene {name}: no such file (shipped: "
-                         f"{', '.join(sorted(p.name for p in shipped.parent.glob('*.toml')))})")
+        names = sorted(p.name for p in (PACKAGE / "scene_files").glob("**/*.toml"))
+        raise SystemExit(f"--scene {name}: no such file (shipped: {', '.join(names)})")
     return str(path.resolve())
 
 
 def _scenes(args, paths: list) -> int:
-    """Each scene cold then warm, ``--repeat`` times, then one row each: the medians."""
+    """Each scene cold then warm, ``--repeat`` times (with ``--against``: both checkouts,
+    in alternating order), then one row each (and checkout): the medians."""
+    packages = [args.package] + ([args.against] if args.against else [])
     rows = []
     for path in paths:
-        runs = []
+        runs = {p: [] for p in packages}
         for r in range(args.repeat):
-            runs.append(_cold_then_warm(args.package, path, args.one_core))
-            print(f"run {r + 1}: {runs[-1][-1]}", flush=True)
+            for package in packages if r % 2 == 0 else packages[::-1]:   # alternated: drift
+                runs[package].append(_cold_then_warm(package, path, args.one_core))
+                label = f" ({package})" if args.against else ""
+                print(f"run {r + 1}{label}: {runs[package][-1][-1]}", flush=True)
         if not args.no_attribute:
             _listened(args.package, path, args.one_core)
-        rows.append((Path(path).name, *(statistics.median(r[k] for r in runs) for k in range(4))))
+        for i, package in enumerate(packages):
+            name = Path(path).name + (f" [{i + 1}]" if args.against else "")
+            rows.append((name, *(statistics.median(r[k] for r in runs[package])
+                                 for k in range(4))))
+    if args.against:
+        print("\n" + "\n".join(f"[{i + 1}] {p}" for i, p in enumerate(packages)))
     print(f"\n{'scene file':34s} {'cold s':>7s} {'warm s':>7s} {'CPU cold':>9s} {'CPU warm':>9s}"
           f"   (wall and CPU, medians of {args.repeat}; targets: cold ≤ {COLD_TARGET:g} s, warm "
           f"≤ {WARM_TARGET:g} s)")

@@ -24,7 +24,7 @@ from ..errors import InputError, SolverError
 from ..linalg import band_solve, rows_matvec
 from .kernels import (CALLEES, EVENT_COLUMNS, FRICTION_COLUMN, IMPACT_FIELDS, NC_COLUMNS,
                       SECTORS, TANGENT_COLUMN, Inputs, Ops, PythonLaw, Series, State,
-                      csr_product, energy_beta, lands_of, move_bounds, record, run_steps,
+                      csr_product, energy_beta, friction_of_ops, lands_of, move_bounds, record, run_steps,
                       run_steps_python)
 from .operators import csr_arrays, load_norms, step_operators
 from .stepping import Stepping
@@ -277,6 +277,7 @@ class BetaScheme:
         self.holes = self.st.hk if self.ops.Nc.shape[0] else None
         self.massless = self.st.ez if self.ops.Zr.size else None
         self.lands = lands_of(self.ops)       # ... and for broached holes
+        self.friction = friction_of_ops(self.ops)   # ... and for friction's work split
 
     def _law(self, law: ContactLaw, m: int) -> ContactLaw:
         """The law to run: none without constraints; "auto" decided for this step."""
@@ -346,7 +347,7 @@ class BetaScheme:
         loop = (types.FunctionType(kernel.signature), types.FunctionType(explicit.signature))
         args = (self.ops, self.st, out, 1, 1,
                 Inputs(np.zeros((0, self.loads.shape[1])), np.zeros(0)), 0.0, self.holes,
-                self.massless, self.lands)
+                self.massless, self.lands, self.friction)
         loop += tuple(typeof(a) for a in args)
         if loop in run_steps.overloads:
             return
@@ -493,7 +494,8 @@ class BetaScheme:
         if self.pysolver is None:
             try:
                 return run_steps(*self._kernels, self.ops, self.st, out, n0, n1, inputs,
-                                 Ebound, self.holes, self.massless, self.lands)
+                                 Ebound, self.holes, self.massless, self.lands,
+                                 self.friction)
             except TypeError as e:
                 # numba 0.68: a Ctrl-C landing while the dispatcher unboxes the law's C
                 # callback surfaces as this TypeError (seen once in CI): it is the interrupt
@@ -504,7 +506,7 @@ class BetaScheme:
         try:
             return run_steps_python(self.ops, self.st, out, n0, n1, inputs, Ebound,
                                     bool(getattr(self.law, "free_inside", True)), self.holes,
-                                    self.massless, self.lands)
+                                    self.massless, self.lands, self.friction)
         finally:
             PythonLaw.solver = PythonLaw.state = None
 

@@ -24,8 +24,8 @@ from ..errors import InputError, SolverError
 from ..linalg import band_solve, rows_matvec
 from .kernels import (CALLEES, EVENT_COLUMNS, FRICTION_COLUMN, IMPACT_FIELDS, NC_COLUMNS,
                       SECTORS, TANGENT_COLUMN, Inputs, Ops, PythonLaw, Series, State,
-                      csr_product, energy_beta, friction_of_ops, lands_of, move_bounds, record, run_steps,
-                      run_steps_python)
+                      csr_product, energy_beta, friction_of_ops, lands_of, move_bounds,
+                      record, run_steps, run_steps_python)
 from .operators import csr_arrays, load_norms, step_operators
 from .stepping import Stepping
 
@@ -274,10 +274,10 @@ class BetaScheme:
         self.ops = self._ops(params)
         self.st = self._state()
         # the loop's code for holes and massless rows: compiled for a run that has them
-        self.holes = self.st.hk if self.ops.Nc.shape[0] else None
+        # (with friction's work split only where some row has Coulomb's μ)
+        self.holes = (self.st.hk, friction_of_ops(self.ops)) if self.ops.Nc.shape[0] else None
         self.massless = self.st.ez if self.ops.Zr.size else None
         self.lands = lands_of(self.ops)       # ... and for broached holes
-        self.friction = friction_of_ops(self.ops)   # ... and for friction's work split
 
     def _law(self, law: ContactLaw, m: int) -> ContactLaw:
         """The law to run: none without constraints; "auto" decided for this step."""
@@ -347,7 +347,7 @@ class BetaScheme:
         loop = (types.FunctionType(kernel.signature), types.FunctionType(explicit.signature))
         args = (self.ops, self.st, out, 1, 1,
                 Inputs(np.zeros((0, self.loads.shape[1])), np.zeros(0)), 0.0, self.holes,
-                self.massless, self.lands, self.friction)
+                self.massless, self.lands)
         loop += tuple(typeof(a) for a in args)
         if loop in run_steps.overloads:
             return
@@ -494,8 +494,7 @@ class BetaScheme:
         if self.pysolver is None:
             try:
                 return run_steps(*self._kernels, self.ops, self.st, out, n0, n1, inputs,
-                                 Ebound, self.holes, self.massless, self.lands,
-                                 self.friction)
+                                 Ebound, self.holes, self.massless, self.lands)
             except TypeError as e:
                 # numba 0.68: a Ctrl-C landing while the dispatcher unboxes the law's C
                 # callback surfaces as this TypeError (seen once in CI): it is the interrupt
@@ -506,7 +505,7 @@ class BetaScheme:
         try:
             return run_steps_python(self.ops, self.st, out, n0, n1, inputs, Ebound,
                                     bool(getattr(self.law, "free_inside", True)), self.holes,
-                                    self.massless, self.lands, self.friction)
+                                    self.massless, self.lands)
         finally:
             PythonLaw.solver = PythonLaw.state = None
 

@@ -462,24 +462,26 @@ def track_holes(ops, st, step, p, lands, friction):
     """hole_kinematics of the state after step (its arrays read off the tuples here: the
     out-of-line function takes arrays, not the tuples' structs, which cost its compile
     ~1 CPU s more)."""
-    hole_kinematics(ops.pair, ops.Nc, (ops.Np, ops.Ni, ops.Nx), st.u_cur, st.stats[3],
-                    (st.mu, st.dy, st.y_cur, st.lo, st.hi), st.work, st.rowwork, st.impact,
-                    st.pos, st.sectors, step, ops.dt, p, lands, friction)
+    hole_kinematics(ops.pair, ops.Nc, (ops.Np, ops.Ni, ops.Nx), (st.u_cur, st.stats[3]),
+                    (st.mu, st.dy, st.y_cur, st.lo, st.hi),
+                    (st.work, st.rowwork, st.impact, st.pos, st.sectors), step, ops.dt, p,
+                    lands, friction)
 
 
 @internal
-def hole_kinematics(pair, Nc, nodes, u, phi, force, work, rowwork, impact, pos, sectors,
-                    step, dt, p, lands, friction):
+def hole_kinematics(pair, Nc, nodes, at, force, tallies, step, dt, p, lands, friction):
     """Two planes, after state step+1: every row's node position, its impact angle and
     velocities when a contact starts, and its work rates' sums (State.pos, rowwork,
     sectors: |F_n||v_t|Δt with F_n the force's normal part, in the sector of the node's
-    angle).  ``nodes``: Ops' (Np, Ni, Nx); ``u``, ``phi``: uⁿ⁺¹ and φ(t_{n+1});
-    ``force``: State's (mu, dy, y_cur, lo, hi).  ``lands``: None (no broached hole: their
-    code is not compiled), or Ops.Nc; ``friction``: None (no row with Coulomb's μ in
-    Nc's FRICTION_COLUMN: the friction splits are not compiled, `friction_of_ops`), or
-    Ops.Nc."""
+    angle).  ``nodes``: Ops' (Np, Ni, Nx); ``at``: (uⁿ⁺¹, φ(t_{n+1})); ``force``:
+    State's (mu, dy, y_cur, lo, hi); ``tallies``: State's (work, rowwork, impact, pos,
+    sectors).  ``lands``: None (no broached hole: their code is not compiled), or Ops.Nc;
+    ``friction``: None (no row with Coulomb's μ in Nc's FRICTION_COLUMN: the friction
+    splits are not compiled, `friction_of_ops`), or Ops.Nc."""
     Np, Ni, Nx = nodes
+    u, phi = at
     mu, dy, y_cur, lo, hi = force
+    work, rowwork, impact, pos, sectors = tallies
     for j in range(mu.size):
         if pair[j] < 0:
             continue
@@ -598,15 +600,15 @@ def stop_code(ops, st, out, step, Ebound, full):
 # nogil: the output pipeline writes the last chunk's rows while this computes the next.
 # No C entry wrapper: it is never passed as a first-class function.
 @njit(cache=True, _nrt=False, nogil=True, no_cfunc_wrapper=True)
-def run_steps(law, explicit, ops, st, out, n0, n1, inputs, Ebound, holes, massless, lands,
-              friction):
+def run_steps(law, explicit, ops, st, out, n0, n1, inputs, Ebound, holes, massless, lands):
     """Steps n = n0..n1−1 (computing uⁿ⁺¹) with a compiled law: the bounds at t_{n+1},
     the law's explicit force, the free step, the law, then `finish_step`, the impact
     events, the diagnostics and `stop_code`.  ``inputs`` (Inputs) hold Gⁿ and φ(t_{n+1})
-    at row n − n0.  ``holes``: None, or the scratch of `hole_kinematics` (two planes with
-    holes); ``massless``: None, or State.ez (quasi-static massless rows); ``lands``: None,
-    or Ops.Nc when a broached hole is among the holes (`lands_of`); ``friction``: None, or
-    Ops.Nc when some row has Coulomb's μ there (`friction_of_ops`).  numba prunes the
+    at row n − n0.  ``holes``: None, or (two planes with holes) the scratch of
+    `hole_kinematics` and its ``friction`` (None, or Ops.Nc when some row has Coulomb's
+    μ there: `friction_of_ops`); ``massless``: None, or State.ez (quasi-static massless
+    rows); ``lands``: None, or Ops.Nc when a broached hole is among the holes
+    (`lands_of`).  numba prunes the
     branch of a None argument before typing it, so a run without holes, massless rows,
     broached holes or friction does not compile their code (0.5, 0.15 and, with
     friction, 3 CPU s of a first run).
@@ -628,7 +630,7 @@ def run_steps(law, explicit, ops, st, out, n0, n1, inputs, Ebound, holes, massle
         finish_step(ops, st, Gn, massless)
         full = track_impacts(ops, st, out, step, lands)
         if holes is not None:
-            track_holes(ops, st, step, holes, lands, friction)
+            track_holes(ops, st, step, holes[0], lands, holes[1])
         record(step + 1, ops, st, out, lands)
         code = stop_code(ops, st, out, step, Ebound, full)
         if code:
@@ -697,7 +699,7 @@ def python_law() -> int:
 
 @njit(cache=True)
 def run_steps_python(ops, st, out, n0, n1, inputs, Ebound, free_inside, holes,
-                     massless, lands, friction):
+                     massless, lands):
     """The same steps as `run_steps` with the law solved in Python (`PythonLaw.solver`,
     e.g. OSQP or daqp, given the step's bounds): the compiled loop calls it for μ when
     the free step leaves its bounds.  When it does not and ``free_inside`` (the law's:
@@ -722,7 +724,7 @@ def run_steps_python(ops, st, out, n0, n1, inputs, Ebound, free_inside, holes,
         finish_step(ops, st, Gn, massless)
         full = track_impacts(ops, st, out, step, lands)
         if holes is not None:
-            track_holes(ops, st, step, holes, lands, friction)
+            track_holes(ops, st, step, holes[0], lands, holes[1])
         record(step + 1, ops, st, out, lands)
         code = stop_code(ops, st, out, step, Ebound, full)
         if code:

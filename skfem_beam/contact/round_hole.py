@@ -28,7 +28,8 @@ against Clarabel (an interior-point conic solver) on recorded step problems
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.np.linalg import F_INT_nbtype, F_INT_nptype, ensure_lapack
 
 from ..errors import InputError
 from .active_set import data_scale
@@ -197,6 +198,34 @@ def _still_holds(D, yf, lo, hi, kind, lands, piece, mu, mu_new, tol):
     return True
 
 
+# LAPACK's dgesv through numba's own entry point: the routine np.linalg.solve calls, on the
+# same copies (J in Fortran order, F), so the same bits, without np.linalg.solve's checks'
+# and error messages' compile (~4 CPU s of a round-hole scene's first run, the law's
+# callees in bench.cold_compile: _check_finite_matrix, _inv_err_handler, str and repr).
+ensure_lapack()
+_xgesv = types.ExternalFunction("numba_xgesv", types.intc(
+    types.char, types.intp, types.intp, types.CPointer(types.float64), types.intp,
+    types.CPointer(F_INT_nbtype), types.CPointer(types.float64), types.intp))
+
+
+@internal
+def gesv(J, F):
+    """F ← J⁻¹F (J square, k × k, C order); False (F undefined) where np.linalg.solve
+    raises: J or F not finite, J singular."""
+    k = F.size
+    for i in range(k):
+        if not np.isfinite(F[i]):
+            return False
+        for q in range(k):
+            if not np.isfinite(J[i, q]):
+                return False
+    a = J.T.copy()                       # J in Fortran order
+    ipiv = np.empty(k, F_INT_nptype)
+    r = _xgesv(100, k, 1, a.ctypes, k, ipiv.ctypes, F.ctypes, k)        # 100: ord('d')
+    # a and ipiv used after the call: numba frees an array after its last use
+    return r == 0 and a.size + ipiv.size > 0
+
+
 @internal
 def _polish(D, yf, lo, hi, kind, lands, piece, mu, tol):
     """Newton on the active set's KKT equations (boxes on their bound, disks on their
@@ -238,12 +267,10 @@ def _polish(D, yf, lo, hi, kind, lands, piece, mu, tol):
                 J[i + 1, i] += pb
                 J[i + 1, i + 1] -= pa
                 i += 2
-        try:
-            delta = np.linalg.solve(J, F)
-        except Exception:   # noqa: BLE001  (numba: a singular matrix)
+        if not gesv(J, F):                  # F ← J⁻¹F
             return False
         for q in range(k):
-            mu_new[act[q]] -= delta[q]
+            mu_new[act[q]] -= F[q]
     # keep it only if the signs and the inactive constraints still hold
     if not _still_holds(D, yf, lo, hi, kind, lands, piece, mu, mu_new, tol):
         return False

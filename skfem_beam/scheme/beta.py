@@ -24,8 +24,8 @@ from ..errors import InputError, SolverError
 from ..linalg import band_solve, rows_matvec
 from .kernels import (CALLEES, EVENT_COLUMNS, FRICTION_COLUMN, IMPACT_FIELDS, NC_COLUMNS,
                       SECTORS, TANGENT_COLUMN, Inputs, Ops, PythonLaw, Series, State,
-                      csr_product, energy_beta, lands_of, move_bounds, record, run_steps,
-                      run_steps_python)
+                      csr_product, energy_beta, friction_of_ops, lands_of, move_bounds,
+                      record, run_steps, run_steps_python)
 from .operators import csr_arrays, load_norms, step_operators
 from .stepping import Stepping
 
@@ -287,7 +287,8 @@ class BetaScheme:
         self.ops = self._ops(params)
         self.st = self._state()
         # the loop's code for holes and massless rows: compiled for a run that has them
-        self.holes = self.st.hk if self.ops.Nc.shape[0] else None
+        # (with friction's work split only where some row has Coulomb's μ)
+        self.holes = (self.st.hk, friction_of_ops(self.ops)) if self.ops.Nc.shape[0] else None
         self.massless = self.st.ez if self.ops.Zr.size else None
         self.lands = lands_of(self.ops)       # ... and for broached holes
 

@@ -369,24 +369,24 @@ def write_event(events, counters, j, e):
 
 
 @njit(cache=True, inline="always")
-def node_position(ops, st, j, out):
-    """out ← the value j's node (v, w) at uⁿ⁺¹ (st.u_cur) minus its hole's centre now."""
+def node_position(Np, Ni, Nx, Nc, u, phi, j, out):
+    """out ← the value j's node (v, w) at ``u`` (uⁿ⁺¹) minus its hole's centre at φ."""
     for c in range(2):
         s = 0.0
-        for p in range(ops.Np[2 * j + c], ops.Np[2 * j + c + 1]):
-            s += ops.Nx[p] * st.u_cur[ops.Ni[p]]
+        for p in range(Np[2 * j + c], Np[2 * j + c + 1]):
+            s += Nx[p] * u[Ni[p]]
         out[c] = s
-    out[2] = out[0] - (ops.Nc[j, 0] + ops.Nc[j, 2] * st.stats[3])
-    out[3] = out[1] - (ops.Nc[j, 1] + ops.Nc[j, 3] * st.stats[3])
+    out[2] = out[0] - (Nc[j, 0] + Nc[j, 2] * phi)
+    out[3] = out[1] - (Nc[j, 1] + Nc[j, 3] * phi)
 
 
 @njit(cache=True, inline="always")
-def normal_of(ops, j, px, py, lands):
+def normal_of(Nc, j, px, py, lands):
     """The unit normal of the value j's wall at the offset (px, py) from the centre
     (``lands``: as hole_kinematics')."""
-    nx, ny = ops.Nc[j, 4], ops.Nc[j, 5]
-    if lands is not None and ops.Nc[j, 6] > 0.0:     # a broached hole: its arc's or line's
-        return land_normal(px, py, ops.Nc[j, 6], ops.Nc[j, 7], ops.Nc[j, 8])
+    nx, ny = Nc[j, 4], Nc[j, 5]
+    if lands is not None and Nc[j, 6] > 0.0:     # a broached hole: its arc's or line's
+        return land_normal(px, py, Nc[j, 6], Nc[j, 7], Nc[j, 8])
     if nx == 0.0 and ny == 0.0:          # a round hole: radial
         r = np.hypot(px, py)
         if r == 0.0:
@@ -413,20 +413,21 @@ def friction_split(mu, dy, at, work, rowwork, ev, a, b, dt):
 
 
 @njit(cache=True)
-def land_friction_split(ops, st, a, dt):
+def land_friction_split(pair, Nc, mu, dy, at, work, rowwork, ev, a, dt):
     """friction_split for a broached hole's pair (a, pair[a]): its contacts' (one, two at
     a lobe's corner: contact.lands.land_split) tangential work ½ λ_t s/Δt² moves from the
-    contact's column to the friction's."""
-    b = ops.pair[a]
-    if st.mu[a] == 0.0 and st.mu[b] == 0.0:
+    contact's column to the friction's.  ``at``: (y^{n+1}, lo, hi)."""
+    y, lo, hi = at
+    b = pair[a]
+    if mu[a] == 0.0 and mu[b] == 0.0:
         return
-    p = (st.y_cur[a] - 0.5 * (st.lo[a] + st.hi[a]), st.y_cur[b] - 0.5 * (st.lo[b] + st.hi[b]))
+    p = (y[a] - 0.5 * (lo[a] + hi[a]), y[b] - 0.5 * (lo[b] + hi[b]))
     count, _, t1, s1, _, t2, s2 = land_split(
-        (st.mu[a], st.mu[b]), p, (st.dy[a], st.dy[b]), 0.5 * (st.hi[a] - st.lo[a]),
-        ops.Nc[a, FRICTION_COLUMN], (ops.Nc[a, 6], ops.Nc[a, 7], ops.Nc[a, 8]))
-    _to_friction(t1, s1, st.work, st.rowwork, st.impact[a], a, dt)
+        (mu[a], mu[b]), p, (dy[a], dy[b]), 0.5 * (hi[a] - lo[a]),
+        Nc[a, FRICTION_COLUMN], (Nc[a, 6], Nc[a, 7], Nc[a, 8]))
+    _to_friction(t1, s1, work, rowwork, ev, a, dt)
     if count == 2:
-        _to_friction(t2, s2, st.work, st.rowwork, st.impact[a], a, dt)
+        _to_friction(t2, s2, work, rowwork, ev, a, dt)
 
 
 @njit(cache=True, inline="always")
@@ -456,43 +457,72 @@ def _to_friction(mt, s, work, rowwork, ev, row, dt):
         ev[10] += abs(mt) / dt
 
 
+@njit(cache=True, inline="always")
+def track_holes(ops, st, step, p, lands, friction):
+    """hole_kinematics of the state after step (its arrays read off the tuples here: the
+    out-of-line function takes arrays, not the tuples' structs, which cost its compile
+    ~1 CPU s more)."""
+    hole_kinematics(ops.pair, ops.Nc, (ops.Np, ops.Ni, ops.Nx), (st.u_cur, st.stats[3]),
+                    (st.mu, st.dy, st.y_cur, st.lo, st.hi),
+                    (st.work, st.rowwork, st.impact, st.pos, st.sectors), step, ops.dt, p,
+                    lands, friction)
+
+
 @internal
-def hole_kinematics(ops, st, step, dt, p, lands):
+def hole_kinematics(pair, Nc, nodes, at, force, tallies, step, dt, p, lands, friction):
     """Two planes, after state step+1: every row's node position, its impact angle and
     velocities when a contact starts, and its work rates' sums (State.pos, rowwork,
     sectors: |F_n||v_t|Δt with F_n the force's normal part, in the sector of the node's
-    angle).  ``lands``: None (no broached hole: their code is not compiled), or Ops.Nc."""
-    for j in range(st.active.size):
-        if ops.pair[j] < 0:
+    angle).  ``nodes``: Ops' (Np, Ni, Nx); ``at``: (uⁿ⁺¹, φ(t_{n+1})); ``force``:
+    State's (mu, dy, y_cur, lo, hi); ``tallies``: State's (work, rowwork, impact, pos,
+    sectors).  ``lands``: None (no broached hole: their code is not compiled), or Ops.Nc;
+    ``friction``: None (no row with Coulomb's μ in Nc's FRICTION_COLUMN: the friction
+    splits are not compiled, `friction_of_ops`), or Ops.Nc."""
+    Np, Ni, Nx = nodes
+    u, phi = at
+    mu, dy, y_cur, lo, hi = force
+    work, rowwork, impact, pos, sectors = tallies
+    for j in range(mu.size):
+        if pair[j] < 0:
             continue
-        if lands is not None and ops.pair[j] > 0 and ops.Nc[j, FRICTION_COLUMN] > 0.0 \
-                and ops.Nc[j, 6] > 0.0:
-            land_friction_split(ops, st, j, dt)
-        elif ops.pair[j] > 0 and ops.Nc[j, FRICTION_COLUMN] > 0.0:
-            friction_split(st.mu, st.dy, (st.y_cur, st.lo, st.hi), st.work, st.rowwork,
-                           st.impact[j], j, ops.pair[j], dt)
-        elif ops.Nc[j, FRICTION_COLUMN] > 0.0:     # a face with friction
-            face_friction_split(st.mu, st.dy, st.work, st.rowwork, st.impact[j],
-                                int(ops.Nc[j, TANGENT_COLUMN]), dt)
-        node_position(ops, st, j, p)
-        ev = st.impact[j]
-        nx, ny = normal_of(ops, j, p[2], p[3], lands)
+        if friction is not None:
+            if lands is not None and pair[j] > 0 and Nc[j, FRICTION_COLUMN] > 0.0 \
+                    and Nc[j, 6] > 0.0:
+                land_friction_split(pair, Nc, mu, dy, (y_cur, lo, hi), work, rowwork,
+                                    impact[j], j, dt)
+            elif pair[j] > 0 and Nc[j, FRICTION_COLUMN] > 0.0:
+                friction_split(mu, dy, (y_cur, lo, hi), work, rowwork, impact[j], j,
+                               pair[j], dt)
+            elif Nc[j, FRICTION_COLUMN] > 0.0:     # a face with friction
+                face_friction_split(mu, dy, work, rowwork, impact[j],
+                                    int(Nc[j, TANGENT_COLUMN]), dt)
+        node_position(Np, Ni, Nx, Nc, u, phi, j, p)
+        ev = impact[j]
+        nx, ny = normal_of(Nc, j, p[2], p[3], lands)
         if ev[0] == step + 1:            # a contact starts: where and how fast before it
-            vx = (st.pos[j, 2] - st.pos[j, 0]) / dt
-            vy = (st.pos[j, 3] - st.pos[j, 1]) / dt
+            vx = (pos[j, 2] - pos[j, 0]) / dt
+            vy = (pos[j, 3] - pos[j, 1]) / dt
             ev[6] = np.arctan2(p[3], p[2])
             ev[7] = vx * nx + vy * ny
             ev[8] = -vx * ny + vy * nx
-        f = abs(st.mu[j]) if ops.pair[j] == 0 else abs(st.mu[j] * nx + st.mu[ops.pair[j]] * ny)
+        f = abs(mu[j]) if pair[j] == 0 else abs(mu[j] * nx + mu[pair[j]] * ny)
         if f != 0.0:                     # |F_n||v_t|Δt, v_t of the central difference
-            vx = (p[0] - st.pos[j, 0]) / (2.0 * dt)
-            vy = (p[1] - st.pos[j, 1]) / (2.0 * dt)
+            vx = (p[0] - pos[j, 0]) / (2.0 * dt)
+            vy = (p[1] - pos[j, 1]) / (2.0 * dt)
             w = f / (dt * dt) * abs(-vx * ny + vy * nx) * dt
-            st.rowwork[j, 1] += w
+            rowwork[j, 1] += w
             k = int((np.arctan2(p[3], p[2]) + np.pi) / (2.0 * np.pi) * SECTORS)
-            st.sectors[j, min(max(k, 0), SECTORS - 1)] += w
-        st.pos[j, 0], st.pos[j, 1] = st.pos[j, 2], st.pos[j, 3]
-        st.pos[j, 2], st.pos[j, 3] = p[0], p[1]
+            sectors[j, min(max(k, 0), SECTORS - 1)] += w
+        pos[j, 0], pos[j, 1] = pos[j, 2], pos[j, 3]
+        pos[j, 2], pos[j, 3] = p[0], p[1]
+
+
+def friction_of_ops(ops):
+    """The loop's ``friction`` argument (run_steps, hole_kinematics): Ops.Nc when some row
+    has Coulomb's μ in Nc's FRICTION_COLUMN (the β-scheme's law takes friction), else
+    None: a run without one compiles none of the friction splits."""
+    Nc = ops.Nc
+    return Nc if Nc.shape[0] and bool((Nc[:, FRICTION_COLUMN] > 0.0).any()) else None
 
 
 @njit(cache=True, inline="always")
@@ -574,12 +604,14 @@ def run_steps(law, explicit, ops, st, out, n0, n1, inputs, Ebound, holes, massle
     """Steps n = n0..n1−1 (computing uⁿ⁺¹) with a compiled law: the bounds at t_{n+1},
     the law's explicit force, the free step, the law, then `finish_step`, the impact
     events, the diagnostics and `stop_code`.  ``inputs`` (Inputs) hold Gⁿ and φ(t_{n+1})
-    at row n − n0.  ``holes``: None, or the scratch of `hole_kinematics` (two planes with
-    holes); ``massless``: None, or State.ez (quasi-static massless rows); ``lands``: None,
-    or Ops.Nc when a broached hole is among the holes (`lands_of`).  numba prunes the
-    branch of a None argument before typing it, so a run without holes, massless rows or
-    broached holes does not compile their code (0.5, 0.15 and, with friction, 3 CPU s of
-    a first run).
+    at row n − n0.  ``holes``: None, or (two planes with holes) the scratch of
+    `hole_kinematics` and its ``friction`` (None, or Ops.Nc when some row has Coulomb's
+    μ there: `friction_of_ops`); ``massless``: None, or State.ez (quasi-static massless
+    rows); ``lands``: None, or Ops.Nc when a broached hole is among the holes
+    (`lands_of`).  numba prunes the
+    branch of a None argument before typing it, so a run without holes, massless rows,
+    broached holes or friction does not compile their code (0.5, 0.15 and, with
+    friction, 3 CPU s of a first run).
 
     Returns 0, FAILED (the law failed at step counters[3]), UNSTABLE (the energy saved
     at state counters[3] is non-finite or above Ebound) or EVENTS_FULL (stopped after
@@ -598,7 +630,7 @@ def run_steps(law, explicit, ops, st, out, n0, n1, inputs, Ebound, holes, massle
         finish_step(ops, st, Gn, massless)
         full = track_impacts(ops, st, out, step, lands)
         if holes is not None:
-            hole_kinematics(ops, st, step, ops.dt, holes, lands)
+            track_holes(ops, st, step, holes[0], lands, holes[1])
         record(step + 1, ops, st, out, lands)
         code = stop_code(ops, st, out, step, Ebound, full)
         if code:
@@ -692,7 +724,7 @@ def run_steps_python(ops, st, out, n0, n1, inputs, Ebound, free_inside, holes,
         finish_step(ops, st, Gn, massless)
         full = track_impacts(ops, st, out, step, lands)
         if holes is not None:
-            hole_kinematics(ops, st, step, ops.dt, holes, lands)
+            track_holes(ops, st, step, holes[0], lands, holes[1])
         record(step + 1, ops, st, out, lands)
         code = stop_code(ops, st, out, step, Ebound, full)
         if code:

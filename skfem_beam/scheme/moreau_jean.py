@@ -51,7 +51,7 @@ from .beta import (disk_rows, friction_of, hole_arrays, observers, penetration_s
                    refuse_lands, start_positions, tangent_rows, two_plane_state)
 from ..contact.friction import MAX_SWEEPS, nsgs
 from .kernels import (EVENT_COLUMNS, FAILED, FRICTION, IMPACT_FIELDS, ITERATIONS, ROW0,
-                      STOPPED_AT, UNSTABLE, Inputs, Series, csr_product, hole_kinematics,
+                      STOPPED_AT, UNSTABLE, Inputs, Series, csr_product, track_holes,
                       track_impacts)
 from .operators import csr_arrays, load_norms, step_operators
 from .stepping import Stepping
@@ -233,7 +233,7 @@ def mj_steps(ops, st, out, n0, n1, inputs, Ebound):
                     st.rowwork[a, 2] += f
         full = track_impacts(ops, st, out, step, None)      # no broached hole (refused)
         if ops.Nc.shape[0]:
-            hole_kinematics(ops, st, step, dt, st.hk, None)
+            track_holes(ops, st, step, st.hk, None, None)   # (Nc: no μ, friction below)
         mj_record(step + 1, ops, st, out)
         if (step + 1) % ops.save_every == 0 \
                 and not abs(out.energy[(step + 1) // ops.save_every - st.counters[ROW0]]) <= Ebound:

@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit, types
-from numba.np.linalg import F_INT_nbtype, F_INT_nptype, ensure_lapack
 
 from ..errors import InputError
 from .active_set import data_scale
@@ -198,32 +197,51 @@ def _still_holds(D, yf, lo, hi, kind, lands, piece, mu, mu_new, tol):
     return True
 
 
+@internal
+def solve_numpy(J, F):
+    """F ← J⁻¹F by np.linalg.solve; False where it raises (J or F not finite, J singular)."""
+    try:
+        F[:] = np.linalg.solve(J, F)
+    except Exception:   # noqa: BLE001  (numba: a singular matrix)
+        return False
+    return True
+
+
 # LAPACK's dgesv through numba's own entry point: the routine np.linalg.solve calls, on the
 # same copies (J in Fortran order, F), so the same bits, without np.linalg.solve's checks'
 # and error messages' compile (~4 CPU s of a round-hole scene's first run, the law's
 # callees in bench.cold_compile: _check_finite_matrix, _inv_err_handler, str and repr).
-ensure_lapack()
-_xgesv = types.ExternalFunction("numba_xgesv", types.intc(
-    types.char, types.intp, types.intp, types.CPointer(types.float64), types.intp,
-    types.CPointer(F_INT_nbtype), types.CPointer(types.float64), types.intp))
+# These are numba's internals: a numba without them gets solve_numpy (the same bits,
+# compiled more slowly).  tests/test_round_hole_gesv.py holds gesv to np.linalg.solve.
+try:
+    from numba.np.linalg import F_INT_nbtype, F_INT_nptype, ensure_lapack
+    ensure_lapack()
+    _xgesv = types.ExternalFunction("numba_xgesv", types.intc(
+        types.char, types.intp, types.intp, types.CPointer(types.float64), types.intp,
+        types.CPointer(F_INT_nbtype), types.CPointer(types.float64), types.intp))
+except (ImportError, AttributeError):
+    _xgesv = None
 
 
-@internal
-def gesv(J, F):
-    """F ← J⁻¹F (J square, k × k, C order); False (F undefined) where np.linalg.solve
-    raises: J or F not finite, J singular."""
-    k = F.size
-    for i in range(k):
-        if not np.isfinite(F[i]):
-            return False
-        for q in range(k):
-            if not np.isfinite(J[i, q]):
+if _xgesv is None:
+    gesv = solve_numpy
+else:
+    @internal
+    def gesv(J, F):
+        """F ← J⁻¹F (J square, k × k, C order); False (F undefined) where np.linalg.solve
+        raises: J or F not finite, J singular."""
+        k = F.size
+        for i in range(k):
+            if not np.isfinite(F[i]):
                 return False
-    a = J.T.copy()                       # J in Fortran order
-    ipiv = np.empty(k, F_INT_nptype)
-    r = _xgesv(100, k, 1, a.ctypes, k, ipiv.ctypes, F.ctypes, k)        # 100: ord('d')
-    # a and ipiv used after the call: numba frees an array after its last use
-    return r == 0 and a.size + ipiv.size > 0
+            for q in range(k):
+                if not np.isfinite(J[i, q]):
+                    return False
+        a = J.T.copy()                       # J in Fortran order
+        ipiv = np.empty(k, F_INT_nptype)
+        r = _xgesv(100, k, 1, a.ctypes, k, ipiv.ctypes, F.ctypes, k)        # 100: ord('d')
+        # a and ipiv used after the call: numba frees an array after its last use
+        return r == 0 and a.size + ipiv.size > 0
 
 
 @internal

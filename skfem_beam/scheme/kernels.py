@@ -517,12 +517,18 @@ def hole_kinematics(pair, Nc, nodes, at, force, tallies, step, dt, p, lands, fri
         pos[j, 2], pos[j, 3] = p[0], p[1]
 
 
+def switch(ops, column: int):
+    """One of the loop's code switches: Ops.Nc when some row has Nc[:, column] > 0, else
+    None (numba prunes the branches of a None argument: their code is not compiled)."""
+    Nc = ops.Nc
+    return Nc if Nc.shape[0] and bool((Nc[:, column] > 0.0).any()) else None
+
+
 def friction_of_ops(ops):
     """The loop's ``friction`` argument (run_steps, hole_kinematics): Ops.Nc when some row
     has Coulomb's μ in Nc's FRICTION_COLUMN (the β-scheme's law takes friction), else
     None: a run without one compiles none of the friction splits."""
-    Nc = ops.Nc
-    return Nc if Nc.shape[0] and bool((Nc[:, FRICTION_COLUMN] > 0.0).any()) else None
+    return switch(ops, FRICTION_COLUMN)
 
 
 @njit(cache=True, inline="always")
@@ -652,8 +658,7 @@ def lands_of(ops):
     """The loop's ``lands`` argument (run_steps): Ops.Nc when some row belongs to a broached
     hole (Nc's column 6, its lands, > 0; contact.lands), else None: a run without one
     compiles none of their code."""
-    Nc = ops.Nc
-    return Nc if Nc.shape[0] and bool((Nc[:, 6] > 0.0).any()) else None
+    return switch(ops, 6)
 
 
 @njit(cache=True)

@@ -58,9 +58,9 @@ class NoWorkers(RuntimeError):
     """The cluster has had no worker for NO_WORKERS_PATIENCE seconds."""
 
 
-def _finished(client, futures, patience: float):
+def _finished(client, futures):
     """``futures`` as they finish (a batch at a time); NoWorkers once the cluster has had no
-    worker for ``patience`` seconds while some are still pending."""
+    worker for NO_WORKERS_PATIENCE seconds while some are still pending."""
     from distributed import wait
     pending, empty_since = list(futures), None
     while pending:
@@ -71,25 +71,23 @@ def _finished(client, futures, patience: float):
                 empty_since = None
             elif empty_since is None:
                 empty_since = time.monotonic()
-            elif time.monotonic() - empty_since >= patience:
-                raise NoWorkers(f"no Dask worker for {patience:g} s: every worker died and "
-                                "none came back") from None
+            elif time.monotonic() - empty_since >= NO_WORKERS_PATIENCE:
+                raise NoWorkers(f"no Dask worker for {NO_WORKERS_PATIENCE:g} s: every worker "
+                                "died and none came back") from None
             continue
         done = [f for f in pending if f.done()]
         pending = [f for f in pending if f not in done]
         yield from done
 
 
-def on_cluster(client, task, settings: dict, todo: list[float], give_up,
-               patience: float | None = None):
+def on_cluster(client, task, settings: dict, todo: list[float], give_up):
     """Results as they finish; a task that raises (a killed worker: KilledWorker) is tried
     again, alone, up to RETRIES times after the others, then given up: its result is
     ``give_up(settings, value, error, attempts)`` (the sweep's :func:`~skfem_beam.sweep.lost`).
     Alone: a worker that dies takes the tasks queued on it along, so a value retried
     beside the one that kills it could be lost with it (seen once in CI).  A cluster left
-    without any worker for ``patience`` seconds (default NO_WORKERS_PATIENCE) gives up every
-    value not yet finished, at once."""
-    patience = NO_WORKERS_PATIENCE if patience is None else patience
+    without any worker for NO_WORKERS_PATIENCE seconds gives up every value not yet
+    finished, at once."""
     attempts = {v: 1 for v in todo}
     key, finished = {}, set()
 
@@ -109,7 +107,7 @@ def on_cluster(client, task, settings: dict, todo: list[float], give_up,
 
     failed = {}
     try:
-        for f in _finished(client, [submit(v) for v in todo], patience):
+        for f in _finished(client, [submit(v) for v in todo]):
             try:
                 yield result(f)
             except Exception as e:     # the worker died (KilledWorker) or the task broke
@@ -118,7 +116,7 @@ def on_cluster(client, task, settings: dict, todo: list[float], give_up,
             while attempts[v] <= RETRIES:
                 attempts[v] += 1
                 f = submit(v)
-                next(_finished(client, [f], patience))
+                next(_finished(client, [f]))
                 try:
                     yield result(f)
                     break

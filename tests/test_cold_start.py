@@ -63,7 +63,6 @@ def test_the_callees_compiled_aside_are_the_loops(tmp_path):
     assert all(r[1:] == ["1", "0", "1"] for r in rows), p.stdout
 
 
-
 PLATE_CHILD = """
 from skfem_beam import aside
 from skfem_beam.linalg import band_solve

@@ -21,7 +21,7 @@ from ..contact.base import NoContact, no_explicit
 from ..contact.registry import Auto
 from ..contact.round_hole import disk_kinds
 from ..errors import InputError, SolverError
-from ..linalg import band_solve, rows_matvec
+from ..linalg import band_solve, row_layout_of, rows_matvec
 from .kernels import (CALLEES, EVENT_COLUMNS, FRICTION_COLUMN, IMPACT_FIELDS, NC_COLUMNS,
                       SECTORS, TANGENT_COLUMN, Inputs, Ops, PythonLaw, Series, State,
                       csr_product, energy_beta, friction_of_ops, lands_of, move_bounds,
@@ -306,8 +306,9 @@ class BetaScheme:
         shift = np.ascontiguousarray(system.bound_shift, dtype=float) if moving else np.zeros(0)
         sshift = np.ascontiguousarray(system.sample_shift, dtype=float) \
             if moving and slo.size else np.zeros(0)
-        return Ops(s.dt, self.beta, s.save_every, s.frame_every, op.Kb.rows, op.Bb, op.Ab.chol,
-                   op.Eb.rows, self.loads, *csr_arrays(op.C), step.lo, step.hi, shift, sshift,
+        return Ops(s.dt, self.beta, s.save_every, s.frame_every, *row_layout_of(op.Kb),
+                   *row_layout_of(op.Bb), op.Ab.chol, *row_layout_of(op.Eb), self.loads,
+                   *csr_arrays(op.C), step.lo, step.hi, shift, sshift,
                    op.W, op.D, *csr_arrays(self.Orows), *samples, slo, shi, params, op.Z,
                    *csr_arrays(system.K.tocsr()[op.Z]), *self._holes())
 
@@ -332,7 +333,7 @@ class BetaScheme:
                      counters=z(6, np.int64), work=z(4),
                      impact=np.full((m, IMPACT_FIELDS), -1.0), **two_plane_state(ops),
                      r_e=z(m), x=np.empty(n), yf=np.empty(m), mu=z(m), Ku=np.empty(n),
-                     d=np.empty(n), dy=z(m), ez=z(self.op.Z.size))
+                     d=np.empty(n), dy=z(m), ez=z(self.op.Z.size), nz=z(m, np.int64))
 
     def series(self, rows: int, nframes: int) -> Series:
         """Saved-series buffers of ``rows`` rows and ``nframes`` field frames."""
@@ -447,10 +448,10 @@ class BetaScheme:
         start_positions(self.ops, st, st.u_prev, st.u_cur)
         out.obs[0] = Orows @ st.u_prev
         out.obsv[0] = Orows @ system.v0
-        rows_matvec(op.Kb.rows, st.u_prev, st.Ku, 1.0, False)   # K uⁿ⁻¹ for the energy
+        rows_matvec(op.Kb.rows, op.Kb.cols, st.u_prev, st.Ku, 1.0, False)   # K uⁿ⁻¹ for the energy
         uncompiled(record)(1, self.ops, st, out, self.lands)
         out.frames_u[0], out.frames_v[0] = st.u_prev, system.v0
-        self.E1 = 0.5 * energy_beta(op.Eb.rows, st.u_prev, st.u_cur, st.Ku, st.d)
+        self.E1 = 0.5 * energy_beta(op.Eb.rows, op.Eb.cols, st.u_prev, st.u_cur, st.Ku, st.d)
         if not (np.isfinite(st.u_cur).all() and math.isfinite(self.E1)):
             raise InputError("the initial state and load are too large for floating point: "
                              f"the first step's energy is {self.E1:g}")

@@ -46,7 +46,7 @@ from ..contact.active_set import box_qp
 from ..contact.base import ContactLaw
 from ..contact.restitution import Restitution
 from ..errors import InputError
-from ..linalg import Banded, band_solve, rows_dot, rows_matvec
+from ..linalg import Banded, band_solve, row_layout_of, rows_dot, rows_matvec
 from .beta import (disk_rows, friction_of, hole_arrays, observers, penetration_samples,
                    refuse_lands, start_positions, tangent_rows, two_plane_state)
 from ..contact.friction import MAX_SWEEPS, nsgs
@@ -58,7 +58,8 @@ from .stepping import Stepping
 
 MJOps = namedtuple("MJOps", [
     "dt", "theta", "e", "save_every", "frame_every",
-    "Kb", "Mb", "Bb", "Achol", "loads",    # K, M, B rows; Â's factor; load vectors
+    "Kb", "Kj", "Mb", "Mj", "Bb", "Bj",   # K, M, B in the row layout (linalg.Banded)
+    "Achol", "loads",                      # Â's factor; load vectors
     "Cp", "Ci", "Cx", "W", "D",            # constraint rows, Â⁻¹Cᵀ, C Â⁻¹ Cᵀ
     "Op", "Oi", "Ox", "Sp", "Si", "Sx",    # observers, penetration samples
     "pair", "disks", "Np", "Ni", "Nx", "Nc",   # two planes: rows, nodes, holes (kernels.Ops)
@@ -105,8 +106,8 @@ def mj_record(n, ops, st, out):
             for q in range(ops.Op[r], ops.Op[r + 1]):
                 out.obs[k, r] += ops.Ox[q] * st.u_cur[ops.Oi[q]]
                 out.obsv[k, r] += ops.Ox[q] * st.v[ops.Oi[q]]
-        out.energy[k] = 0.5 * (rows_dot(ops.Mb, st.v, st.v) + rows_dot(ops.Kb, st.u_cur,
-                                                                        st.u_cur))
+        out.energy[k] = 0.5 * (rows_dot(ops.Mb, ops.Mj, st.v, st.v)
+                               + rows_dot(ops.Kb, ops.Kj, st.u_cur, st.u_cur))
         out.work[k, :] = st.work
         out.lam[k, :] = st.mu / dt2
         out.resid[k] = st.fres[0]
@@ -166,8 +167,8 @@ def mj_steps(ops, st, out, n0, n1, inputs, Ebound):
     n, m = st.x.size, st.mu.size
     for step in range(n0, n1):
         Gn = inputs.G[step - n0]
-        rows_matvec(ops.Kb, st.u_cur, st.Ku, 1.0, np.bool_(False))
-        rows_matvec(ops.Kb, st.v, st.Kv, 1.0, np.bool_(False))
+        rows_matvec(ops.Kb, ops.Kj, st.u_cur, st.Ku, 1.0, np.bool_(False))
+        rows_matvec(ops.Kb, ops.Kj, st.v, st.Kv, 1.0, np.bool_(False))
         x = st.x
         for i in range(n):
             s = -st.Ku[i] - dt * th * st.Kv[i]
@@ -175,7 +176,7 @@ def mj_steps(ops, st, out, n0, n1, inputs, Ebound):
                 s += Gn[k] * ops.loads[i, k]
             x[i] = dt * s
         if ops.Bb.shape[0]:
-            rows_matvec(ops.Bb, st.v, x, -dt, np.bool_(True))
+            rows_matvec(ops.Bb, ops.Bj, st.v, x, -dt, np.bool_(True))
         band_solve(ops.Achol, x)
         for i in range(n):
             x[i] += st.v[i]                      # v_free
@@ -198,10 +199,10 @@ def mj_steps(ops, st, out, n0, n1, inputs, Ebound):
                 s += ops.loads[i, k] * st.Kv[i]
             st.work[1] += dt * Gn[k] * s
         if ops.Bb.shape[0]:
-            st.work[0] += dt * rows_dot(ops.Bb, st.Kv, st.Kv)
+            st.work[0] += dt * rows_dot(ops.Bb, ops.Bj, st.Kv, st.Kv)
         if th != 0.5:
-            st.work[0] += (th - 0.5) * (rows_dot(ops.Mb, st.dv, st.dv)
-                                        + dt * dt * rows_dot(ops.Kb, st.Kv, st.Kv))
+            st.work[0] += (th - 0.5) * (rows_dot(ops.Mb, ops.Mj, st.dv, st.dv)
+                                        + dt * dt * rows_dot(ops.Kb, ops.Kj, st.Kv, st.Kv))
         for i in range(n):
             st.u_prev[i] = st.u_cur[i]
             st.u_cur[i] += dt * st.Kv[i]
@@ -302,9 +303,10 @@ class MoreauJeanScheme:
         system, s, op = self.system, self.stepping, self.op
         samples, _, _ = penetration_samples(system)
         B = system.B
-        return MJOps(s.dt, self.theta, self.e, s.save_every, s.frame_every, op.Kb.rows,
-                     Banded(system.M).rows, Banded(B).rows if B is not None
-                     else np.zeros((0, 1)), op.Ab.chol, self.loads, *csr_arrays(op.C),
+        return MJOps(s.dt, self.theta, self.e, s.save_every, s.frame_every,
+                     *row_layout_of(op.Kb), *row_layout_of(Banded(system.M)),
+                     *row_layout_of(Banded(B) if B is not None else None), op.Ab.chol,
+                     self.loads, *csr_arrays(op.C),
                      op.W, op.D, *csr_arrays(self.Orows), *samples, *hole_arrays(system),
                      friction_of(system), NSGS_TOL)
 

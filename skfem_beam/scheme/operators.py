@@ -37,7 +37,7 @@ class StepOperators:
     Ab: Banded          # A with its Cholesky factor
     Eb: Banded          # M/Δt² + βK
     Kb: Banded
-    Bb: np.ndarray      # damping rows, (0, 1) when there is none
+    Bb: Banded | None   # damping, None when there is none
     C: sp.csr_matrix
     W: np.ndarray       # A⁻¹Cᵀ (n × m)
     D: np.ndarray       # C A⁻¹ Cᵀ (m × m), both times β with quasi-static massless rows
@@ -121,7 +121,7 @@ def step_operators(system, dt: float, beta: float, massless: str = "beta",
         Z = np.zeros(0, dtype=np.int64)
     D = np.ascontiguousarray((C @ W).reshape(m, m)) if delassus else np.zeros((0, 0))
     return StepOperators(A=sp.csr_matrix(A), Ab=Ab, Eb=Banded(E), Kb=Banded(K),
-                         Bb=Banded(B).rows if B is not None else np.zeros((0, 1)),
+                         Bb=Banded(B) if B is not None else None,
                          C=C, W=W, D=D, Z=Z.astype(np.int64))
 
 

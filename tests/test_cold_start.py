@@ -59,7 +59,7 @@ def test_the_callees_compiled_aside_are_the_loops(tmp_path):
     assert p.returncode == 0, p.stderr
     rows = [line.split() for line in p.stdout.splitlines()]
     assert [r[0] for r in rows] == ["rows_matvec", "csr_product", "rows_dot", "write_event",
-                                    "energy_beta"], p.stdout
+                                    "energy_beta", "add_columns"], p.stdout
     assert all(r[1:] == ["1", "0", "1"] for r in rows), p.stdout
 
 

@@ -25,7 +25,7 @@ import numpy as np
 from numba import njit, objmode, types
 
 from ..contact.lands import land_excess, land_normal, land_split
-from ..linalg import band_solve, csr_product, rows_dot, rows_matvec
+from ..linalg import add_columns, band_solve, csr_product, rows_dot, rows_matvec
 
 Ops = namedtuple("Ops", [
     "dt", "beta", "save_every", "frame_every",
@@ -77,7 +77,7 @@ State = namedtuple("State", [
     "x", "yf", "mu", "Ku", "d", "dy", # the step's free solution (then uⁿ⁺¹), C x, μ, K uⁿ,
                                       # scratch (n), C(uⁿ⁺¹ − uⁿ⁻¹)
     "ez",                             # the massless rows' explicit force of the step
-    "nz",                             # scratch (m): the rows with μ ≠ 0 (finish_step)
+    "nz",                             # scratch (m) of add_columns
 ])
 Series = namedtuple("Series", ["obs", "obsv", "energy", "work", "lam", "frames_u", "frames_v",
                                "frames_f", "events", "resid"])   # resid: friction's residual
@@ -138,12 +138,6 @@ def massless_work(Zr, ez, d, mu, Cp, Ci, Cx, beta, dt):
     return 0.5 * s
 
 
-# W μ by columns while W fits in cache (a beam's: 0.1–0.5 µs a step faster), by rows above
-# (a plate's at 40 × 40, 6,400 × 1,521 with 150 contacts: 4.2 → 1.3 ms; its columns are
-# strided); the same bits either way
-W_BY_ROWS = 1 << 19
-
-
 # The helpers inlined into the loop read the tuples' fields they use before their first
 # loop or branch: a tuple used in one block only is an SSA value, one used across blocks
 # a stack copy of the whole struct in every helper (compile time, docs/design.md).
@@ -199,22 +193,7 @@ def finish_step(ops, st, Gn, massless):
     dy, y_prev, y_cur, r_e, rowwork, nz = st.dy, st.y_prev, st.y_cur, st.r_e, st.rowwork, \
         st.nz
     if W.shape[1] == mu.size:   # else an x-space law wrote uⁿ⁺¹ into x (no W)
-        if W.size < W_BY_ROWS:
-            for j in range(mu.size):
-                if mu[j] != 0.0:
-                    for i in range(x.size):
-                        x[i] += W[i, j] * mu[j]
-        else:
-            k = 0
-            for j in range(mu.size):
-                if mu[j] != 0.0:
-                    nz[k] = j
-                    k += 1
-            for i in range(x.size):     # by W's rows, each sum in the same order of j
-                s = x[i]
-                for q in range(k):
-                    s += W[i, nz[q]] * mu[nz[q]]
-                x[i] = s
+        add_columns(W, mu, x, nz)
     for i in range(x.size):
         d[i] = x[i] - u_prev[i]
     if Bb.shape[0]:
@@ -675,7 +654,8 @@ _v, _M, _i = types.float64[::1], types.float64[:, ::1], types.int64[::1]
 _J = types.int64[:, ::1]
 CALLEES = ((rows_matvec, (_M, _J, _v, _v, types.float64, types.boolean)),
            (csr_product, (_i, _i, _v, _v, _v)), (rows_dot, (_M, _J, _v, _v)),
-           (write_event, (_M, _i, types.int64, _v)), (energy_beta, (_M, _J, _v, _v, _v, _v)))
+           (write_event, (_M, _i, types.int64, _v)), (energy_beta, (_M, _J, _v, _v, _v, _v)),
+           (add_columns, (_M, _v, _v, _i)))
 
 
 def lands_of(ops):

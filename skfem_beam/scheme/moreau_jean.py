@@ -46,7 +46,7 @@ from ..contact.active_set import box_qp
 from ..contact.base import ContactLaw
 from ..contact.restitution import Restitution
 from ..errors import InputError
-from ..linalg import Banded, band_solve, row_layout_of, rows_dot, rows_matvec
+from ..linalg import Banded, add_columns, band_solve, row_layout_of, rows_dot, rows_matvec
 from .beta import (disk_rows, friction_of, hole_arrays, observers, penetration_samples,
                    refuse_lands, start_positions, tangent_rows, two_plane_state)
 from ..contact.friction import MAX_SWEEPS, nsgs
@@ -73,7 +73,7 @@ MJState = namedtuple("MJState", [
     "pos", "rowwork", "sectors", "hk", "fc",   # two planes (kernels.State)
     "fres",                                # round holes: [the step's NSGS residual, max]
     "mu",                                  # Δt·p (so that mu/Δt² is the force p/Δt)
-    "p", "wf", "x", "dv", "Ku", "Kv",      # scratch
+    "p", "wf", "x", "dv", "Ku", "Kv", "nz",   # scratch
 ])
 
 
@@ -185,10 +185,7 @@ def mj_steps(ops, st, out, n0, n1, inputs, Ebound):
             st.counters[STOPPED_AT] = step + 1
             return FAILED
         st.counters[ITERATIONS] += its
-        for j in range(m):
-            if st.p[j] != 0.0:
-                for i in range(n):
-                    x[i] += ops.W[i, j] * st.p[j]
+        add_columns(ops.W, st.p, x, st.nz)
         # x = v^{n+1}; dv = Δv; Kv ← v^θ
         for i in range(n):
             st.dv[i] = x[i] - st.v[i]
@@ -324,7 +321,7 @@ class MoreauJeanScheme:
                        work=z(4), impact=np.full((m, IMPACT_FIELDS), -1.0),
                        **two_plane_state(self.ops, bool(disk_rows(system).size)),
                        fres=z(2), mu=z(m), p=z(m), wf=z(m),
-                       x=z(n), dv=z(n), Ku=z(n), Kv=z(n))
+                       x=z(n), dv=z(n), Ku=z(n), Kv=z(n), nz=z(m, np.int64))
 
     def series(self, rows: int, nframes: int) -> Series:
         """Saved-series buffers (Moreau–Jean keeps its frames, whatever the run asked)."""

@@ -448,7 +448,7 @@ class BetaScheme:
         start_positions(self.ops, st, st.u_prev, st.u_cur)
         out.obs[0] = Orows @ st.u_prev
         out.obsv[0] = Orows @ system.v0
-        rows_matvec(op.Kb.rows, op.Kb.cols, st.u_prev, st.Ku, 1.0, False)   # K uⁿ⁻¹ for the energy
+        rows_matvec(op.Kb.rows, op.Kb.cols, st.u_prev, st.Ku, 1.0, False)   # K uⁿ⁻¹: energy
         uncompiled(record)(1, self.ops, st, out, self.lands)
         out.frames_u[0], out.frames_v[0] = st.u_prev, system.v0
         self.E1 = 0.5 * energy_beta(op.Eb.rows, op.Eb.cols, st.u_prev, st.u_cur, st.Ku, st.d)

@@ -29,6 +29,7 @@ import scipy.sparse.linalg as spla
 
 from ..errors import InputError
 from ..linalg import Banded, band_solve
+from ..spaces.redistribution import massless_rows
 
 
 @dataclass
@@ -42,11 +43,6 @@ class StepOperators:
     W: np.ndarray       # A⁻¹Cᵀ (n × m)
     D: np.ndarray       # C A⁻¹ Cᵀ (m × m), both times β with quasi-static massless rows
     Z: np.ndarray       # the quasi-static massless rows (empty with massless="beta")
-
-
-def massless_rows(M) -> np.ndarray:
-    """The dofs without inertia (their rows of M are zero: a redistributed mass)."""
-    return np.flatnonzero(np.asarray(abs(sp.csr_matrix(M)).sum(axis=1)).ravel() == 0)
 
 
 def load_norms(system, dt: float, beta: float) -> np.ndarray:

@@ -42,6 +42,11 @@ from ..errors import InputError
 MOMENTS = ((0, 0), (0, 1))      # total mass, first moment (centre of mass)
 
 
+def massless_rows(M) -> np.ndarray:
+    """The dofs without inertia (their rows of M are zero: a redistributed mass)."""
+    return np.flatnonzero(np.asarray(abs(sp.csr_matrix(M)).sum(axis=1)).ravel() == 0)
+
+
 def massless_dofs(C) -> np.ndarray:
     """The dofs the constraint rows act on."""
     C = sp.csr_matrix(C)

@@ -15,6 +15,7 @@ from PIL import Image
 
 from skfem_beam import chart_process
 from skfem_beam._startup import CHART_MODULES
+from skfem_beam.aside import cores
 from skfem_beam.cases import flat_obstacles
 from skfem_beam.output.charts import trajectory_chart
 
@@ -71,15 +72,16 @@ def test_the_chart_process_loads_matplotlib_and_not_the_package(process):
 
 
 def test_each_chart_is_drawn_in_a_child_of_the_single_threaded_chart_process(tmp_path, process):
-    """The chart process has one thread (BLAS's workers are off), so it forks one child per
-    chart; two charts are drawn by two children, neither of them the chart process."""
+    """The chart process has one thread (BLAS's workers are off), so it forks its workers,
+    one per core; two charts are drawn by two of them (one on one core), never by the chart
+    process."""
     server = process._process.pid
     for name in ("a", "b"):
         process.draw(exec, f"import os; open({str(tmp_path / name)!r}, 'w').write(str(os.getpid()))")
     process.wait()
     drawers = {int((tmp_path / name).read_text()) for name in ("a", "b")}
     assert len(os.listdir(f"/proc/{server}/task")) == 1
-    assert len(drawers) == 2 and server not in drawers
+    assert len(drawers) == min(2, cores()) and server not in drawers
 
 
 def test_a_chart_whose_child_died_is_drawn_again_by_the_chart_process(tmp_path, process):

@@ -31,8 +31,9 @@ def test_a_run_imports_no_extra(tmp_path):
 
 
 def test_a_scene_loads_no_writer_or_chart_library_before_its_loop():
-    """meshio and h5py come with the first frame, matplotlib with the first chart (in the
-    chart process): before its loop a command runs on one core (docs/design.md)."""
+    """meshio and h5py come with the loop (a thread imports them while the loop runs),
+    matplotlib with the first chart (in the chart process): before its loop a command runs
+    on one core (docs/design.md)."""
     code = ("import sys, skfem_beam.scenefile, skfem_beam.cases.flat_obstacles, "
             "skfem_beam.cases.point_stops, skfem_beam.cases.impacting_bar; "
             "print(sorted({'meshio', 'h5py', 'matplotlib'} & set(sys.modules)))")

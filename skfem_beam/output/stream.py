@@ -79,6 +79,8 @@ class _Fields:
                              f"(it keeps every {run.frame_every}-th)")
         self.every, self.until, self.written = every, series.field_until, 0
         self.make = series.writer or FieldWriter
+        threading.Thread(target=_import_writers, args=(fmt,), daemon=True,
+                         name="field-imports").start()
 
     @property
     def writer(self) -> FieldWriter:
@@ -98,6 +100,17 @@ class _Fields:
     def close(self) -> None:
         if self._writer is not None:   # a run stopped before its first frame has no field
             self._writer.close()       # files (none made on a disk that may be full)
+
+
+def _import_writers(fmt: str) -> None:
+    """The field writers' imports (meshio, h5py: 0.2–0.3 s), made in a thread while the
+    loop runs (its kernel releases the GIL), so that they are done by the first frame."""
+    try:
+        import meshio  # noqa: F401
+        if fmt in ("xdmf", "both"):
+            from . import xdmf  # noqa: F401
+    except Exception:       # noqa: BLE001  (the frame's own import will say what is wrong)
+        pass
 
 
 def prepare(options: OutputOptions) -> Path:

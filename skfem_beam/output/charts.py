@@ -370,3 +370,21 @@ def _contact_statistics(ax2, results: list[dict], label: str) -> None:
     ax3.set_ylabel("contact-time fraction", color="tab:orange")
     ax2.set_xlabel(label)
     ax2.grid(alpha=0.3)
+
+
+def deflection_chart(path, points, cells, w, title="") -> None:
+    """w over the plate (mm, colour) at one frame, with the mesh's cells drawn."""
+    from matplotlib.collections import PolyCollection
+    tall = np.ptp(points[:, 1]) > 1.5 * np.ptp(points[:, 0])
+    with figure(path, figsize=(5, 6.5) if tall else (7, 5)) as (fig, ax):
+        polys = points[cells][:, :, :2]
+        coll = PolyCollection(polys, array=1e3 * w[cells].mean(axis=1), cmap="viridis",
+                              edgecolors="0.6", linewidths=0.3)
+        ax.add_collection(coll)
+        ax.set_xlim(points[:, 0].min(), points[:, 0].max())
+        ax.set_ylim(points[:, 1].min(), points[:, 1].max())
+        ax.set_aspect("equal")
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("y (m)")
+        ax.set_title(title, fontsize=9)
+        fig.colorbar(coll, ax=ax, label="w (mm), cell mean")

@@ -114,7 +114,7 @@ def vertex_fields(system, u, v, force, ops=None) -> dict[str, np.ndarray]:
     nv = space.vertices.shape[1]
     full = full_dofs(system, u)
     w = full[space.w_dofs]
-    vel = full_dofs(system, v)[space.w_dofs]
+    vel = vertex_w(system, v)
     where = system.meta["contact_vertices"]
     f = np.zeros(nv)
     f[where] = force
@@ -124,6 +124,12 @@ def vertex_fields(system, u, v, force, ops=None) -> dict[str, np.ndarray]:
     return {"w": w, "displacement_vector": np.column_stack([0 * w, 0 * w, w]),
             "velocity": vel, "contact_force": f, "g1": g1, "g2": g2,
             **bending_moments(space, full, ops)}
+
+
+def vertex_w(system, u) -> np.ndarray:
+    """w at each vertex of the mesh from the system's coefficients u."""
+    from ..plate.system import full_dofs
+    return full_dofs(system, u)[system.meta["space"].w_dofs]
 
 
 def plate_cells(system) -> tuple[np.ndarray, list]:
@@ -232,22 +238,3 @@ def plate_impacts(folder: Path, run, last: int | None = None) -> dict:
                           for rows in (np.flatnonzero(table["value"] == j) for j in touched)],
              "units": units}
     return {"impact_statistics": stats}
-
-
-def deflection_chart(path, points, cells, w, title="") -> None:
-    """w over the plate (mm, colour) at one frame, with the mesh's cells drawn."""
-    from matplotlib.collections import PolyCollection
-    from .charts import figure
-    tall = np.ptp(points[:, 1]) > 1.5 * np.ptp(points[:, 0])
-    with figure(path, figsize=(5, 6.5) if tall else (7, 5)) as (fig, ax):
-        polys = points[cells][:, :, :2]
-        coll = PolyCollection(polys, array=1e3 * w[cells].mean(axis=1), cmap="viridis",
-                              edgecolors="0.6", linewidths=0.3)
-        ax.add_collection(coll)
-        ax.set_xlim(points[:, 0].min(), points[:, 0].max())
-        ax.set_ylim(points[:, 1].min(), points[:, 1].max())
-        ax.set_aspect("equal")
-        ax.set_xlabel("x (m)")
-        ax.set_ylabel("y (m)")
-        ax.set_title(title, fontsize=9)
-        fig.colorbar(coll, ax=ax, label="w (mm), cell mean")

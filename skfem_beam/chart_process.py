@@ -63,6 +63,7 @@ _outbox: queue.SimpleQueue | None = None   # pickled jobs for the process's send
 _pending: list = []        # the jobs sent and not yet reported drawn, in order
 PIPE_BYTES = 1 << 20       # Linux's default limit for an unprivileged process
 NICE = 10                  # the chart process's priority below its command's
+STOP_WAIT = 1.0            # s for the chart process to end its workers, then it is killed
 JOB_LENGTH = "<Q"          # each job on the pipe: its length in bytes, then the pickled job
 # BLAS without its worker threads in the chart process: it forks (serve), and a fork
 # copies only the thread that calls it
@@ -171,13 +172,19 @@ def _lost(quiet: bool = False) -> None:
 
 
 def stop() -> None:
-    """End the chart process (killed: it holds nothing to save, and the ~0.1 s of its
-    interpreter's teardown would add to its command's)."""
+    """End the chart process: SIGTERM, on which it ends its workers, waits for them and
+    exits without its interpreter's teardown (~0.1 s that would add to its command's), so
+    that the command's CPU time counts theirs; killed if it has not ended within
+    ``STOP_WAIT`` seconds (a stopped process)."""
     if _outbox is not None:
         _outbox.put(None)               # its sender thread ends
     if _process is not None and _process.poll() is None:
-        _process.kill()
-        _process.wait()
+        _process.terminate()
+        try:
+            _process.wait(timeout=STOP_WAIT)
+        except subprocess.TimeoutExpired:
+            _process.kill()
+            _process.wait()
 
 
 def serve(parent: int, preload=()) -> None:
@@ -201,6 +208,12 @@ def serve(parent: int, preload=()) -> None:
     for _ in range(cores() if forks else 0):
         if worker := _Worker.fork(workers):
             workers.append(worker)
+
+    def end(*_):                        # SIGTERM (stop()) or the command's end: the workers
+        for worker in workers:          # go too, waited for (their CPU time is counted)
+            worker.end()
+        os._exit(0)
+    signal.signal(signal.SIGTERM, end)
     idle = collections.deque(workers)
     charts = collections.deque()        # [job, report, done] per chart, in the order sent
     waiting = collections.deque()       # the charts no worker has taken yet
@@ -223,7 +236,7 @@ def serve(parent: int, preload=()) -> None:
             if fd == 0:
                 header = _read(0, struct.calcsize(JOB_LENGTH))
                 if header is None:
-                    os._exit(0)         # nothing to tear down: the command has ended
+                    end()               # nothing to tear down: the command has ended
                 job = _read(0, struct.unpack(JOB_LENGTH, header)[0])
                 charts.append([job, None, False])
                 waiting.append(charts[-1])
@@ -293,6 +306,14 @@ class _Worker:
             return True
         except OSError:
             return False
+
+    def end(self) -> None:
+        """Kill it and wait for it."""
+        try:
+            os.kill(self.pid, signal.SIGKILL)
+            os.waitpid(self.pid, 0)
+        except OSError:                 # gone already (its chart's report said so)
+            pass
 
     def result(self):
         """Its report of the chart it was sent, or _DIED."""

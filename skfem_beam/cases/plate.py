@@ -85,7 +85,7 @@ def plate_charts(case: str, system, setup):
         r = run.result()
         force = np.abs(r.frames_force).sum(axis=1) if r.frames_force.size else np.zeros(1)
         k = int(np.argmax(force)) if np.any(force) else r.frames_t.size - 1
-        w = vertex_w(system, r.frames_u[k])     # not vertex_fields: its moments cost 0.5 s
+        w = vertex_w(system, r.frames_u[k])     # not vertex_fields: no moments needed here
         points, ((_, cells),) = plate_cells(system)
         draw(deflection_chart, folder / "deflection.png", points, cells, w,
              title=f"{case}: w at t = {r.frames_t[k]:.4g} s\n({about})")

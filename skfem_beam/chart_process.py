@@ -201,19 +201,7 @@ def serve(parent: int, preload=()) -> None:
     import matplotlib.pyplot  # noqa: F401  (what every chart needs, loaded while waiting)
     for module in preload:              # the chart functions the command will send
         importlib.import_module(module)
-    from .aside import cores            # the standard library only, as here
-    # workers where forking is safe: Linux, and this process has one thread
-    forks = sys.platform.startswith("linux") and len(os.listdir("/proc/self/task")) == 1
-    workers = []
-    for _ in range(cores() if forks else 0):
-        if worker := _Worker.fork(workers):
-            workers.append(worker)
-
-    def end(*_):                        # SIGTERM (stop()) or the command's end: the workers
-        for worker in workers:          # go too, waited for (their CPU time is counted)
-            worker.end()
-        os._exit(0)
-    signal.signal(signal.SIGTERM, end)
+    workers = _start_workers()
     idle = collections.deque(workers)
     charts = collections.deque()        # [job, report, done] per chart, in the order sent
     waiting = collections.deque()       # the charts no worker has taken yet
@@ -236,7 +224,7 @@ def serve(parent: int, preload=()) -> None:
             if fd == 0:
                 header = _read(0, struct.calcsize(JOB_LENGTH))
                 if header is None:
-                    end()               # nothing to tear down: the command has ended
+                    _end(workers)       # nothing to tear down: the command has ended
                 job = _read(0, struct.unpack(JOB_LENGTH, header)[0])
                 charts.append([job, None, False])
                 waiting.append(charts[-1])
@@ -249,6 +237,27 @@ def serve(parent: int, preload=()) -> None:
             else:
                 idle.append(worker)
             chart[1:] = result, True
+
+
+def _start_workers() -> list:
+    """One :class:`_Worker` per core where forking is safe (Linux, and this process has one
+    thread); a SIGTERM (:func:`stop`) then ends them and this process (:func:`_end`)."""
+    from .aside import cores            # the standard library only, as here
+    forks = sys.platform.startswith("linux") and len(os.listdir("/proc/self/task")) == 1
+    workers = []
+    for _ in range(cores() if forks else 0):
+        if worker := _Worker.fork(workers):
+            workers.append(worker)
+    signal.signal(signal.SIGTERM, lambda *_: _end(workers))
+    return workers
+
+
+def _end(workers) -> None:
+    """The workers killed and waited for (so that the command's CPU time counts theirs),
+    then this process, without its interpreter's teardown."""
+    for worker in workers:
+        worker.end()
+    os._exit(0)
 
 
 _DIED = object()

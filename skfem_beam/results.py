@@ -98,13 +98,16 @@ def _unplain(value):
 
 def read_csv(path: Path) -> dict[str, np.ndarray]:
     """A CSV with a header row as columns: floats where every value parses as one (parsed
-    exactly: the digits written come back bit for bit), strings otherwise."""
+    exactly: the digits written come back bit for bit), strings otherwise.  A last line
+    without its newline is a part of a row (a run killed within a write: output.series)
+    and is left out."""
     path = Path(path)
     with open(path, newline="") as fh:
         header = next(csv.reader([fh.readline()]), [])
         if not header:
             raise InputError(f"{path} has no header row")
         body = fh.read()
+    body = body[:body.rfind("\n") + 1]
     if not body.strip():          # a header alone: e.g. impacts.csv of a run without impact
         return {name: np.zeros(0) for name in header}
     try:    # the fast path: every value a number (numpy's parser rounds correctly)
@@ -118,8 +121,7 @@ def read_csv(path: Path) -> dict[str, np.ndarray]:
             raise InputError(f"{path}: {values.shape[1]} values per row under "
                              f"{len(header)} column names")
         return {name: values[:, i].copy() for i, name in enumerate(header)}
-    with open(path, newline="") as fh:      # mixed columns (e.g. a label per impact)
-        rows = list(csv.reader(fh))[1:]
+    rows = list(csv.reader(io.StringIO(body)))   # mixed columns (e.g. a label per impact)
     out = {}
     for i, name in enumerate(header):
         col = [r[i] if i < len(r) else "" for r in rows]

@@ -15,7 +15,7 @@ from skfem_beam import InputError, read_run
 from skfem_beam.__main__ import COMMANDS, listing, main as skfem_main
 from skfem_beam.cases import _beam, convex_obstacles, flat_obstacles, impacting_bar, point_stops
 from skfem_beam.output.fields import sample_line
-from skfem_beam.results import export, export_main, matlab_name, variables
+from skfem_beam.results import export, export_main, matlab_name, read_csv, variables
 
 MATLAB = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,62}$")
 
@@ -244,3 +244,18 @@ def test_python_m_skfem_beam(tmp_path):
     assert p.returncode == 2 and p.stderr.count("\n") == 1 and "not a run folder" in p.stderr
     assert not list(tmp_path.iterdir())
     assert skfem_main(["nope"]) == 2
+
+
+@pytest.mark.parametrize("tail", ["", "0.3,2.5", "0.3,", "0.3,2.5e-1", "0.3,x"])
+def test_a_part_of_a_row_without_its_newline_is_left_out(tmp_path, tail):
+    """A run killed within a write() of timeseries.csv can end in a part of a row without
+    its newline (output.series): read_csv reads the whole rows and leaves that part out,
+    numbers and mixed columns alike."""
+    whole = "t,u\n0.1,0.5\n0.2,-1.25e-7\n"
+    for text, kind in ((whole, float), (whole.replace("0.5", "a"), str)):
+        path = tmp_path / "timeseries.csv"
+        path.write_text(text + tail)
+        cols = read_csv(path)
+        assert list(cols) == ["t", "u"] and cols["t"].tolist() == [0.1, 0.2]
+        assert cols["u"].tolist()[1] == ("-1.25e-7" if kind is str else -1.25e-7)
+

@@ -1,7 +1,8 @@
 """``timeseries.csv`` as a run writes it, and the same rows kept in memory for the charts.
 
 The file grows by whole rows after every chunk (flushed and fsynced: a run killed at any
-moment leaves a readable file up to its last flush); the rows in memory are whole up to
+moment leaves its rows up to its last flush, and at most a part of one more row without its
+newline, which results.read_csv leaves out: :meth:`SeriesFile._write`); the rows in memory are whole up to
 KEEP_ROWS, then each column's extremes per time bin (what a chart shows), so that memory
 stays flat however long the run.  A resume reads the rows back block by block
 (:func:`read_rows`, :func:`file_crc`; :mod:`.checkpoint`).
@@ -116,9 +117,13 @@ class SeriesFile:
         self.sync()
 
     def _write(self, data: bytes) -> None:
-        """Whole rows in writes of at most a page: a process killed (SIGKILL) in the middle
-        of a large write() leaves a part of it, but not of a one-page write, so the file
-        ends on a whole row whenever the process dies."""
+        """Whole rows in writes of at most a page.  A SIGKILL in the middle of a write()
+        leaves a part of it: the kernel copies the data page by page of the file and stops
+        between two (Linux: generic_perform_write), so a write that crosses a page boundary
+        of the file (rows are not page-aligned) can end at it, in a row; the file then
+        ends in a part of a row without its newline (seen once in a CI run of
+        tests/test_resume.py), which readers leave out and a resume cuts off (the
+        checkpoint's byte count).  At most a page: one such part, not a large write's."""
         try:
             start = 0
             while start < len(data):

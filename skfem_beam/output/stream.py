@@ -2,8 +2,8 @@
 
 One pipeline for the beam scenes and the bar.  After every input has been checked the
 output :class:`~.folder.Folder` is made (summary "running"); ``timeseries.csv`` grows by
-whole rows after every chunk (:mod:`.series`: a run killed at any moment leaves a
-readable file up to its last flush) and the rows are also kept in memory for the charts
+whole rows after every chunk (:mod:`.series`: a run killed at any moment leaves its rows
+up to its last flush, and at most a part of one more row without its newline) and the rows are also kept in memory for the charts
 and the summary; the field frames are written as they come.  With ``--checkpoint-every
 S`` the run's full state is written to ``checkpoint.npz`` (:mod:`.checkpoint`).
 ``--resume DIR`` rebuilds the same run from ``summary.json``, restores the checkpoint,

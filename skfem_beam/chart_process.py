@@ -214,7 +214,9 @@ def serve(parent: int, preload=()) -> None:
             worker, chart = idle.popleft(), waiting.popleft()
             if worker.send(chart[0]):
                 busy[worker.reports] = worker, chart
-            else:                       # it died: drawn here
+            else:                       # it died: drawn here, and it is no worker any more
+                workers.remove(worker)  # (else charts would wait for it when none is left)
+                worker.end()
                 chart[1:] = _draw(pickle.loads(chart[0])), True
         if waiting and not workers:     # none left (or none could be forked): drawn here
             chart = waiting.popleft()

@@ -92,6 +92,26 @@ def test_a_chart_whose_child_died_is_drawn_again_by_the_chart_process(tmp_path, 
     assert (tmp_path / "drawn").read_text() == str(server)
 
 
+def test_charts_are_drawn_when_every_worker_died_while_idle(tmp_path, process):
+    """Workers killed between charts: each chart sent to a dead one is drawn by the chart
+    process and that worker is dropped, so that no chart waits for a worker that is gone."""
+    server = process._process.pid
+    time.sleep(2)                       # its workers forked (matplotlib loaded)
+    children = Path(f"/proc/{server}/task/{server}/children").read_text().split()
+    assert len(children) == cores()
+    for pid in children:
+        os.kill(int(pid), signal.SIGKILL)
+    time.sleep(0.2)
+    t = np.linspace(0, 1, 11)
+    for k in range(len(children) + 2):
+        process.draw(trajectory_chart, tmp_path / f"{k}.png", t, {"y": t})
+    waiter = threading.Thread(target=process.wait, daemon=True)
+    waiter.start()
+    waiter.join(timeout=60)
+    assert not waiter.is_alive(), "a chart waits for a dead worker"
+    assert all((tmp_path / f"{k}.png").stat().st_size > 0 for k in range(len(children) + 2))
+
+
 def test_a_chart_error_is_raised_in_the_command_with_its_errno(tmp_path, process):
     t = np.linspace(0, 1, 11)
     process.draw(trajectory_chart, tmp_path / "no such folder" / "x.png", t, {"y": t})

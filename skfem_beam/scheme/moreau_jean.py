@@ -46,7 +46,7 @@ from ..contact.active_set import box_qp
 from ..contact.base import ContactLaw
 from ..contact.restitution import Restitution
 from ..errors import InputError
-from ..linalg import Banded, add_columns, band_solve, row_layout_of, rows_dot, rows_matvec
+from ..linalg import add_columns, band_solve, row_layout, row_layout_of, rows_dot, rows_matvec
 from .beta import (disk_rows, friction_of, hole_arrays, observers, penetration_samples,
                    refuse_lands, start_positions, tangent_rows, two_plane_state)
 from ..contact.friction import MAX_SWEEPS, nsgs
@@ -301,8 +301,8 @@ class MoreauJeanScheme:
         samples, _, _ = penetration_samples(system)
         B = system.B
         return MJOps(s.dt, self.theta, self.e, s.save_every, s.frame_every,
-                     *row_layout_of(op.Kb), *row_layout_of(Banded(system.M)),
-                     *row_layout_of(Banded(B) if B is not None else None), op.Ab.chol,
+                     *row_layout_of(op.Kb), *row_layout(system.M),
+                     *(row_layout(B) if B is not None else row_layout_of(None)), op.Ab.chol,
                      self.loads, *csr_arrays(op.C),
                      op.W, op.D, *csr_arrays(self.Orows), *samples, *hole_arrays(system),
                      friction_of(system), NSGS_TOL)

@@ -24,6 +24,10 @@ The process hands the charts to its workers, one per core, forked once matplotli
 other, while the command writes its fields at a higher priority (docs/design.md).  Its
 reports still reach the command in the order the charts were sent.
 
+With ``SKFEM_BEAM_CHARTS=0`` in the environment nothing is drawn and no chart process
+starts (:func:`wanted`): for runs whose pictures nobody looks at (the test suite, scripted
+sweeps of commands), the charts are about half of a short command's CPU time.
+
 Only the standard library is imported here: the command imports this module first.
 """
 from __future__ import annotations
@@ -68,6 +72,7 @@ JOB_LENGTH = "<Q"          # each job on the pipe: its length in bytes, then the
 # BLAS without its worker threads in the chart process: it forks (serve), and a fork
 # copies only the thread that calls it
 ONE_THREAD = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+CHARTS = "SKFEM_BEAM_CHARTS"     # "0": no charts (module docstring)
 
 
 def _packages(modules) -> list[str]:
@@ -84,7 +89,7 @@ def start(preload=()) -> None:
     the modules of this package it imports while it waits for its first chart (the chart
     functions its caller will send, ``_startup.CHART_MODULES``)."""
     global _process, _outbox
-    if _process is not None:
+    if _process is not None or not wanted():
         return
     try:
         _process = subprocess.Popen(
@@ -124,8 +129,22 @@ def running() -> bool:
     return _process is not None and _process.poll() is None
 
 
-def draw(chart, *args, **kwargs) -> None:
-    """``chart(*args, **kwargs)`` in the chart process when one runs, else here."""
+def wanted() -> bool:
+    """False when the environment says ``SKFEM_BEAM_CHARTS=0``."""
+    return os.environ.get(CHARTS, "1") != "0"
+
+
+def draw(chart, path, *args, **kwargs) -> None:
+    """``chart(path, *args, **kwargs)`` in the chart process when one runs, else here;
+    with charts not :func:`wanted`, nothing but the removal of an earlier picture at
+    ``path`` (a resumed or overwritten folder's: it would not show this run)."""
+    if not wanted():
+        try:
+            os.remove(path)
+        except FileNotFoundError:
+            pass
+        return
+    args = (path, *args)
     if running():
         job = (chart, args, kwargs)
         try:

@@ -1,3 +1,4 @@
+import os
 import sys
 from functools import cache
 from pathlib import Path
@@ -5,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from skfem_beam import scenes
+from skfem_beam import chart_process, scenes
 from skfem_beam.cli import main_guard
 
 sys.path.insert(0, str(Path(__file__).parent / "reference"))
@@ -16,6 +17,18 @@ def _machine_pins():
     """(this machine's pins or None, the line that says which check the pins' tests run)."""
     from pins import machine_pins
     return machine_pins()
+
+
+def pytest_configure(config):
+    # commands draw no charts in the suite (half of a short command's CPU), but in the
+    # tests that ask for them (the `charts` fixture); SKFEM_BEAM_CHARTS=1 draws them all
+    os.environ.setdefault(chart_process.CHARTS, "0")
+
+
+@pytest.fixture
+def charts(monkeypatch):
+    """Commands and in-process runs draw their charts (the suite's default is none)."""
+    monkeypatch.setenv(chart_process.CHARTS, "1")
 
 
 def pytest_sessionstart(session):

@@ -301,6 +301,7 @@ def test_run_refuses_bad_steps():
 CASE = [sys.executable, "-m", "skfem_beam.cases.impacting_bar"]
 
 
+@pytest.mark.usefixtures("charts")
 def test_case_end_to_end(tmp_path):
     out = tmp_path / "run"
     p = subprocess.run(CASE + ["--T", "2.5", "--out", str(out)], capture_output=True,

@@ -137,6 +137,7 @@ def test_no_node_leaves_k_in_the_shipped_scenes(name, lands):
     assert result.max_nodal_violation <= 1e-12 * R
 
 
+@pytest.mark.usefixtures("charts")
 def test_the_trefoil_scene_draws_its_outline(tmp_path):
     out = tmp_path / "run"
     assert exit_code(run_main, [str(example("tube_trefoil_holes")), "--set", "time.T=0.05",

@@ -19,6 +19,7 @@ from skfem_beam.aside import cores
 from skfem_beam.cases import flat_obstacles
 from skfem_beam.output.charts import trajectory_chart
 
+pytestmark = pytest.mark.usefixtures("charts")
 ARGS = ["--T", "0.2", "--J", "8", "--format", "none"]
 CHARTS = ("tip_displacement.png", "energy.png", "contact_force.png", "beam_shapes.png")
 
@@ -38,6 +39,23 @@ def servers(parent: int) -> list[int]:
         if b"skfem_beam.chart_process" in b" ".join(argv) and str(parent).encode() in argv:
             found.append(int(proc.name))
     return found
+
+
+def test_with_charts_off_a_command_draws_none_starts_no_process_and_keeps_no_old_one(
+        tmp_path, monkeypatch):
+    """SKFEM_BEAM_CHARTS=0: no picture and no chart process; a folder run again loses the
+    pictures of its earlier run (they would not show this one)."""
+    out = tmp_path / "run"
+    cmd = [sys.executable, "-m", "skfem_beam.cases.flat_obstacles", *ARGS, "--out", str(out)]
+    assert subprocess.run(cmd, capture_output=True).returncode == 0
+    assert all((out / name).exists() for name in CHARTS)
+    monkeypatch.setenv(chart_process.CHARTS, "0")
+    p = subprocess.Popen([*cmd, "--overwrite"], stderr=subprocess.PIPE)
+    time.sleep(1.0)
+    started = servers(p.pid)
+    assert p.wait() == 0, p.stderr.read()
+    assert started == [] and not any((out / name).exists() for name in CHARTS)
+    assert (out / "timeseries.csv").exists()
 
 
 @pytest.fixture

@@ -128,6 +128,7 @@ def test_flat_obstacles_are_lines(monkeypatch, tmp_path):
     plt.close(store["fig"])
 
 
+@pytest.mark.usefixtures("charts")
 def test_case_charts_force_in_newtons(monkeypatch, tmp_path):
     """The pipe's ρS is known: its contact force chart is in N (the contact_force_N column)."""
     figures = {}

@@ -481,6 +481,7 @@ def test_output_flags_are_checked(tmp_path, capsys, main, flag, value):
     assert not list(tmp_path.iterdir())
 
 
+@pytest.mark.usefixtures("charts")
 def test_resume_of_a_long_run_reads_no_row(tmp_path, monkeypatch):
     """A run longer than the rows kept whole (KEEP_ROWS, made 1,000 here) checkpoints its
     chart envelope: --resume checks the rows on disk (CRC, block by block) and parses

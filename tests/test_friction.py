@@ -201,6 +201,7 @@ def is_png(path) -> bool:
     return path.stat().st_size > 0 and path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
+@pytest.mark.usefixtures("charts")
 def test_a_tube_run_prints_its_supports_and_draws_their_wear(tmp_path, capsys, monkeypatch):
     """The friction scene prints one row per support whose numbers are summary.json's (to
     the 4 digits printed), and draws wear_<x>.png per support from the same wear entry."""
@@ -230,6 +231,7 @@ def test_a_tube_run_prints_its_supports_and_draws_their_wear(tmp_path, capsys, m
         assert drawn[f"wear_{s['x']:g}.png"] == s["wear"]
 
 
+@pytest.mark.usefixtures("charts")
 def test_without_land_or_wear_the_table_says_so_and_without_wear_no_wear_chart(
         tmp_path, capsys):
     """No land: the depth column is "—", the chart draws volumes; no [wear]: "—" for the

@@ -14,6 +14,7 @@ def run_case(module, tmp_path, *args):
     return exit_code(module.main, ["--out", str(out), *args]), out
 
 
+@pytest.mark.usefixtures("charts")
 @pytest.mark.parametrize("element", ["hermite", "bspline"])
 def test_flat_obstacles_defaults(tmp_path, element):
     code, out = run_case(flat_obstacles, tmp_path, "--element", element)

@@ -4,6 +4,7 @@ energy identity, read from the files; the fields read back with meshio; the bad 
 refused in one line with nothing written; modes; --resume."""
 import csv
 import json
+import os
 import subprocess
 import sys
 
@@ -12,6 +13,7 @@ import numpy as np
 import pytest
 
 from conftest import assert_scene_refused, exit_code
+from skfem_beam import chart_process
 from skfem_beam.output.plate import MOMENTS, vertex_fields
 from skfem_beam.scenefile import example, load, modes_main, run_main
 from skfem_beam.scheme import drive
@@ -29,11 +31,13 @@ def columns(folder) -> dict:
 
 @pytest.fixture(scope="module", params=SHIPPED)
 def shipped(request, tmp_path_factory):
-    """(name, output folder) of a shipped scene run by ``python -m skfem_beam run``."""
+    """(name, output folder) of a shipped scene run by ``python -m skfem_beam run``, its
+    charts drawn."""
     out = tmp_path_factory.mktemp(request.param) / "run"
     done = subprocess.run([sys.executable, "-m", "skfem_beam", "run",
                            str(example(request.param)), "--out", str(out)],
-                          capture_output=True, text=True, timeout=300)
+                          capture_output=True, text=True, timeout=300,
+                          env={**os.environ, chart_process.CHARTS: "1"})
     assert done.returncode == 0, done.stderr
     return request.param, out
 

@@ -18,6 +18,7 @@ def run(args, **kw):
     return subprocess.run(CASE + args, capture_output=True, text=True, timeout=300, **kw)
 
 
+@pytest.mark.usefixtures("charts")
 def test_case_runs_end_to_end(tmp_path):
     out = tmp_path / "run"
     p = run(["--T", "0.3", "--out", str(out)])

@@ -166,6 +166,7 @@ def test_a_failed_resume_of_a_moved_folder_leaves_it_resumable(tmp_path, monkeyp
         assert (b / name).read_bytes() == (ref / name).read_bytes(), name
 
 
+@pytest.mark.usefixtures("charts")
 @pytest.mark.parametrize("sig, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
 def test_a_signal_during_the_charts_gives_its_exit_code(tmp_path, monkeypatch, capsys, sig,
                                                         code):

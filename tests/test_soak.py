@@ -8,6 +8,9 @@ import pytest
 
 from skfem_beam.bench import soak
 
+# the commands draw their charts: a kill may land while they are drawn
+pytestmark = pytest.mark.usefixtures("charts")
+
 
 def test_a_small_soak_has_no_hang_no_stuck_folder_no_difference(capsys):
     assert soak.main(["--cycles", "4", "--seed", "7"]) == 0

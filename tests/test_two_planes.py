@@ -267,6 +267,7 @@ def test_a_push_lands_where_it_points_and_says_so():
 
 
 # ---------------------------------------------------------------- the command
+@pytest.mark.usefixtures("charts")
 def test_the_round_hole_scene_writes_orbits_angles_and_work_rates(tmp_path):
     out = tmp_path / "run"
     assert exit_code(run_main, [str(example("tube_round_holes")), "--set", "time.T=0.3",

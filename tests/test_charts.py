@@ -2,10 +2,12 @@
 drawn as ParaView shows it (ũ, with the obstacles), forces in newtons, legends."""
 import tracemalloc
 from contextlib import contextmanager
+from pathlib import Path
 
 import matplotlib.pyplot as plt
 import numpy as np
 import pytest
+from PIL import Image
 
 from conftest import exit_code
 from skfem_beam import beam_system, scenes, solve
@@ -13,6 +15,7 @@ from skfem_beam.cases import point_stops
 from skfem_beam.output import charts
 from skfem_beam.output.charts import (envelope, plot_reduced, shape_chart, shapes,
                                       trajectory_chart)
+from skfem_beam.scenefile import run_main
 
 N = 2_000_000
 
@@ -218,3 +221,22 @@ def test_long_series_kept_for_the_charts_keep_every_extreme_in_bounded_memory(tm
     for a, b, lo, hi in windows:
         held = data["y"][(data["t"] >= a) & (data["t"] <= b)]
         assert held.min() <= lo + slope * width and held.max() >= hi - slope * width
+
+
+# the plates' shipped scenes draw theirs in tests/test_plate_scenes.py
+SHIPPED = sorted((Path(charts.__file__).parents[1] / "scene_files").glob("*.toml"))
+
+
+@pytest.mark.usefixtures("charts")
+@pytest.mark.parametrize("scene", SHIPPED, ids=lambda p: p.stem)
+def test_every_shipped_scene_draws_its_charts(scene, tmp_path):
+    """The suite's commands draw no chart (tests/conftest.py): every shipped scene, run
+    briefly, draws its own, each a picture of the chart's size."""
+    out = tmp_path / "run"
+    assert exit_code(run_main, [str(scene), "--set", "time.T=0.02", "--format", "none",
+                                "--out", str(out)]) == 0
+    pictures = sorted(out.glob("*.png"))
+    assert pictures, sorted(p.name for p in out.iterdir())
+    for path in pictures:
+        with Image.open(path) as image:
+            assert min(image.size) >= 300, (path.name, image.size)

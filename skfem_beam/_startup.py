@@ -61,7 +61,11 @@ def command_starting() -> None:
     command = " ".join(argv[i + 1:i + 3]) if i >= 0 else ""
     if command.startswith(CHARTING):
         from . import chart_process
-        chart_process.start(CHART_MODULES)
+        try:
+            chart_process.start(CHART_MODULES)
+        except ValueError as e:     # a bad SKFEM_BEAM_CHARTS: one line, nothing written
+            os.write(2, f"error: {e}\n".encode())
+            os._exit(2)
 
 
 def _ending(signum, frame):

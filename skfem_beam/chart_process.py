@@ -130,8 +130,14 @@ def running() -> bool:
 
 
 def wanted() -> bool:
-    """False when the environment says ``SKFEM_BEAM_CHARTS=0``."""
-    return os.environ.get(CHARTS, "1") != "0"
+    """True with SKFEM_BEAM_CHARTS unset or 1, False with 0; another value is refused
+    (InputError naming it: a command says so in one line as it starts, _startup)."""
+    value = os.environ.get(CHARTS, "1")
+    if value not in ("0", "1"):
+        from .errors import InputError     # standard library only, as this module
+        raise InputError(f"{CHARTS}={value!r} in the environment: allowed 0 (no charts) "
+                         f"or 1 (charts, the default)")
+    return value == "1"
 
 
 def draw(chart, path, *args, **kwargs) -> None:

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
+from conftest import exit_code
 from skfem_beam import chart_process
 from skfem_beam._startup import CHART_MODULES
 from skfem_beam.aside import cores
@@ -216,3 +217,20 @@ def test_every_chart_a_command_sends_is_a_function_of_the_modules_the_process_lo
     assert len(sent) >= 8, sent
     for where, name in sent:
         assert any(hasattr(m, name) for m in loaded), (where, name)
+
+
+@pytest.mark.parametrize("value", ["no", "false", "2", ""])
+def test_a_bad_charts_value_is_one_line_and_nothing_written(tmp_path, monkeypatch, capsys,
+                                                             value):
+    """SKFEM_BEAM_CHARTS takes 0 or 1: another value is one line naming it, exit 2 and no
+    folder, from the command line (as it starts) and from a command's main()."""
+    monkeypatch.setenv(chart_process.CHARTS, value)
+    out = tmp_path / "run"
+    p = subprocess.run([sys.executable, "-m", "skfem_beam.cases.flat_obstacles", *ARGS,
+                        "--out", str(out)], capture_output=True, text=True)
+    assert p.returncode == 2 and not out.exists(), p.stderr
+    err = p.stderr.strip().splitlines()
+    assert len(err) == 1 and f"SKFEM_BEAM_CHARTS={value!r}" in err[0] and "0" in err[0], err
+    assert exit_code(flat_obstacles.main, [*ARGS, "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"SKFEM_BEAM_CHARTS={value!r}" in err[0] and not out.exists()

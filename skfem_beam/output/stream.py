@@ -186,6 +186,7 @@ def execute(run: Run, options: OutputOptions, summary: dict, series, finish) -> 
     """
     if not isinstance(series, Series):
         series = Series(series)
+    chart_process.wanted()          # a bad SKFEM_BEAM_CHARTS is refused before any file
     out = Path(options.out)
     resume = bool(options.resume)
     every = options.checkpoint_every

@@ -166,32 +166,14 @@ def rows_dot(P, J, x, z):
     return s
 
 
-# W c by columns while W fits in cache (a beam's: 0.1–0.5 µs a step faster), by W's rows
-# above (a plate's at 40 × 40, 6,400 × 1,521 with 150 contacts: 4.2 → 1.3 ms; its columns
-# are strided); the same sums in the same order either way
-BY_ROWS = 1 << 19       # entries of W
-
-
 @njit(cache=True)
-def add_columns(W, c, x, nz):
-    """x += W c over the columns j where c[j] ≠ 0, each x[i]'s sum in the order of j;
-    ``nz``: scratch of c's size."""
-    if W.size < BY_ROWS:
-        for j in range(c.size):
-            if c[j] != 0.0:
-                for i in range(x.size):
-                    x[i] += W[i, j] * c[j]
-        return
-    k = 0
+def add_columns(Wt, c, x):
+    """x += W c with Wt = Wᵀ (m × n, W's columns as its rows: contiguous), over the
+    columns j where c[j] ≠ 0, each x[i]'s sum in the order of j."""
     for j in range(c.size):
         if c[j] != 0.0:
-            nz[k] = j
-            k += 1
-    for i in range(x.size):
-        s = x[i]
-        for q in range(k):
-            s += W[i, nz[q]] * c[nz[q]]
-        x[i] = s
+            for i in range(x.size):
+                x[i] += Wt[j, i] * c[j]
 
 
 @njit(cache=True)

@@ -309,7 +309,7 @@ class BetaScheme:
         return Ops(s.dt, self.beta, s.save_every, s.frame_every, *row_layout_of(op.Kb),
                    *row_layout_of(op.Bb), op.Ab.chol, *row_layout_of(op.Eb), self.loads,
                    *csr_arrays(op.C), step.lo, step.hi, shift, sshift,
-                   op.W, op.D, *csr_arrays(self.Orows), *samples, slo, shi, params, op.Z,
+                   op.W.T, op.D, *csr_arrays(self.Orows), *samples, slo, shi, params, op.Z,
                    *csr_arrays(system.K.tocsr()[op.Z]), *self._holes())
 
     def _holes(self):
@@ -333,7 +333,7 @@ class BetaScheme:
                      counters=z(6, np.int64), work=z(4),
                      impact=np.full((m, IMPACT_FIELDS), -1.0), **two_plane_state(ops),
                      r_e=z(m), x=np.empty(n), yf=np.empty(m), mu=z(m), Ku=np.empty(n),
-                     d=np.empty(n), dy=z(m), ez=z(self.op.Z.size), nz=z(m, np.int64))
+                     d=np.empty(n), dy=z(m), ez=z(self.op.Z.size))
 
     def series(self, rows: int, nframes: int) -> Series:
         """Saved-series buffers of ``rows`` rows and ``nframes`` field frames."""
@@ -437,7 +437,7 @@ class BetaScheme:
                 st.law_state[:] = 0
                 st.active[:] = False
             if op.W.shape[1] == st.mu.size:     # else an x-space law wrote u¹ into u1
-                u1 = u1 + op.W @ st.mu
+                u1 = u1 + np.ascontiguousarray(op.W) @ st.mu   # (BLAS on W's rows, as ever)
         st.u_cur[:] = u1
         csr_product(self.ops.Cp, self.ops.Ci, self.ops.Cx, u1, st.y_cur)
         st.mu[:] = 0.0

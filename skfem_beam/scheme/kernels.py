@@ -34,7 +34,8 @@ Ops = namedtuple("Ops", [
     "loads",                          # (n, k) load vectors b_k
     "Cp", "Ci", "Cx", "lo", "hi",     # constrained values y = C u and their bounds at rest
     "shift", "sshift",                # bounds at t: lo + shift·φ(t) (and samples); () if fixed
-    "W", "D",                         # A⁻¹Cᵀ and the Delassus matrix C A⁻¹ Cᵀ
+    "Wt", "D",                        # Wᵀ = C A⁻¹ (m × n: W's columns contiguous, for
+    #                                   W μ) and the Delassus matrix C A⁻¹ Cᵀ
     "Op", "Oi", "Ox",                 # observed values (e.g. the tip)
     "Sp", "Si", "Sx", "slo", "shi",   # penetration samples between the nodes and their bounds
     "params",                         # the contact law's constants
@@ -77,7 +78,6 @@ State = namedtuple("State", [
     "x", "yf", "mu", "Ku", "d", "dy", # the step's free solution (then uⁿ⁺¹), C x, μ, K uⁿ,
                                       # scratch (n), C(uⁿ⁺¹ − uⁿ⁻¹)
     "ez",                             # the massless rows' explicit force of the step
-    "nz",                             # scratch (m) of add_columns
 ])
 Series = namedtuple("Series", ["obs", "obsv", "energy", "work", "lam", "frames_u", "frames_v",
                                "frames_f", "events", "resid"])   # resid: friction's residual
@@ -186,14 +186,13 @@ def finish_step(ops, st, Gn, massless):
         ½E_β^{n+1} − ½E_β^n + δᵀBδ/(4Δt) = ½ Gⁿ·Lᵀδ + ½ λᵀCδ,   δ = uⁿ⁺¹ − uⁿ⁻¹,
     (L the load vectors), so the saved energy, the damping work and the load and contact
     work add up to round-off at every step (``st.work``)."""
-    dt, W, Bb, Bj, loads, Cp, Ci, Cx = ops.dt, ops.W, ops.Bb, ops.Bj, ops.loads, ops.Cp, \
+    dt, Wt, Bb, Bj, loads, Cp, Ci, Cx = ops.dt, ops.Wt, ops.Bb, ops.Bj, ops.loads, ops.Cp, \
         ops.Ci, ops.Cx
     Zr, beta = ops.Zr, ops.beta
     x, mu, d, u_prev, u_cur, work = st.x, st.mu, st.d, st.u_prev, st.u_cur, st.work
-    dy, y_prev, y_cur, r_e, rowwork, nz = st.dy, st.y_prev, st.y_cur, st.r_e, st.rowwork, \
-        st.nz
-    if W.shape[1] == mu.size:   # else an x-space law wrote uⁿ⁺¹ into x (no W)
-        add_columns(W, mu, x, nz)
+    dy, y_prev, y_cur, r_e, rowwork = st.dy, st.y_prev, st.y_cur, st.r_e, st.rowwork
+    if Wt.shape[0] == mu.size:  # else an x-space law wrote uⁿ⁺¹ into x (no W)
+        add_columns(Wt, mu, x)
     for i in range(x.size):
         d[i] = x[i] - u_prev[i]
     if Bb.shape[0]:
@@ -655,7 +654,7 @@ _J = types.int64[:, ::1]
 CALLEES = ((rows_matvec, (_M, _J, _v, _v, types.float64, types.boolean)),
            (csr_product, (_i, _i, _v, _v, _v)), (rows_dot, (_M, _J, _v, _v)),
            (write_event, (_M, _i, types.int64, _v)), (energy_beta, (_M, _J, _v, _v, _v, _v)),
-           (add_columns, (_M, _v, _v, _i)))
+           (add_columns, (_M, _v, _v)))
 
 
 def lands_of(ops):

@@ -60,7 +60,7 @@ MJOps = namedtuple("MJOps", [
     "dt", "theta", "e", "save_every", "frame_every",
     "Kb", "Kj", "Mb", "Mj", "Bb", "Bj",   # K, M, B in the row layout (linalg.Banded)
     "Achol", "loads",                      # Â's factor; load vectors
-    "Cp", "Ci", "Cx", "W", "D",            # constraint rows, Â⁻¹Cᵀ, C Â⁻¹ Cᵀ
+    "Cp", "Ci", "Cx", "Wt", "D",           # constraint rows, (Â⁻¹Cᵀ)ᵀ, C Â⁻¹ Cᵀ
     "Op", "Oi", "Ox", "Sp", "Si", "Sx",    # observers, penetration samples
     "pair", "disks", "Np", "Ni", "Nx", "Nc",   # two planes: rows, nodes, holes (kernels.Ops)
     "fric", "tol",                         # round holes: μ per first row; the NSGS tolerance
@@ -73,7 +73,7 @@ MJState = namedtuple("MJState", [
     "pos", "rowwork", "sectors", "hk", "fc",   # two planes (kernels.State)
     "fres",                                # round holes: [the step's NSGS residual, max]
     "mu",                                  # Δt·p (so that mu/Δt² is the force p/Δt)
-    "p", "wf", "x", "dv", "Ku", "Kv", "nz",   # scratch
+    "p", "wf", "x", "dv", "Ku", "Kv",   # scratch
 ])
 
 
@@ -185,7 +185,7 @@ def mj_steps(ops, st, out, n0, n1, inputs, Ebound):
             st.counters[STOPPED_AT] = step + 1
             return FAILED
         st.counters[ITERATIONS] += its
-        add_columns(ops.W, st.p, x, st.nz)
+        add_columns(ops.Wt, st.p, x)
         # x = v^{n+1}; dv = Δv; Kv ← v^θ
         for i in range(n):
             st.dv[i] = x[i] - st.v[i]
@@ -304,7 +304,7 @@ class MoreauJeanScheme:
                      *row_layout_of(op.Kb), *row_layout(system.M),
                      *(row_layout(B) if B is not None else row_layout_of(None)), op.Ab.chol,
                      self.loads, *csr_arrays(op.C),
-                     op.W, op.D, *csr_arrays(self.Orows), *samples, *hole_arrays(system),
+                     op.W.T, op.D, *csr_arrays(self.Orows), *samples, *hole_arrays(system),
                      friction_of(system), NSGS_TOL)
 
     def _state(self) -> MJState:
@@ -321,7 +321,7 @@ class MoreauJeanScheme:
                        work=z(4), impact=np.full((m, IMPACT_FIELDS), -1.0),
                        **two_plane_state(self.ops, bool(disk_rows(system).size)),
                        fres=z(2), mu=z(m), p=z(m), wf=z(m),
-                       x=z(n), dv=z(n), Ku=z(n), Kv=z(n), nz=z(m, np.int64))
+                       x=z(n), dv=z(n), Ku=z(n), Kv=z(n))
 
     def series(self, rows: int, nframes: int) -> Series:
         """Saved-series buffers (Moreau–Jean keeps its frames, whatever the run asked)."""

@@ -40,7 +40,7 @@ class StepOperators:
     Kb: Banded
     Bb: Banded | None   # damping, None when there is none
     C: sp.csr_matrix
-    W: np.ndarray       # A⁻¹Cᵀ (n × m)
+    W: np.ndarray       # A⁻¹Cᵀ (n × m, Fortran order: W.T is C-contiguous)
     D: np.ndarray       # C A⁻¹ Cᵀ (m × m), both times β with quasi-static massless rows
     Z: np.ndarray       # the quasi-static massless rows (empty with massless="beta")
 
@@ -94,16 +94,18 @@ def step_operators(system, dt: float, beta: float, massless: str = "beta",
                          f"floating-point range ({e}): check the scales of k2, L, dt") from None
     C = system.C.tocsr()
     m = C.shape[0]
+    # W is kept in Fortran order (W.T C-contiguous): the loop's W μ reads W's columns
     if not delassus:
-        W = np.zeros((system.n, 0))
+        W = np.zeros((0, system.n)).T
     elif getattr(system, "meta", {}).get("kind") == "plate":
         W = multi_rhs_W(Ab, C)
     else:
-        W = np.zeros((system.n, m))
+        Wt = np.zeros((m, system.n))
         for j in range(m):
             col = C[j].toarray().ravel()
             band_solve(Ab.chol, col)
-            W[:, j] = col
+            Wt[j] = col
+        W = Wt.T
     if quasi_static and Z.size:
         if B is not None:
             raise InputError("massless='quasi-static' with damping is not supported (the "
@@ -125,7 +127,7 @@ def multi_rhs_W(Ab: Banded, C) -> np.ndarray:
     """W = A⁻¹Cᵀ by LAPACK's banded solve of all m columns at once (one call, no CSR slice
     per column: 40 × 40 plate, 1,521 columns: 25 s column by column before)."""
     W = np.asfortranarray(C.T.toarray())
-    return np.ascontiguousarray(
+    return np.asfortranarray(
         scipy.linalg.cho_solve_banded((Ab.lapack_band("chol"), False), W, overwrite_b=True,
                                       check_finite=False))
 

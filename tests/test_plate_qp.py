@@ -7,7 +7,7 @@ import pytest
 import scipy.sparse as sp
 
 from skfem_beam import InputError
-from skfem_beam.contact import sparse_qp
+from skfem_beam.contact import registry, sparse_qp
 from skfem_beam.contact.sparse_qp import COUNTS, SelectorQP, selected_unknowns
 from skfem_beam.methods import PositionLevel
 from skfem_beam.plate import Plate, plate_space
@@ -57,6 +57,20 @@ def test_an_x_space_engine_runs_the_active_sets_plate(plate, law, chol, monkeypa
     assert (y - system.lo).min() >= -1e-12 * w_max
     assert r.max_nodal_violation <= 1e-12 * w_max
     assert np.abs(closure(r)).max() <= 1e-9 * np.abs(r.energy).max()
+
+
+def test_auto_takes_pdas_sparse_where_w_would_pass_its_budget(plate, monkeypatch):
+    """auto: the compiled active set while W = A⁻¹Cᵀ fits in registry.W_BUDGET bytes,
+    pdas-sparse past it (chosen before W is built), the same run to the bit as naming it."""
+    system, _, _ = plate
+    fits = 8.0 * system.n * system.C.shape[0]
+    monkeypatch.setattr(registry, "W_BUDGET", fits)
+    assert solve(system, DT, 10 * DT).solver == "active-set"
+    monkeypatch.setattr(registry, "W_BUDGET", fits - 1.0)
+    r = solve(system, DT, T)
+    named = solve(system, DT, T, method=PositionLevel("pdas-sparse"))
+    assert r.solver == "pdas-sparse" and r.impacts > 0
+    assert np.array_equal(r.frames_u, named.frames_u)
 
 
 @pytest.mark.parametrize("chol", ["band", "cholmod"])

@@ -20,7 +20,13 @@ from .projection import Projection
 from .restitution import Restitution
 from .round_hole import RoundHole
 from .round_hole_friction import RoundHoleFriction
-from .sparse_qp import ClarabelSparseLaw, OSQPSparseLaw, PDASSparse
+from .sparse_qp import ClarabelSparseLaw, OSQPSparseLaw, PDASSparse, selected_unknowns
+
+# bytes of W = A⁻¹Cᵀ (n × m) past which "auto" takes pdas-sparse where C selects unknowns
+# (a fine plate over an obstacle): at 80 × 80 (W 1.3 GB) building W took 75 s and the
+# active set's step 0.9 s against pdas-sparse's 0.6–0.8 s; at 60 × 60 (0.4 GB) 25 s and
+# 0.12 s against 0.29 s (docs/plate.md, "Which engine at which size")
+W_BUDGET = 1e9
 
 # The step solvers: how the step's QP of exact contact at position level is solved (each
 # gives the same step where it applies); a user's own joins them by register()
@@ -150,8 +156,21 @@ def resolve(law: str | ContactLaw = "auto", stiffness: float | None = None,
 class Auto(ContactLaw):
     """The exact law with Coulomb friction at position level when a round hole or a face
     has μ > 0; else the exact round-hole law where there are round holes, projection when
-    the constraints are decoupled, the exact active set when not."""
+    the constraints are decoupled, the exact active set when not; pdas-sparse, before W
+    and D are built, where W would pass W_BUDGET bytes (`before_operators`)."""
     name = "auto"
+
+    @staticmethod
+    def before_operators(n: int, C) -> ContactLaw | None:
+        """pdas-sparse where W = A⁻¹Cᵀ would pass W_BUDGET bytes and each row of C selects
+        one unknown; else None (`choose` decides, once W and D are built)."""
+        if 8.0 * n * C.shape[0] <= W_BUDGET:
+            return None
+        try:
+            selected_unknowns(C)
+        except InputError:
+            return None
+        return PDASSparse()
 
     @staticmethod
     def choose(step: StepData) -> ContactLaw:

@@ -251,6 +251,8 @@ class BetaScheme:
         self.save_every, self.frame_every = s.save_every, s.frame_every
         self.shift = 0.5 * s.dt if s.load_window == "centered" else 0.0
         law = resolve(law) if not isinstance(law, ContactLaw) else law
+        if isinstance(law, Auto) and m > 0:
+            law = law.before_operators(system.n, system.C) or law
         x_space = law.x_space and m > 0   # no W, no D
         with _callees_aside():
             self.op = op = step_operators(system, s.dt, beta, s.massless,

@@ -152,3 +152,20 @@ def test_the_kept_factor_solves_as_a_fresh_factorisation(chol):
     assert changes > 50 and fast["columns"] > 0 and fast["factors"] > 1
     assert (fast["guesses"] > 0) == (chol == "band")     # inexact sweeps: the band's only
     assert fast["factors"] < fresh["factors"]
+
+
+def test_a_large_w_is_announced_on_stderr(plate, monkeypatch, capsys):
+    """W = A⁻¹Cᵀ past operators.SAY_W_BYTES: one line saying its size before it is built
+    (and how to build none); below it, nothing."""
+    from skfem_beam.scheme import operators
+    system, _, _ = plate
+    size = 8.0 * system.n * system.C.shape[0]
+    monkeypatch.setattr(operators, "SAY_W_BYTES", size + 1.0)
+    solve(system, DT, 2 * DT)
+    assert "building W" not in capsys.readouterr().err
+    monkeypatch.setattr(operators, "SAY_W_BYTES", size)
+    solve(system, DT, 2 * DT)
+    err = capsys.readouterr().err.splitlines()
+    said = [line for line in err if line.startswith("building W")]
+    assert said == [f"building W = A⁻¹Cᵀ for the contact law: {system.C.shape[0]} columns, "
+                    f"{size * 1e-9:.2f} GB (solver pdas-sparse builds none) …"]

@@ -20,6 +20,7 @@ Massless rows (a redistributed mass) step in one of two ways (``massless``):
 """
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -123,9 +124,17 @@ def step_operators(system, dt: float, beta: float, massless: str = "beta",
                          C=C, W=W, D=D, Z=Z.astype(np.int64))
 
 
+SAY_W_BYTES = 100e6   # a W this large takes long enough to be announced (60 × 60: 25 s)
+
+
 def multi_rhs_W(Ab: Banded, C) -> np.ndarray:
     """W = A⁻¹Cᵀ by LAPACK's banded solve of all m columns at once (one call, no CSR slice
-    per column: 40 × 40 plate, 1,521 columns: 25 s column by column before)."""
+    per column: 40 × 40 plate, 1,521 columns: 25 s column by column before); one line on
+    stderr first when W passes SAY_W_BYTES."""
+    n, m = C.shape[1], C.shape[0]
+    if 8.0 * n * m >= SAY_W_BYTES:
+        print(f"building W = A⁻¹Cᵀ for the contact law: {m} columns, {8e-9 * n * m:.2f} GB "
+              f"(solver pdas-sparse builds none) …", file=sys.stderr, flush=True)
     W = np.asfortranarray(C.T.toarray())
     return np.asfortranarray(
         scipy.linalg.cho_solve_banded((Ab.lapack_band("chol"), False), W, overwrite_b=True,

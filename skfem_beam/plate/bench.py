@@ -6,15 +6,16 @@ the whole plate at w ≥ −0.2 w_s (w_s: the static centre deflection under the
 plate starting flat at rest under a uniform −10 kPa: it falls onto the obstacle within a
 quarter period and stays pressed on it.  Printed per mesh: the half bandwidth, the setup
 (the banded Cholesky of A = M + βΔt²K alone, and the whole of scheme.operators:
-step_operators, with W = A⁻¹Cᵀ and D = C W, when W fits in W_LIMIT bytes) and the bytes
-of W and D; per step, one banded solve with A's factor (the scheme's, linalg.band_solve,
-LAPACK's dpbtrf and dpbtrs on one thread, and CHOLMOD's numeric factorisation and solve:
-the x-space laws' two Cholesky factors, contact.sparse_qp), the scheme's step without
-obstacles, and the step pressed on the obstacle with each exact law (its mean over the
-run, with the fraction of steps in contact, and its ratio to the scheme's banded solve
-and to dpbtrs); the process's peak memory after each mesh.  The laws that need W and D
-(active-set, daqp, osqp) run only where W fits; the x-space laws (contact.sparse_qp) build neither.  Only
-measured, nothing tuned (docs/plate.md, "Which engine at which size").
+step_operators, with W = A⁻¹Cᵀ and D = C W where "auto" builds them, W within
+contact.registry.W_BUDGET bytes) and the bytes of W and D; per step, one banded solve
+with A's factor (the scheme's, linalg.band_solve, LAPACK's dpbtrf and dpbtrs on one
+thread, and CHOLMOD's numeric factorisation and solve: the x-space laws' two Cholesky
+factors, contact.sparse_qp), the scheme's step without obstacles, and the step pressed on
+the obstacle with each exact law (its mean over the run, with the fraction of steps in
+contact, and its ratio to the scheme's banded solve and to dpbtrs); the process's peak
+memory after each mesh.  The laws that need W and D (active-set, daqp, osqp) run only
+where W is built; the x-space laws (contact.sparse_qp) build neither.  Only measured,
+nothing tuned (docs/plate.md, "Which engine at which size").
 """
 from __future__ import annotations
 
@@ -25,11 +26,11 @@ import time
 import numpy as np
 import scipy.linalg
 
+from ..contact.registry import W_BUDGET
 from ..contact.sparse_qp import COUNTS, SparseCholesky, _one_thread, cholesky_kind
 from ..linalg import Banded, band_solve
 from ..methods import PositionLevel
 from ..scheme import solve
-from ..scheme.methods import PositionLevel
 from ..scheme.operators import step_operators
 from .model import Plate
 from .space import plate_space
@@ -40,7 +41,6 @@ DT = 2e-4                    # s (the first period is 20 ms)
 STEPS = 100                  # steps of each law's run (--steps: one number per mesh)
 DELASSUS_LAWS = ("active-set", "daqp", "osqp")               # need W and D
 X_SPACE_LAWS = ("pdas-sparse", "osqp-sparse", "clarabel-sparse")   # neither
-W_LIMIT = 200e6              # bytes: W = A⁻¹Cᵀ (dense n × m) is built below this only
 
 
 def timed(f, repeat: int = 1) -> float:
@@ -65,10 +65,10 @@ def systems(n: int):
 
 def setup_row(system) -> dict:
     """The band, the factor's and step_operators' times (with W and D if W fits in
-    W_LIMIT, else without), and W's and D's bytes."""
+    W_BUDGET, else without), and W's and D's bytes."""
     A = system.M + 0.5 * DT**2 * system.K
     factor = timed(lambda: Banded(A, factor=True), 3)
-    delassus = 8.0 * system.n * system.C.shape[0] <= W_LIMIT
+    delassus = 8.0 * system.n * system.C.shape[0] <= W_BUDGET
     t0 = time.perf_counter()
     ops = step_operators(system, DT, 0.5, delassus=delassus)
     total = time.perf_counter() - t0

@@ -53,8 +53,8 @@ and takes u^{n+1} from the engine, contact/registry.py):
 
 - ``pdas-sparse``: the primal-dual active set, warm-started from the last step's set;
 - ``osqp-sparse``: OSQP on the Jacobi-scaled problem finds the set (factorised once per
-  run, q and the bounds updated each step, warm-started), the active set method above
-  finishes it exactly (it also repairs a set OSQP misread at grazing contact);
+  run, q and the bounds updated each step, warm-started, to OSQP_EPS), the active set
+  method above finishes it exactly (it also repairs the rows a loose OSQP misreads);
 - ``clarabel-sparse``: Clarabel's interior point finds the set (a cold solve each step:
   Clarabel has no warm start), the same exact finish.
 

@@ -439,8 +439,9 @@ class BetaScheme:
                 st.law_state[:] = 0
                 st.active[:] = False
             if op.W.shape[1] == st.mu.size:     # else an x-space law wrote u¹ into u1
-                # (W in C order: the BLAS call, and so the bits, of the pinned runs)
-                u1 = u1 + np.ascontiguousarray(op.W) @ st.mu
+                # W in C order: the BLAS call, and so the bits, of the pinned runs; with
+                # no contact W·0 is +0.0 everywhere, added without a copy of W
+                u1 = u1 + (np.ascontiguousarray(op.W) @ st.mu if st.mu.any() else 0.0)
         st.u_cur[:] = u1
         csr_product(self.ops.Cp, self.ops.Ci, self.ops.Cx, u1, st.y_cur)
         st.mu[:] = 0.0

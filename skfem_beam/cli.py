@@ -95,7 +95,8 @@ def output_flags(p: Parser, prog: str) -> Parser:
     p.add_argument("--format", default="both",
                    help="field time series for ParaView: xdmf | vtu | both | none")
     p.add_argument("--out", default=f"out/{prog.rsplit('.', 1)[-1]}", help="output folder")
-    p.add_argument("--overwrite", action="store_true", help="replace an existing --out folder")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace the --out folder of an earlier run (never other files)")
     p.add_argument("--flush-every", type=int, default=20000,
                    help="steps between writes of the series to disk")
     p.add_argument("--checkpoint-every", type=float, default=None, metavar="SECONDS",

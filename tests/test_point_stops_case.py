@@ -77,6 +77,19 @@ def test_unwritable_out_and_existing_results(tmp_path):
     assert json.loads((out / "summary.json").read_text())["steps"] == 400
 
 
+def test_overwrite_refuses_a_folder_no_run_wrote(tmp_path):
+    """--overwrite empties a run's folder, never a folder of the user's own files."""
+    (tmp_path / "thesis.tex").write_text("mine")
+    (tmp_path / "data").mkdir()
+    (tmp_path / "data" / "x.csv").write_text("1,2")
+    p = run(["--T", "0.01", "--out", str(tmp_path), "--overwrite"])
+    assert p.returncode == 2 and p.stderr.strip() == (
+        f"error: --out {tmp_path} holds files no run wrote (data, thesis.tex); --overwrite "
+        "replaces only a run's folder (one with its summary.json): choose a new or empty "
+        "folder")
+    assert sorted(q.name for q in tmp_path.rglob("*")) == ["data", "thesis.tex", "x.csv"]
+
+
 def test_unstable_run_exit_code_and_valid_files(tmp_path):
     out = tmp_path / "run"
     p = run(["--beta", "0.1", "--dt", "1.92e-5", "--T", "0.1", "--out", str(out)])

@@ -101,8 +101,8 @@ def check_output_dir(out: str | os.PathLike, overwrite: bool = False) -> Path:
         raise InputError(f"--out {out} exists and is not a folder")
     if out.is_dir():
         check_not_busy(out)
-    if out.is_dir() and _holds_files(out) and not overwrite:
-        raise InputError(f"--out {out} already holds files; pass --overwrite to replace them")
+    if out.is_dir() and _holds_files(out):
+        _check_replaceable(out, overwrite)
     # missing parents are made when the run starts (after every check); probe the
     # nearest folder that exists: permission bits say little (root, read-only mounts, /proc)
     parent = out.resolve().parent
@@ -119,6 +119,24 @@ def check_output_dir(out: str | os.PathLike, overwrite: bool = False) -> Path:
 
 def _holds_files(out: Path) -> bool:
     return any(p.name not in OURS for p in out.iterdir())
+
+
+def _check_replaceable(out: Path, overwrite: bool) -> None:
+    """Refuse a folder holding files, unless ``overwrite`` and an earlier run wrote it
+    (its summary.json says so): --overwrite empties the folder, and must not take a
+    user's own files with it (``--out .`` in a folder of notes)."""
+    if not overwrite:
+        raise InputError(f"--out {out} already holds files; pass --overwrite to replace them")
+    try:
+        ours = "package_version" in json.loads((out / SUMMARY).read_text())
+    except (OSError, ValueError, TypeError):
+        ours = False
+    if not ours:
+        names = sorted(p.name for p in out.iterdir() if p.name not in OURS)
+        shown = ", ".join(names[:3]) + (", …" if len(names) > 3 else "")
+        raise InputError(f"--out {out} holds files no run wrote ({shown}); --overwrite "
+                         f"replaces only a run's folder (one with its {SUMMARY}): choose "
+                         f"a new or empty folder")
 
 
 def _empty(out: Path, keep: tuple[str, ...]) -> None:
@@ -220,9 +238,7 @@ class Folder:
         _make_locked(out)
         try:
             if not resume and _holds_files(out):   # filled since the checks: a race lost
-                if not overwrite:
-                    raise InputError(f"--out {out} already holds files; pass --overwrite "
-                                     "to replace them")
+                _check_replaceable(out, overwrite)
                 _empty(out, keep=(LOCK,))   # the lock file: it is what others lock
             folder = cls(out, summary)
             OPENED.append(out)

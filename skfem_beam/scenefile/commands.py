@@ -27,7 +27,8 @@ def _run_parser() -> argparse.ArgumentParser:
                    help="override a key of the file, e.g. time.dt=1e-5 (repeatable)")
     p.add_argument("--T", type=float, default=None, help="final time (s): [time] T")
     p.add_argument("--out", default=None, help="output folder (default out/<scene name>)")
-    p.add_argument("--overwrite", action="store_true", help="replace an existing --out folder")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace the --out folder of an earlier run (never other files)")
     for flag in ("format", "frames", "save-every", "flush-every", "checkpoint-every"):
         p.add_argument(f"--{flag}", default=None,
                        type=str if flag == "format" else float if flag == "checkpoint-every"
@@ -167,7 +168,8 @@ def _modes_parser() -> argparse.ArgumentParser:
     p.add_argument("--set", action="append", default=None, metavar="KEY=VALUE",
                    help="override a key of the file (repeatable)")
     p.add_argument("--out", default=None, help="write DIR/modes.csv")
-    p.add_argument("--overwrite", action="store_true", help="replace an existing --out folder")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace the --out folder of an earlier run (never other files)")
     return p
 
 

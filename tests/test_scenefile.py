@@ -241,6 +241,8 @@ BAD = {
     "second plane's start in one plane": (
         PIPE + "[initial]\nu0_w = { x = [0.0, 1.501], u = [0.0, 0.001] }\n",
         "[initial] u0_w start the second plane: they need planes = 2"),
+    "obstacle without bounds": (PIPE + "[[obstacles]]\nx = 0.79\n",
+                                "[obstacles.1] needs g1 and/or g2 (m), or a hole"),
     "table t not increasing": (PIPE + '[motion]\nend = "left"\ntable = "phi.csv"\n',
                                "t is not increasing at row 4"),
 }
@@ -261,6 +263,7 @@ def test_bad_scene_one_line_exit_2_nothing_written(tmp_path, capsys, what):
 @pytest.mark.parametrize("setting, word", [
     ("time.dtt=1e-5", "unknown key 'dtt'"), ("nosuch.x=1", "unknown key 'nosuch'"),
     ("obstacles.3.g1=0", "index '3'"), ("time", "KEY=VALUE"),
+    ("obstacles.1.x=0.79", "[obstacles.1] needs g1 and/or g2"),
 ])
 def test_bad_set_key_is_refused_by_name(tmp_path, capsys, setting, word):
     src = write(tmp_path, PIPE)

@@ -53,6 +53,9 @@ def _hole(o: dict, i: int, friction: float = 0.0):
 
 def _obstacle(o: dict, i: int) -> Obstacles:
     where = f"obstacles.{i}"
+    if "g1" not in o and "g2" not in o:     # else it would bound nothing, and run silently
+        raise InputError(f"[{where}] needs g1 and/or g2 (m), or a hole: without them it "
+                         "bounds nothing")
     g1, g2 = _g(o.get("g1", -np.inf), f"{where}.g1"), _g(o.get("g2", np.inf), f"{where}.g2")
     carried = o.get("carried", False)
     if "x" in o:

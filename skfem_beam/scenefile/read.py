@@ -96,8 +96,11 @@ def apply_set(data: dict, assignment: str) -> tuple[str, str]:
         if isinstance(sub, list):
             items = node
             if not part.isdigit() or int(part) > len(items):
-                raise InputError(f"--set {key}: {key_path(parts[:i])} has {len(items)} "
-                                 f"item(s); index {part!r} must be 0..{len(items)}")
+                n = len(items)
+                raise InputError(f"--set {key}: {key_path(parts[:i])} has {n} item(s); "
+                                 f"index {part!r} must be "
+                                 + (f"0..{n - 1} (an item) or " if n else "")
+                                 + f"{n} (a new one)")
             if int(part) == len(items):
                 items.append({})
             node, sub = items[int(part)], sub[0]

@@ -247,6 +247,17 @@ def _given(parser, argv) -> dict:
             a.default = d
 
 
+def _as_given(k: str, v) -> str:
+    """A flag's value as a user writes it: ``--set time.dt=5e-5 --set ...``, the scene file
+    (positional), ``--dt 1e-06``; "no --set" when not given."""
+    if v is None or v == []:
+        return "no scene file" if k == "scene" else f"no --{k.replace('_', '-')}"
+    if k == "scene":
+        return f"scene file {v}"
+    values = v if isinstance(v, list) else [v]
+    return " ".join(f"--{k.replace('_', '-')} {x}" for x in values)
+
+
 def stored_args(args, parser, argv=None):
     """For ``--resume DIR``: the flags of the run stored in DIR/summary.json, once DIR is
     locked and its summary, checkpoint and rows agree.  ``--T`` may grow (extending the
@@ -268,14 +279,13 @@ def stored_args(args, parser, argv=None):
         if k == "T" and T is not None and check_positive("T", v) >= T:
             T = v
             continue
-        flag = f"--{k.replace('_', '-')}"
         if k == "T":
-            raise InputError(f"--resume {out}: {flag} {v:g} is shorter than the run's T={T:g} "
+            raise InputError(f"--resume {out}: --T {v:g} is shorter than the run's T={T:g} "
                              "(a run can only be extended)")
         if k not in config or config[k] != v:
-            raise InputError(f"--resume {out}: {flag} {v} differs from the run's "
-                             f"{config.get(k)!r}; a resumed run keeps its flags (only --T "
-                             "may grow)")
+            raise InputError(f"--resume {out}: {_as_given(k, v)}, where the run had "
+                             f"{_as_given(k, config.get(k))}; a resumed run keeps its scene "
+                             "and flags (only --T may grow: extend it with --T)")
     check_resumable(out, summary, ck, extend=T is not None and T > config.get("T", T))
     stored = vars(parser.parse_args([]))
     for k in stored:

@@ -349,8 +349,8 @@ def test_resume_refuses_changed_flags_and_extends_T(finished, tmp_path, capsys):
     out = tmp_path / "run"
     shutil.copytree(finished, out)
     before = snapshot(out)
-    for argv, word in ((["--T", "0.2", "--dt", "1e-6"], "--dt 1e-06 differs from the run's"),
-                       (["--frames", "-1"], "--frames -1 differs from the run's"),
+    for argv, word in ((["--T", "0.2", "--dt", "1e-6"], "--dt 1e-06, where the run had --dt "),
+                       (["--frames", "-1"], "--frames -1, where the run had --frames "),
                        (["--T", "0.05"], "--T 0.05 is shorter than the run's T=0.1"),
                        ([], "holds a finished run (status success): nothing to resume")):
         assert exit_code(point_stops.main, ["--resume", str(out)] + argv) == 2

@@ -794,3 +794,20 @@ def test_a_shipped_scene_runs_by_its_name_from_any_folder(tmp_path, monkeypatch,
     capsys.readouterr()
     assert_refused(run_main, ["point_stops.toml", "--set", "kind=foo", "--out",
                               str(out / "x")], "a scene's kind is its file's", capsys, out)
+
+
+def test_resume_names_a_changed_set_or_scene_as_written(tmp_path, capsys):
+    """A resumed run keeps its scene and --set: the refusal shows both as a user writes
+    them (not Python lists or None)."""
+    src = write(tmp_path, PIPE + '[output]\nformat = "none"\n')
+    other = write(tmp_path, PIPE, name="other.toml")
+    out = tmp_path / "run"
+    assert exit_code(run_main, [str(src), "--out", str(out)]) == 0
+    capsys.readouterr()
+    for argv, line in (
+            (["--set", "time.dt=2e-5"], "--set time.dt=2e-5, where the run had no --set"),
+            ([str(other)], f"scene file {other}, where the run had scene file {src}")):
+        assert exit_code(run_main, ["--resume", str(out), *argv]) == 2
+        assert capsys.readouterr().err == (
+            f"error: --resume {out}: {line}; a resumed run keeps its scene and flags (only "
+            "--T may grow: extend it with --T)\n")

@@ -50,7 +50,7 @@ def run_main(argv) -> int:
     scene = _scene_of(args.scene, args.set, args.resume)
     name = f"scene {Path(args.scene).stem}" if args.scene else "scene"
     if scene.kind == "plate":
-        from ..cases.plate import run_plate_case
+        from ..cases._plate import run_plate_case
         flags = {k: v for k, v in vars(args).items() if k != "resume"}
         return run_plate_case(name, scene.problem, _plate_spec(scene, flags, args.resume))
     spec = _spec(scene, {k: v for k, v in vars(args).items() if k != "resume"}, args.resume)
@@ -90,7 +90,7 @@ def _same_mesh(scene, summary: dict, resume) -> None:
     """A resumed plate's mesh is the run's: its vertices, triangles and box as its
     summary.json records them (a folder written before the mesh file's bytes were stored
     has no sha256: this is what it can be checked against)."""
-    from ..cases.plate import geometry
+    from ..cases._plate import geometry
     built = geometry(scene.problem.space.plate)
     if "mesh" not in built or "vertices" not in summary:
         return

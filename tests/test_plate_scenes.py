@@ -142,6 +142,21 @@ def test_bad_value_line_names_the_file(tmp_path, capsys):
     assert not (tmp_path / "run").exists()
 
 
+@pytest.mark.parametrize("sets, warning", [
+    (["material.E=210"], "[material] E = 210 Pa is outside engineering materials"),
+    (["material.rho=7.77"], "[material] rho = 7.77 kg/m³ is outside engineering materials"),
+    (["obstacles.0.g1=-0.175"], "no contact in 500 steps: the largest displacement at the "
+                                "obstacles was"),
+])
+def test_implausible_values_warn_in_one_line_and_the_run_goes_on(tmp_path, capsys, sets,
+                                                                 warning):
+    """As a beam's: a value in the wrong unit (GPa, g/cm³, mm) warns and the run goes on."""
+    argv = [str(example("plate_on_stops")), "--format", "none", "--out", str(tmp_path / "r")]
+    assert exit_code(run_main, argv + [a for s in sets for a in ("--set", s)]) == 0
+    err = [e for e in capsys.readouterr().err.splitlines() if e.startswith("warning")]
+    assert len(err) == 1 and warning in err[0], err
+
+
 def test_modes_lists_the_plate_frequencies(tmp_path, capsys):
     assert exit_code(modes_main, [str(example("plate_rattling")), "--n", "3", "--out",
                                   str(tmp_path / "m")]) == 0

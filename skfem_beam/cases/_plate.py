@@ -14,6 +14,7 @@ from ..output.plate import (UNITS, PlateFieldWriter, plate_cells,
                             plate_columns, plate_impacts, probe_name, vertex_w)
 from ..output.stream import Series, execute, prepare
 from ..spec import RunSpec
+from ._beam import warn_no_contact
 
 
 def smallest_gap(system) -> float | None:
@@ -61,7 +62,10 @@ def run_plate_case(case: str, setup, spec: RunSpec) -> int:
     }
     series = Series(plate_columns(setup.probes), writer=PlateFieldWriter,
                     events=plate_impacts)
-    return execute(run, spec.options, summary, series, plate_charts(case, system, setup))
+    code = execute(run, spec.options, summary, series, plate_charts(case, system, setup))
+    if code == 0:
+        warn_no_contact(run, system)
+    return code
 
 
 def plate_charts(case: str, system, setup):

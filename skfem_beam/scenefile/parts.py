@@ -21,14 +21,20 @@ PLAUSIBLE = {"E": (1e6, 1.2e12, "Pa"), "rho": (10.0, 23000.0, "kg/m³")}
 def material_of(d: dict, where: str, plausible: bool = True) -> Material:
     """[material] E, rho; a beam's outside PLAUSIBLE warns (a bar's may be the papers'
     dimensionless a = ρ = 1)."""
-    from ..cli import warn
     material = Material(**need(d, ("E", "rho"), where))
+    if plausible:
+        warn_implausible(d, where)
+    return material
+
+
+def warn_implausible(d: dict, where: str) -> None:
+    """One warning line for each of E, rho outside PLAUSIBLE (a beam's, a plate's)."""
+    from ..cli import warn
     for key, (low, high, unit) in PLAUSIBLE.items():
         value = d[key]
-        if plausible and not low <= value <= high:
+        if not low <= value <= high:
             warn(f"[{where}] {key} = {value:g} {unit} is outside engineering materials "
                  f"({low:g}–{high:g} {unit}): is it in {unit}?")
-    return material
 
 
 def section_of(d: dict, where: str) -> Section:

@@ -18,7 +18,7 @@ from ..errors import InputError
 from ..plate.model import EDGES, ELEMENTS, SUPPORTS, MeshPlate, Plate
 from ..scheme import Stepping
 from .forcing import _time_function
-from .parts import need
+from .parts import need, warn_implausible
 from .read import Parsed, Tables
 from .schema import OUTPUT_DEFAULTS, PLATE_KEYS
 
@@ -96,6 +96,7 @@ def _section_material(data: dict) -> tuple:
     check_positive("[material] rho", m["rho"])
     if not -1.0 < m["nu"] < 0.5:
         raise InputError(f"[material] nu={m['nu']!r} must lie in (-1, 0.5)")
+    warn_implausible(m, "material")
     return h, m
 
 

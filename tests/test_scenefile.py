@@ -811,3 +811,14 @@ def test_resume_names_a_changed_set_or_scene_as_written(tmp_path, capsys):
         assert capsys.readouterr().err == (
             f"error: --resume {out}: {line}; a resumed run keeps its scene and flags (only "
             "--T may grow: extend it with --T)\n")
+
+
+def test_a_T_between_steps_says_where_the_run_ends(tmp_path, capsys):
+    """The run ends at the first step at or after T (⌈T/Δt⌉ steps): one line says so."""
+    argv = [str(write(tmp_path, PIPE)), "--format", "none", "--set", "time.dt=3e-5"]
+    assert exit_code(run_main, argv + ["--out", str(tmp_path / "a")]) == 0
+    notes = [e for e in capsys.readouterr().err.splitlines() if e.startswith("note")]
+    assert notes == ["note: T=0.01 s is not a whole number of steps dt=3e-05 s: the run "
+                     "ends at t=0.01002 s (334 steps)"]
+    assert exit_code(run_main, argv[:-1] + ["time.dt=2.5e-5", "--out", str(tmp_path / "b")]) == 0
+    assert "note" not in capsys.readouterr().err

@@ -205,6 +205,7 @@ def execute(run: Run, options: OutputOptions, summary: dict, series, finish) -> 
         # the checkpoint is the one truth: a resume that stops before its first new
         # checkpoint leaves a summary that still names it
         summary = {**summary, "checkpoint_step": int(ck["n"])}
+    _note_last_step(run)
     with _Signals() as stop:
         folder = Folder.open(out, summary, overwrite=options.overwrite, resume=resume)
         try:
@@ -218,6 +219,15 @@ def execute(run: Run, options: OutputOptions, summary: dict, series, finish) -> 
                                    can_checkpoint), finish)
         finally:
             folder.release()
+
+
+def _note_last_step(run) -> None:
+    """One line when T is not a whole number of steps: the run ends at the first step at
+    or after T (Stepping.steps), which a user reading the last row should not wonder at."""
+    s = getattr(run, "stepping", None)
+    if s is not None and abs(s.steps * s.dt - s.T) > 1e-9 * s.T:
+        print(f"note: T={s.T:g} s is not a whole number of steps dt={s.dt:g} s: the run "
+              f"ends at t={s.steps * s.dt:.9g} s ({s.steps} steps)", file=sys.stderr)
 
 
 PHASES = ("last-chunk", "final-checkpoint", "charts", "impacts", "summary")

@@ -243,6 +243,8 @@ BAD = {
         "[initial] u0_w start the second plane: they need planes = 2"),
     "obstacle without bounds": (PIPE + "[[obstacles]]\nx = 0.79\n",
                                 "[obstacles.1] needs g1 and/or g2 (m), or a hole"),
+    "wear without holes": (PIPE + "[wear]\ncoefficient = 1e-14\nservice_years = 40\n",
+                           "error: scene.toml: [wear] needs holes"),
     "table t not increasing": (PIPE + '[motion]\nend = "left"\ntable = "phi.csv"\n',
                                "t is not increasing at row 4"),
 }

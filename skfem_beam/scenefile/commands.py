@@ -133,8 +133,11 @@ def _spec(scene: Scene, flags: dict, resume) -> RunSpec:
               "law": law, "solver": "auto" if restitution else solver,
               "stiffness": scene.stiffness, "restitution": restitution, "mass": mass,
               "massless": stepping.massless, "probe": probes}
-    return RunSpec(stepping, scene.method, options, config, mass, tuple(probes),
-                   wear(scene) if scene.kind == "beam" else None)
+    try:        # [wear] is read here, after the file's own build: its lines name it too
+        worn = wear(scene) if scene.kind == "beam" else None
+    except InputError as e:
+        raise InputError(f"{Path(flags['scene'] or 'scene.toml').name}: {e}") from None
+    return RunSpec(stepping, scene.method, options, config, mass, tuple(probes), worn)
 
 
 def _plate_spec(scene, flags: dict, resume) -> RunSpec:

@@ -2,7 +2,8 @@
 
 Sphinx with MyST: the pages are the Markdown the repository already reads on GitHub, and
 autodoc builds the API reference from the docstrings in the same build.  The scene-file
-reference is generated from the code's key tables before the build (skfem_beam.scenedocs).
+reference (docs/scene_keys.md) is rewritten from the code's key tables before the build
+(skfem_beam.scenedocs), where it differs.
 """
 import os
 import sys
@@ -16,7 +17,7 @@ author = "the skfem_beam developers"
 extensions = ["myst_parser", "sphinx.ext.autodoc"]
 source_suffix = {".md": "markdown"}
 root_doc = "index"
-exclude_patterns = ["_build", "_generated", "**/.ipynb_checkpoints"]
+exclude_patterns = ["_build", "**/.ipynb_checkpoints"]
 myst_heading_anchors = 3
 html_theme = "alabaster"
 html_title = "skfem_beam"
@@ -26,10 +27,9 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 
 
 def write_scene_keys(app) -> None:
-    from skfem_beam.scenedocs import reference
-    out = HERE / "_generated" / "scene_keys.md"
-    out.parent.mkdir(exist_ok=True)
-    text = reference()
+    from skfem_beam.scenedocs import PAGE, page
+    out = HERE.parent / PAGE
+    text = page()
     if not out.is_file() or out.read_text() != text:
         out.write_text(text)
 

@@ -165,3 +165,17 @@ def reference() -> str:
                          for kind, ks in kinds.items())
         rows.append(f"| {label} | {keys} | {SECTION_DOCS[name]} |")
     return "\n".join(rows) + "\n"
+
+
+PAGE = "docs/scene_keys.md"     # relative to the repository
+
+
+def page() -> str:
+    """docs/scene_keys.md: :func:`reference` under its heading (tests/test_docs.py checks
+    that the committed page is this text, so that it reads on GitHub as the code is)."""
+    return ("# Scene-file keys\n\n"
+            "Every section and key of a beam's or a bar's scene file, read from the code's own "
+            "tables\n(`skfem_beam.scenefile.BEAM_KEYS`, `BAR_KEYS`; the texts are "
+            "`skfem_beam.scenedocs`,\nand a test fails when a key has none or this page is "
+            "not the code's). A plate's keys:\n[plate.md](plate.md). Rewritten by the docs "
+            "build.\n\n" + reference())

@@ -33,3 +33,10 @@ def test_the_reference_lists_every_key_of_the_code():
         for key in schema:
             assert f"`{key}`" in text or f"[{key}]" in text, key
     assert text.count("\n") == len(scenedocs.sections()) + 2
+
+
+def test_the_committed_key_page_is_the_code_s():
+    """docs/scene_keys.md reads on GitHub: it must be what the code's tables give."""
+    from pathlib import Path
+    page = Path(__file__).parent.parent / scenedocs.PAGE
+    assert page.read_text() == scenedocs.page(), "run the docs build to rewrite it"

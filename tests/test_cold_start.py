@@ -10,7 +10,8 @@ from pathlib import Path
 import skfem_beam
 from skfem_beam.scheme.kernels import CALLEES
 
-NOTICE = "compiling numerical kernels (first run only)"
+NOTICE = ("compiling numerical kernels (once per method and scene type; later runs load "
+          "them)")
 
 
 def test_cold_then_warm_run_same_files_one_notice(tmp_path):

@@ -46,7 +46,8 @@ class _CompileNotice(event.Listener):
             return
         if not _CompileNotice.said:
             _CompileNotice.said = True
-            print("compiling numerical kernels (first run only) …", file=sys.stderr, flush=True)
+            print("compiling numerical kernels (once per method and scene type; later runs "
+                  "load them) …", file=sys.stderr, flush=True)
 
     def on_end(self, ev):
         pass

@@ -159,6 +159,58 @@ def test_refusals(kwargs, message):
         plate_system(plate_space(Plate(nx=4, ny=4, edges={"left": "clamped"})), **kwargs)
 
 
+ORDER = r"\(x0, x1, y0, y1\) in m \(a scene file writes \[x0, y0, x1, y1\]\)"
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    # a scene file's corner order given to Python: one point, refused (it held one vertex)
+    ({"obstacles": [PlateObstacle(g1=-1e-3, region=(0.25, 0.25, 0.75, 0.75))]},
+     r"region=\(0.25, 0.25, 0.75, 0.75\) needs x0 ≤ x1 and y0 ≤ y1, not one point: " + ORDER),
+    ({"obstacles": [PlateObstacle(g1=-1e-3, region=(0.8, 0.9, 0.7, 0.2))]}, "needs x0 ≤ x1"),
+    ({"obstacles": [PlateObstacle(g1=-1e-3, region=(0.5, 2.0, 0.0, 1.0))]}, "is off"),
+    ({"obstacles": [PlateObstacle(g1=-1e-3, region=(0.51, 0.52, 0.51, 0.52))]},
+     "holds no vertex"),
+    ({"loads": [Pressure(1e4, region=(0.5, 0.5, 0.0, 1.0))]},
+     "Pressure region=.* needs x0 < x1 and y0 < y1"),
+    ({"obstacles": PlateObstacle(g1=-1e-3)}, "obstacles= must be a list of PlateObstacle"),
+    ({"loads": [1e4]}, "loads= must be a list of Pressure"),
+    ({"initial": Pressure(1e4)}, "initial=.* must be a PlateInitial or None"),
+])
+def test_python_inputs_are_refused_in_one_line(kwargs, message):
+    """Each mistake of a Python user refused by name (before: silently no load or one
+    vertex, or an AttributeError from inside)."""
+    with pytest.raises(InputError, match=message):
+        plate_system(plate_space(Plate(nx=4, ny=4)), **kwargs)
+
+
+@pytest.mark.parametrize("make_it, message", [
+    (lambda: Plate(E=0), "plate E=0 must be > 0"),
+    (lambda: Plate(rho=-1), "plate rho=-1 must be > 0"),
+    (lambda: Plate(E=float("nan")), "plate E=nan must be a finite number"),
+    (lambda: Plate(h=[0.01]), r"plate thickness h=\[0.01\] is not a number"),
+    (lambda: Plate(edges=["left"]), "plate edges=.* must map edges to supports"),
+    (lambda: Pressure(float("nan")), r"Pressure p=nan must be a finite number \(Pa\)"),
+    (lambda: PlateInitial(static=1e4), "must be a Pressure"),
+    (lambda: PlateInitial(v0=np.zeros(3)), "PlateInitial v0=.* must be a finite number"),
+])
+def test_plate_parts_check_their_values(make_it, message):
+    with pytest.raises(InputError, match=message):
+        make_it()
+
+
+def test_modes_and_statics_check_their_arguments():
+    from skfem_beam.plate import natural_frequencies, static_deflection
+    from skfem_beam.plate.space import load_vector
+    space = plate_space(Plate(nx=4, ny=4))
+    for n in (0, 64, "6", True):
+        with pytest.raises(InputError, match=r"must be a whole number in \[1, 63\]"):
+            natural_frequencies(space, n)
+    with pytest.raises(InputError, match=r"f has shape \(5,\): a load vector over all 100"):
+        static_deflection(space, np.ones(5))
+    # a number is a uniform pressure: 1 kPa on 1 m² is 1 kN in all
+    assert load_vector(space, 1e3).sum() == pytest.approx(1e3, rel=1e-12)
+
+
 @pytest.mark.parametrize("dofname, normal_axis, fixed", [
     ("u", 1, False), ("u_y", 1, True), ("u_xy", 1, True), ("u_x", 1, False),
     ("u_yy", 1, False), ("u_n", 0, True), ("u_xx", 0, False)])

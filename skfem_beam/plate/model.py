@@ -2,6 +2,7 @@
 (:class:`MeshPlate`), its material, the support of each edge and the element."""
 from dataclasses import dataclass, field
 
+from ..checks import check_finite, check_positive
 from ..errors import InputError
 
 EDGES = ("left", "right", "bottom", "top")
@@ -17,10 +18,12 @@ class _Plate:
     """What every plate derives from its material, its edges and its bounding ``box``."""
 
     def _check_section(self) -> None:
-        if not -1.0 < self.nu < 0.5:
+        """h, E, rho positive numbers, nu in (−1, ½) (each refused in one line naming it)."""
+        self.h = check_positive("plate thickness h", self.h)
+        self.E = check_positive("plate E", self.E)
+        self.rho = check_positive("plate rho", self.rho)
+        if not -1.0 < check_finite("plate nu", self.nu) < 0.5:
             raise InputError(f"plate nu={self.nu!r} must lie in (-1, 0.5)")
-        if not self.h > 0:
-            raise InputError(f"plate thickness h={self.h!r} must be > 0")
 
     @property
     def size(self) -> float:
@@ -45,6 +48,9 @@ class _Plate:
 def _check_supports(edges: dict, names, whose: str = "") -> None:
     """Each edge a name of ``names`` (``whose``: " the boundaries of ..." in the error
     line) with a support of SUPPORTS."""
+    if not isinstance(edges, dict):
+        raise InputError(f"plate edges={edges!r} must map edges to supports, e.g. "
+                         f"{{'left': 'clamped'}} (supports: {', '.join(SUPPORTS)})")
     for edge, support in edges.items():
         if edge not in names:
             raise InputError(f"plate edge {edge!r} is not one of{whose}: "

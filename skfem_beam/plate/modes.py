@@ -3,6 +3,7 @@ import numpy as np
 from scipy.linalg import eigh
 from scipy.sparse.linalg import eigsh
 
+from ..errors import InputError
 from .space import PlateSpace
 
 DENSE_UP_TO = 200   # free dofs below which a dense eigh is quicker than shift-invert
@@ -12,6 +13,9 @@ def natural_frequencies(space: PlateSpace, n: int = 6) -> tuple[np.ndarray, np.n
     """The n lowest circular frequencies ω (rad/s), ascending, and their mode shapes
     (all dofs, one column each, M-normalised)."""
     free = space.free_dofs
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 1 <= n < len(free):
+        raise InputError(f"n={n!r} must be a whole number in [1, {len(free) - 1}] (the "
+                         f"plate has {len(free)} free dofs)")
     K = space.K[free][:, free]
     M = space.M[free][:, free]
     if len(free) <= DENSE_UP_TO:

@@ -153,10 +153,12 @@ def mass_matrix(basis: Basis, rho_h: float) -> sparse.csr_matrix:
 
 
 def load_vector(space: PlateSpace, pressure) -> np.ndarray:
-    """f from a pressure p(x, y) (Pa, positive along w): f_i = ∫ p φ_i."""
+    """f from a pressure p(x, y) (Pa, positive along w; a number: uniform): f_i = ∫ p φ_i."""
+    p = pressure if callable(pressure) else (lambda x, y, c=pressure: c + 0.0 * x)
+
     @LinearForm
     def load(v, w):
-        return pressure(w.x[0], w.x[1]) * v
+        return p(w.x[0], w.x[1]) * v
     return asm(load, space.basis)
 
 

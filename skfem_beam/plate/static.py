@@ -7,8 +7,13 @@ from .space import PlateSpace
 
 
 def static_deflection(space: PlateSpace, f: np.ndarray) -> np.ndarray:
-    """All the dofs' values (w, its derivatives) under the load vector f."""
+    """All the dofs' values (w, its derivatives) under the load vector f (all dofs:
+    :func:`~skfem_beam.plate.space.load_vector`)."""
     free = space.free_dofs
+    f = np.asarray(f, dtype=float)
+    if f.shape != (space.basis.N,):
+        raise InputError(f"f has shape {f.shape}: a load vector over all {space.basis.N} "
+                         "dofs is needed (load_vector(space, p))")
     u = np.zeros(space.basis.N)
     u[free] = spsolve(space.K[free][:, free].tocsc(), f[free])
     return u

@@ -20,6 +20,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
 
+from ..checks import check_finite
 from ..errors import InputError
 from ..system import SemiDiscrete
 from .space import PlateSpace, load_vector
@@ -45,6 +46,29 @@ def _inside(region, x, y, tol: float) -> np.ndarray:
     return (x >= x0 - tol) & (x <= x1 + tol) & (y >= y0 - tol) & (y <= y1 + tol)
 
 
+def checked_region(what: str, region, plate, area: bool):
+    """``region`` = (x0, x1, y0, y1) (m) on the plate's bounding box, x0 ≤ x1 and y0 ≤ y1
+    (``area``: both strict; else one side may be zero, a line of vertices, but not both:
+    a point is ``points``), or None; else one line naming it and the order, which is not
+    a scene file's [x0, y0, x1, y1]."""
+    if region is None:
+        return None
+    order = "(x0, x1, y0, y1) in m (a scene file writes [x0, y0, x1, y1])"
+    try:
+        x0, x1, y0, y1 = (check_finite("region", v) for v in region)
+    except (TypeError, ValueError, InputError):
+        raise InputError(f"{what} region={region!r} must be four numbers {order}") from None
+    bx0, bx1, by0, by1 = plate.box
+    tol = 1e-9 * plate.size
+    sides = (x1 - x0, y1 - y0)
+    if min(sides) < 0 or (max(sides) == 0 if not area else min(sides) == 0):
+        need = "x0 < x1 and y0 < y1" if area else "x0 ≤ x1 and y0 ≤ y1, not one point"
+        raise InputError(f"{what} region={region!r} needs {need}: {order}")
+    if x0 < bx0 - tol or y0 < by0 - tol or x1 > bx1 + tol or y1 > by1 + tol:
+        raise InputError(f"{what} region={region!r} is off {plate.outline()}: {order}")
+    return x0, x1, y0, y1
+
+
 @dataclass(frozen=True)
 class PlateObstacle:
     """g1(x, y) ≤ w ≤ g2(x, y) (numbers or vectorised functions of x, y; ±inf: one-sided)
@@ -62,7 +86,11 @@ class PlateObstacle:
             where = np.zeros(x.size, dtype=bool)
             where[[vertex_index(space, px, py) for px, py in self.points]] = True
         else:
-            where = _inside(self.region, x, y, 1e-9 * space.plate.size)
+            region = checked_region("PlateObstacle", self.region, space.plate, area=False)
+            where = _inside(region, x, y, 1e-9 * space.plate.size)
+            if not where.any():
+                raise InputError(f"PlateObstacle region={self.region!r} holds no vertex of "
+                                 "the mesh")
         lo = np.where(where, _values(self.g1, x, y), -np.inf)
         hi = np.where(where, _values(self.g2, x, y), np.inf)
         return lo, hi
@@ -77,11 +105,17 @@ class Pressure:
     time: Callable = one
     region: tuple[float, float, float, float] | None = None
 
+    def __post_init__(self):
+        _number_or_function("Pressure p", self.p, "Pa", "x, y")
+        if not callable(self.time):
+            raise InputError(f"Pressure time={self.time!r} must be a function of t")
+
     def vector(self, space: PlateSpace) -> np.ndarray:
         """b = ∫ p·1_region φ (N), all dofs."""
         tol = 1e-9 * space.plate.size
+        region = checked_region("Pressure", self.region, space.plate, area=True)
         return load_vector(space, lambda x, y: _values(self.p, x, y)
-                           * _inside(self.region, x, y, tol))
+                           * _inside(region, x, y, tol))
 
 
 @dataclass(frozen=True)
@@ -91,6 +125,23 @@ class PlateInitial:
     x, y), L²-projected on the free dofs as the beam's v0 is."""
     static: Pressure | None = None
     v0: float | Callable = 0.0
+
+    def __post_init__(self):
+        if self.static is not None and not isinstance(self.static, Pressure):
+            raise InputError(f"PlateInitial static={self.static!r} must be a Pressure (the "
+                             "load whose static deflection starts the run) or None")
+        _number_or_function("PlateInitial v0", self.v0, "m/s", "x, y")
+
+
+def _number_or_function(name: str, value, unit: str, of: str) -> None:
+    """A finite number or a function (of ``of``), else one line naming it."""
+    if callable(value):
+        return
+    try:
+        check_finite(name, value)
+    except InputError:
+        raise InputError(f"{name}={value!r} must be a finite number ({unit}) or a function "
+                         f"of {of}") from None
 
 
 def vertex_index(space: PlateSpace, x: float, y: float) -> int:
@@ -178,6 +229,19 @@ def _observers(space, points, position) -> dict[str, np.ndarray]:
     return rows
 
 
+def _check_parts(space, obstacles, loads, initial) -> None:
+    """The arguments' kinds, each refused in one line saying what goes there."""
+    if not isinstance(space, PlateSpace):
+        raise InputError(f"plate_system needs the plate's space, plate_space(plate), not "
+                         f"{type(space).__name__}")
+    for name, items, kind in (("obstacles", obstacles, PlateObstacle),
+                              ("loads", loads, Pressure)):
+        if isinstance(items, kind) or not all(isinstance(i, kind) for i in items):
+            raise InputError(f"{name}= must be a list of {kind.__name__} (got {items!r})")
+    if initial is not None and not isinstance(initial, PlateInitial):
+        raise InputError(f"initial={initial!r} must be a PlateInitial or None")
+
+
 def plate_system(space: PlateSpace, obstacles=(), loads=(), initial: PlateInitial | None = None,
                  observe=None) -> SemiDiscrete:
     """The plate's :class:`~skfem_beam.system.SemiDiscrete` (physical units, see the
@@ -186,6 +250,7 @@ def plate_system(space: PlateSpace, obstacles=(), loads=(), initial: PlateInitia
     ``observe`` the vertices (x, y) whose w is observed (None: the one nearest the
     centre).  ``meta``: "dofs" (skfem's dof of each unknown), "contact_vertices",
     "y_contact" (x_contact holds the x of each constrained vertex)."""
+    _check_parts(space, obstacles, loads, initial)
     dofs = grid_order(space)
     position = np.full(space.basis.N, -1)
     position[dofs] = np.arange(dofs.size)

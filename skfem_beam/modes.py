@@ -60,6 +60,9 @@ class Modes:
 
 def modes(problem: BeamProblem, n: int = 6, samples_per_element: int = 10) -> Modes:
     """The ``n`` lowest natural frequencies and mode shapes of ``problem``'s beam."""
+    if not isinstance(problem, BeamProblem):
+        raise InputError(f"modes needs the BeamProblem (not {type(problem).__name__}; a "
+                         "plate's: skfem_beam.plate.natural_frequencies)")
     space = beam_space(problem)
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 1 <= n <= space.n:
         raise InputError(f"n={n!r} modes: must be a whole number in [1, {space.n}] (the "

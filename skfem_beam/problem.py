@@ -294,6 +294,14 @@ class Obstacles:
     def __post_init__(self):
         if not isinstance(self.carried, (bool, np.bool_)):
             raise InputError(f"carried={self.carried!r} must be True or False")
+        for name in ("g1", "g2"):
+            g = getattr(self, name)
+            if not callable(g):
+                try:
+                    float(g)
+                except (TypeError, ValueError):
+                    raise InputError(f"{name}={g!r} must be a number (m; ±inf: none) or a "
+                                     "vectorised function of x") from None
 
     @classmethod
     def stops(cls, x, g1, g2, carried: bool = False) -> "Obstacles":
@@ -510,6 +518,14 @@ class InitialState:
     du0: Profile | None = None
     fixed_frame: bool = False
 
+    def __post_init__(self):
+        for name in ("u0", "v0", "du0"):
+            f = getattr(self, name)
+            if f is not None and not callable(f):
+                raise InputError(f"InitialState {name}={f!r} must be a function of x (None: "
+                                 "zero); values at the nodes: wrap them, e.g. lambda x: "
+                                 "np.interp(x, nodes, values)")
+
 
 @dataclass(frozen=True)
 class Plane:
@@ -551,6 +567,7 @@ class BeamProblem:
     second: Plane = field(default_factory=Plane)
 
     def __post_init__(self):
+        self._check_kinds()
         object.__setattr__(self, "ends", check_ends(self.ends))
         self._check_planes()
         object.__setattr__(self, "supports", self._check_supports())
@@ -607,6 +624,16 @@ class BeamProblem:
         if self.support.moves:
             self._check_moving_support()
         self.obstacles.carried_at(self.nodes[free])   # carried and fixed may not meet
+
+    def _check_kinds(self) -> None:
+        """The parts' kinds, each refused in one line saying what goes there."""
+        for name, kind, example in (("beam", Beam, "Beam(L, k2=...)"),
+                                    ("obstacles", Obstacles, "Obstacles(g1=-0.01, g2=0.01)"),
+                                    ("initial", InitialState, "InitialState(u0=...)")):
+            value = getattr(self, name)
+            if not isinstance(value, kind):
+                raise InputError(f"BeamProblem {name}= is a {type(value).__name__}: it takes "
+                                 f"{example}")
 
     def _check_planes(self) -> None:
         if self.planes not in (1, 2) or isinstance(self.planes, bool):

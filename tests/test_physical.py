@@ -7,8 +7,8 @@ import pytest
 from scipy.optimize import brentq
 
 import skfem_beam
-from skfem_beam import (Beam, BeamProblem, InputError, Material, Section, beam_system,
-                        scenes, solve)
+from skfem_beam import (Beam, BeamProblem, InitialState, InputError, Material, Obstacles,
+                        Section, beam_system, scenes, solve)
 from skfem_beam.spaces import make_space
 
 STEEL = Material(2e11, 8000.0)
@@ -148,6 +148,15 @@ def test_stepped_beam_needs_a_node_at_the_step():
     (lambda: Beam.stepped([]), ["at least one"]),
     (lambda: Beam.stepped([(0.5, STEEL)]), ["part 0", "(length, Material, Section)"]),
     (lambda: Beam.stepped([(-0.5, STEEL, PIPE)]), ["length of part 0=-0.5"]),
+    # the kinds of a problem's parts (before: AttributeError or TypeError from inside)
+    (lambda: BeamProblem(Beam(1.5, k2=282.84), (-0.1, 0.1), J=10),
+     ["BeamProblem obstacles= is a tuple: it takes Obstacles(g1=-0.01, g2=0.01)"]),
+    (lambda: Obstacles(g1="a", g2=0.1), ["g1='a' must be a number (m; ±inf: none)"]),
+    (lambda: InitialState(v0=np.zeros(5)), ["InitialState v0=", "must be a function of x"]),
+    (lambda: skfem_beam.modes(beam_system(BeamProblem(Beam(1.5, k2=282.84), J=4)), 2),
+     ["modes needs the BeamProblem (not SemiDiscrete"]),
+    (lambda: skfem_beam.solve(BeamProblem(Beam(1.5, k2=282.84), J=4), 1e-4, 0.1),
+     ["solve needs a semi-discrete system (beam_system(problem)", "not BeamProblem"]),
 ])
 def test_bad_physical_input_is_refused_with_one_clear_line(make, words):
     with pytest.raises(InputError) as err:

@@ -6,6 +6,7 @@ import math
 import sys
 
 from ..errors import InputError, SolverError
+from ..system import SemiDiscrete
 from .methods import MoreauJean, Penalty, PositionLevel, with_beta
 from .run import Run
 from .stepping import Result, Stepping
@@ -36,6 +37,10 @@ def solve(system, dt: float, T: float, beta: float | None = None, method=None, *
     or a value turns non-finite; what was computed up to the last good saved state is
     returned.
     """
+    if not isinstance(system, SemiDiscrete):
+        raise InputError(f"solve needs a semi-discrete system (beam_system(problem), "
+                         f"bar_system(bar), plate_system(space, ...)), not "
+                         f"{type(system).__name__}")
     method = PositionLevel() if method is None else method
     if not isinstance(method, (PositionLevel, Penalty, MoreauJean)):
         raise InputError(f"method={method!r}: a method object is needed "

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from conftest import assert_refused, exit_code
+from skfem_beam import InputError
 from skfem_beam.methods import Penalty
 from skfem_beam.scenefile import load, run_main
 from skfem_beam.scheme import solve
@@ -100,6 +101,18 @@ def test_a_spring_behaves_as_in_the_run_where_all_have_its_stiffness(tmp_path):
         for a, b in ((one.observed[tip], each.observed[tip]), (one.energy, each.energy),
                      (one.contact_force, each.contact_force)):
             assert np.array_equal(a, b)
+
+
+@pytest.mark.parametrize("stiffness, damping, word", [
+    ((K1, K2, K1), 0.0, "Penalty stiffness: 3 values for 2 obstacle(s)"),
+    ((K1,), (1.0, 2.0, 3.0), "Penalty damping: 3 values for 2 obstacle(s)"),
+])
+def test_a_value_per_obstacle_needs_one_for_each(tmp_path, stiffness, damping, word):
+    """Too many values was run with the extra ones left out, silently."""
+    system = beam_system(load(write(tmp_path)).problem)
+    with pytest.raises(InputError) as e:
+        solve(system, 1e-3, 0.01, 0.25, Penalty(stiffness, damping=damping))
+    assert str(e.value).startswith(word)
 
 
 @pytest.mark.parametrize("change, word", [

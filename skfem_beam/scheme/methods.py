@@ -130,6 +130,14 @@ class Penalty:
     def law(self, system) -> ContactLaw:
         scale = 1.0 if self.equation_units or system is None else mass_scale(system)
         k, c = np.asarray(self.stiffness), np.asarray(self.damping)
+        problem = None if system is None else system.meta.get("problem")
+        if problem is not None and problem.planes == 1:     # one per obstacle: all of them
+            count = len(problem.obstacles.parts) or 1
+            for name, v in (("stiffness", k), ("damping", c)):
+                if v.size > 1 and v.size != count:
+                    raise InputError(f"Penalty {name}: {v.size} values for {count} "
+                                     "obstacle(s): give one per obstacle, in their order, "
+                                     "or one for all")
         return PenaltyLaw(k / scale, c / scale, self.implicit)     # the one conversion
 
     def build(self, system, stepping) -> Run:   # the quasi-static massless rows refuse springs

@@ -138,7 +138,7 @@ def method(args) -> methods.Method:
     --massless, --theta, --beta: the β-scheme's β, None its default)."""
     return methods.make(args.law, getattr(args, "solver", "auto"), args.restitution,
                         args.stiffness if args.law == "penalty" else None,
-                        getattr(args, "massless", None),
+                        getattr(args, "massless", None), words=methods.FLAGS,
                         params=law_params(getattr(args, "param", None),
                                           theta=getattr(args, "theta", None),
                                           beta=getattr(args, "beta", None)))

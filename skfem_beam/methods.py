@@ -36,10 +36,12 @@ class Words:
     restitution: str = "--restitution "
     theta: str = "--theta "
     param: str = "--param "
+    stiffness: str = "--stiffness "
 
 
 FLAGS = Words()
-KEYS = Words("solver=", "massless=", "law=", "restitution=", "theta=", "params: ")   # the API's
+KEYS = Words("solver=", "massless=", "law=", "restitution=", "theta=", "params: ",
+             "stiffness=")   # the API's
 
 
 def _name(word: str) -> str:
@@ -48,14 +50,15 @@ def _name(word: str) -> str:
 
 def make(law: str = "position", solver: str = "auto", restitution: float = 0.0,
          stiffness: float | None = None, massless: str | None = None,
-         words: Words = FLAGS, damping: float = 0.0, params: dict | None = None) -> Method:
+         words: Words = KEYS, damping: float = 0.0, params: dict | None = None) -> Method:
     """The method the words name: ``law`` one of LAWS, ``solver`` the position-level
     QP solver, ``stiffness`` and ``damping`` the penalty springs and their dashpots (N/m,
     N·s/m, see :class:`Penalty`), ``massless`` the massless rows' stepping; ``params``
     the method's own parameters: ``theta``, Moreau–Jean's θ, ``beta``, the β-scheme's β
     (position, penalty; Moreau–Jean has none: checked and not used), and the
     position-level solver's (its law's table,
-    :func:`skfem_beam.contact.registry.check_params`); None: the defaults."""
+    :func:`skfem_beam.contact.registry.check_params`); None: the defaults.  ``words``:
+    how error lines name them (the API's keywords; the command line passes FLAGS)."""
     check_choice(_name(words.law), law, LAWS)
     params = dict(params or {})
     theta, beta = params.pop("theta", None), params.pop("beta", None)
@@ -76,6 +79,9 @@ def make(law: str = "position", solver: str = "auto", restitution: float = 0.0,
         mj = MoreauJean(0.5 if theta is None else check_theta(theta, words.theta), e)
         return with_beta(mj, beta)       # no β: checked, as the other front ends' words
     if law == "penalty":     # the registry's checks: no solver, no restitution with springs
+        if stiffness is None:
+            raise InputError(f"{words.law}penalty needs the springs' stiffness: "
+                             f"{words.stiffness}K (N/m)")
         resolve("penalty" if solver == "auto" else solver, stiffness, e)
         return Penalty(stiffness, massless=massless or "beta", damping=damping, beta=beta)
     check_choice(_name(words.solver), solver, SOLVERS)

@@ -39,7 +39,11 @@ def test_defaults_and_checks():
                       (lambda: methods.make("moreau-jean", params={"beta": 0.6}), "beta=0.6"),
                       (lambda: methods.make("moreau-jean", "osqp"), "does not apply"),
                       (lambda: methods.make("penalty", restitution=0.5, stiffness=1.0),
-                       "cannot be combined with stiffness")]:
+                       "cannot be combined with stiffness"),
+                      # from Python the lines name the keywords, not the command's flags
+                      (lambda: methods.make("lagrange"), "law='lagrange' is not one of"),
+                      (lambda: methods.make("penalty"),
+                       "law=penalty needs the springs' stiffness: stiffness=K (N/m)")]:
         with pytest.raises(InputError, match=word.replace("[", r"\[").replace("(", r"\(")):
             bad()
 

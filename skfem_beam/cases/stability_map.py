@@ -21,7 +21,7 @@ import numpy as np
 from .. import cli, scenes
 from ..errors import InputError
 from ..scheme import solve
-from ..methods import Penalty, law_of, make
+from ..methods import FLAGS, Penalty, law_of, make
 from ..output.charts import figure
 from ..output.folder import Folder, check_output_dir
 from ..checks import check_beta, check_positive
@@ -64,7 +64,7 @@ def run_map(system, grid, T, stiffness, step_of) -> list[dict]:
     for beta, ratio, method in grid:
         dt = ratio * step_of(beta)
         law = Penalty(stiffness, equation_units=True, beta=beta) \
-            if law_of(method) == "penalty" else make(law_of(method), params={"beta": beta})
+            if law_of(method) == "penalty" else make(law_of(method), params={"beta": beta}, words=FLAGS)
         r = solve(system, dt, T, method=law, save_every=max(1, int(1e-4 / dt)), frames=2,
                   progress=False)
         tip = r.observed["tip_displacement"]

@@ -23,7 +23,8 @@ from .schema import CONTACT, OUTPUT_DEFAULTS
 BEAM_MASSES = ("consistent", "redistributed")        # [mesh] mass of a beam
 SCENE_WORDS = methods.Words(solver="[contact] law = ", massless="[mesh] massless = ",
                             law="[contact] law = ", restitution="[contact] restitution = ",
-                            theta="[contact] theta = ", param="[contact] ")
+                            theta="[contact] theta = ", param="[contact] ",
+                            stiffness="[contact] stiffness = ")
 
 
 @dataclass(frozen=True)

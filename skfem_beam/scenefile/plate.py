@@ -24,7 +24,8 @@ from .schema import OUTPUT_DEFAULTS, PLATE_KEYS
 
 PLATE_WORDS = methods.Words(solver="[contact] solver = ", massless="[mesh] massless = ",
                             law="[contact] law = ", restitution="[contact] restitution = ",
-                            theta="[contact] theta = ", param="[contact] ")
+                            theta="[contact] theta = ", param="[contact] ",
+                            stiffness="[contact] stiffness = ")
 TIME_FORMS = ("amplitude", "omega", "phase", "value", "sines", "table", "random", "psd")
 
 

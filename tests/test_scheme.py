@@ -90,3 +90,11 @@ def test_unstable_run_is_detected_and_truncated(pipe):
     assert np.isfinite(r.energy).all() and r.energy.max() < 100 * r.energy[0]
     ok = solve(system, 0.9 * limit, 0.1, 0.1)
     assert ok.status == "success"
+
+
+def test_a_name_not_in_a_result_s_table_says_which_are():
+    r = solve(free_system(), 1e-3, 0.01)
+    with pytest.raises(KeyError, match="'tip_velocity' is not in this run's table; it holds: "
+                                       "tip_displacement"):
+        r.observed["tip_velocity"]
+    assert r.velocity["tip_displacement"].shape == r.t.shape and "contact" in r.work

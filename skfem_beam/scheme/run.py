@@ -13,7 +13,7 @@ from ..errors import Deferred, InputError, SolverError
 from ..stability import kappa_h, linear_limit
 from .kernels import (CONTACT_STEPS, EVENT_COLUMNS, EVENTS_FULL, EVENTS_WRITTEN, FAILED, ROW0,
                       STOPPED_AT, UNSTABLE, WORK_TERMS, Inputs, PythonLaw)
-from .stepping import Result
+from .stepping import Named, Result
 
 FIRST_ROWS = 1 << 15      # saved rows allocated at first; more as a chunk needs them
 SAVED = ("obs", "obsv", "energy", "work", "lam", "resid")   # the saved series, by row
@@ -375,8 +375,9 @@ class Run:
         obs, obsv = out.obs[:keep], out.obsv[:keep]
         return Result(
             t=np.arange(first, first + keep) * self.save_every * self.dt,
-            observed={k: obs[:, i] for i, k in enumerate(names)},
-            velocity={k: obsv[:, i] for i, k in enumerate(names)}, energy=out.energy[:keep],
+            observed=Named({k: obs[:, i] for i, k in enumerate(names)}),
+            velocity=Named({k: obsv[:, i] for i, k in enumerate(names)}),
+            energy=out.energy[:keep],
             contact_force=out.lam[:keep], frames_t=np.arange(nf) * self.frame_every * self.dt,
             frames_u=out.frames_u[:nf], frames_v=out.frames_v[:nf],
             frames_force=out.frames_f[:nf],
@@ -387,6 +388,6 @@ class Run:
             max_penetration_below=float(st[1]), max_penetration_above=float(st[2]),
             impacts=int(c[0]), contact_fraction=float(c[1]) / max(1, self.n - 1),
             qp_iterations=int(c[2]),
-            work={k: out.work[:keep, i] for i, k in enumerate(self.work_terms)},
+            work=Named({k: out.work[:keep, i] for i, k in enumerate(self.work_terms)}),
             impact_events=self.impact_events(), system=self.system,
             springs=self.springs)

@@ -62,6 +62,14 @@ class Stepping:
         return max(1, self.steps // self.frames)
 
 
+class Named(dict):
+    """A result's table by name (observed, velocity, work): a missing name says which
+    there are (a bare KeyError did not)."""
+
+    def __missing__(self, key):
+        raise KeyError(f"{key!r} is not in this run's table; it holds: {', '.join(self)}")
+
+
 @dataclass
 class Result:
     """What a run returns, in the spirit of ``scipy.integrate.solve_ivp``.

@@ -188,6 +188,10 @@ def test_modes_command_prints_and_writes_the_cantilever_frequencies(tmp_path, ca
     assert f"{float(rows[1][1]):14.6g}".strip() in text
     x = [float(h[2:-1]) for h in rows[0][3:]]
     assert x[0] == 0.0 and x[-1] == pytest.approx(1.501) and float(rows[1][3]) == 0.0
+    # its folder is a run's: --overwrite replaces it
+    assert exit_code(modes_main, [str(example("point_stops")), "--n", "2", "--out", str(out),
+                                  "--overwrite"]) == 0
+    assert len(list(csv.reader(open(out / "modes.csv")))) == 3
 
 
 def test_heat_exchanger_tube_rattles_in_both_baffles(tmp_path):

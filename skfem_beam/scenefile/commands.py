@@ -216,6 +216,15 @@ def _write_modes(out: Path, rows: list, x, two: bool) -> None:
         for i, (f, om, p, shape) in enumerate(rows, 1):
             w.writerow([i] + ([p] if two else []) + [f"{f:.17g}", f"{om:.17g}"]
                        + [f"{u:.17g}" for u in shape])
+    _modes_written(out, len(rows))
+
+
+def _modes_written(out: Path, n: int) -> None:
+    """The folder's summary.json (so that --overwrite knows a folder this command wrote)
+    and the line naming modes.csv."""
+    from ..output.folder import stamp, write_summary
+    write_summary(out, {"command": "python -m skfem_beam modes", "status": "success",
+                        "modes": n, **stamp()})
     print(f"written: {out / 'modes.csv'}", file=sys.stderr)
 
 
@@ -242,5 +251,5 @@ def _plate_modes(scene, args) -> int:
             for i, om in enumerate(omega):
                 w.writerow([i + 1, f"{om / (2 * np.pi):.17g}", f"{om:.17g}"]
                            + [f"{v:.17g}" for v in shapes[space.w_dofs, i]])
-        print(f"written: {out / 'modes.csv'}", file=sys.stderr)
+        _modes_written(out, len(omega))
     return 0

@@ -309,6 +309,8 @@ def export(folder, to: str, out=None) -> Path:
     if to not in FORMATS:
         raise InputError(f"--to {to!r} is not one of: {', '.join(FORMATS)}")
     folder = Path(folder)
+    if not folder.is_dir():             # before --out, which defaults to a file inside it
+        raise InputError(f"{folder} is not a run folder: no such folder")
     out = Path(out) if out is not None else folder / f"{folder.resolve().name}.{to}"
     if out.suffix != f".{to}":
         raise InputError(f"--out {out} must end in .{to} for --to {to}")

@@ -259,3 +259,10 @@ def test_a_part_of_a_row_without_its_newline_is_left_out(tmp_path, tail):
         assert list(cols) == ["t", "u"] and cols["t"].tolist() == [0.1, 0.2]
         assert cols["u"].tolist()[1] == ("-1.25e-7" if kind is str else -1.25e-7)
 
+
+
+def test_export_of_a_folder_that_does_not_exist_names_it(tmp_path, capsys):
+    """Not the --out the user never gave (it defaults to a file inside the folder)."""
+    assert exit_code(export_main, [str(tmp_path / "nosuch"), "--to", "npz"]) == 2
+    assert capsys.readouterr().err == f"error: {tmp_path / 'nosuch'} is not a run folder: " \
+        "no such folder\n"

@@ -828,3 +828,26 @@ def test_a_T_between_steps_says_where_the_run_ends(tmp_path, capsys):
                      "ends at t=0.01002 s (334 steps)"]
     assert exit_code(run_main, argv[:-1] + ["time.dt=2.5e-5", "--out", str(tmp_path / "b")]) == 0
     assert "note" not in capsys.readouterr().err
+
+
+SUMMARY_ONLY = ("displacement", "energy_balance", "linear_stability_limit_dt",
+                "max_support_deflection", "rho_S", "probes")
+
+
+@pytest.mark.parametrize("name", ["point_stops", "heat_exchanger_tube",
+                                  "tube_round_holes_friction"])
+def test_units_name_each_column_written_and_no_other(tmp_path, name):
+    """summary.json's units: one entry per timeseries column under its own name (a
+    plane's suffix, a hole's x as <x>), and none for a column the run did not write."""
+    out = tmp_path / name
+    assert exit_code(run_main, [str(example(name)), "--set", "time.T=0.01", "--format",
+                                "none", "--out", str(out)]) == 0
+    units = json.loads((out / "summary.json").read_text())["units"]
+    columns = (out / "timeseries.csv").read_text().splitlines()[0].split(",")
+    named = {c if not c.startswith("hole_") else f"hole_<x>_displacement{c[-2:]}"
+             for c in columns}
+    assert named - set(units) == set()
+    assert set(units) - named - set(SUMMARY_ONLY) == set()
+    if name == "tube_round_holes_friction":
+        assert units["tip_velocity_w"].endswith("; the second plane's, along z")
+        assert "work_friction_J" in units and "tip_velocity" not in units

@@ -45,7 +45,7 @@ def run_beam_case(case: str, problem, spec: RunSpec, stops=(), extra=None) -> in
         "kappa_h": kh,
         "linear_stability_limit_dt": limit if math.isfinite(limit) else None,
         "observed_x": system.view.observed_x or problem.beam.L,
-        "units": units(rho_S, system),
+        "units": units(rho_S, system, "friction" in run.work_terms),
         "penalty_stiffness_N_per_m": spec.method.stiffness if penalty else None,
         "penalty_damping_N_s_per_m": spec.method.damping if penalty else None,
         "config": spec.config,
@@ -274,18 +274,14 @@ def wear_charts(folder, data, run, case, problem, about, rho_S, wear) -> None:
              f"{h.hole.shape} hole\n({about})", h.hole.centre)
 
 
-PLANE_UNITS = {   # summary.json's units of each plane's own columns (two planes)
-    "_v": {"tip_displacement": "m, the first plane's (along y), as tip_displacement",
-           "hole_<x>_displacement": "m, the node of a hole at x, first plane (the orbit)",
-           "contact_force": "net contact force along y, as contact_force"},
-    "_w": {"tip_displacement": "m, the second plane's (along z)",
-           "hole_<x>_displacement": "m, the same, second plane",
-           "contact_force": "net contact force along z, as contact_force"}}
+PLANES = {"_v": "the first plane's, along y", "_w": "the second plane's, along z"}
+PER_PLANE = ("tip_displacement", "tip_velocity", "contact_force", "contact_force_N")
 
 
-def units(rho_S, system) -> dict:
-    """summary.json's ``units``: what every timeseries column is, in which unit and frame
-    (a two-plane run's per-plane columns, named with the plane's suffix, after the probes')."""
+def units(rho_S, system, friction: bool = False) -> dict:
+    """summary.json's ``units``: what every timeseries column is, in which unit and frame,
+    under the column's own name (two planes: each plane's columns with its suffix, after
+    the probes'); ``friction``: the run has Coulomb friction (its work and residual)."""
     lift = system.view.lift if system.view is not None else None
     frame = ("ũ(L) = u(L) + h(L)φ(t): the physical displacement in the fixed frame, "
              "support motion included" if lift is not None else "u(L): the support is at rest")
@@ -294,41 +290,49 @@ def units(rho_S, system) -> dict:
     held = "" if x is None else (f"at x = {x:g} m, not at L: the end at L is held, so the "
                                  "default series observes the node of largest first-mode "
                                  "amplitude (add --probe X for others); ")
+    terms = WORK_TERMS + (("friction",) if friction else ())
+    works = ("work lost in damping (≥ 0)", "work of the loads (the support's motion included)",
+             "work of the contact forces (≤ 0 for exact contact)",
+             "work of Coulomb friction (≤ 0)")
     out = {"t": "s", "displacement": "m",
            "tip_displacement": f"m, {held}{frame}",
-           "tip_velocity": "m/s, backward difference of u(L)"
+           "tip_velocity": "m/s, backward difference of tip_displacement"
                            + (" plus h(L)φ'(t)" if lift is not None else ""),
            "energy": f"½E_β, m³/s² {per_mass}; of u, relative to the lifted support motion",
            "contact_force": f"net nodal λ, m²/s² (N per kg/m), {per_mass}; positive upwards",
            **{f"work_{k}": f"m³/s² (as energy), {what}, cumulative since t = 0"
-              for k, what in zip(WORK_TERMS, ("work lost in damping (≥ 0)",
-                                        "work of the loads (the support's motion included)",
-                                        "work of the contact forces (≤ 0 for exact contact)"))},
-           "energy_balance": "energy − energy[0] + work_damping = work_input + work_contact "
-                             "(to round-off)",
+              for k, what in zip(terms, works)},
+           "energy_balance": "energy − energy[0] + work_damping = work_input + work_contact"
+                             + (" + work_friction" if friction else "") + " (to round-off)",
            "linear_stability_limit_dt": "s, 2/√(κ_h(1−4β)); null: no limit (β ≥ 1/4)",
            "max_support_deflection": "m: the largest compression of the supports' springs "
                                      "(a stiffness: the penalty law), null for rigid ones"}
+    if friction:
+        out["friction_residual"] = ("the friction's Gauss–Seidel residual at the saved step "
+                                    "(largest impulse change of its last sweep, relative; 0 "
+                                    "with one contact: exact)")
     if rho_S:
         out.update({"contact_force_N": "N (contact_force × rho_S)",
                     "energy_J": "J (energy × rho_S)",
-                    **{f"work_{k}_J": f"J (work_{k} × rho_S)" for k in WORK_TERMS},
+                    **{f"work_{k}_J": f"J (work_{k} × rho_S)" for k in terms},
                     "rho_S": f"{rho_S:g} kg/m"})
-    return {**out, "probes": probe_units(system), **plane_units(rho_S, system.planes)}
+    own = plane_units(out, system.planes)      # pops the one plane's names it replaces
+    return {**out, "probes": probe_units(system), **own}
 
 
-def plane_units(rho_S, planes: int) -> dict:
-    """The units of each plane's own columns, named with its suffix (none for one plane,
-    whose columns are :func:`units`' own), and of the friction's (two planes)."""
-    suffixes = [s for s in plane_suffixes(planes) if s]
-    out = {f"{name}{s}": PLANE_UNITS[s][name] for name in PLANE_UNITS["_v"] for s in suffixes}
-    if rho_S:
-        out.update({f"contact_force{s}_N": "N" for s in suffixes})
-    if suffixes:
-        out.update({"work_friction": "as energy: the work of Coulomb friction (≤ 0), "
-                                     "cumulative since t = 0; energy − energy[0] + "
-                                     "work_damping = work_input + work_contact + work_friction",
-                    "friction_residual": "the friction's Gauss–Seidel residual at the saved "
-                                         "step (largest impulse change of its last sweep, "
-                                         "relative; 0 with one contact: exact)"})
-    return out
+def plane_units(out: dict, planes: int) -> dict:
+    """Two planes: each plane's columns (PER_PLANE and a hole's orbit) under their
+    suffixed names, taking the place of the one plane's (popped from ``out``)."""
+    if planes == 1:
+        return {}
+    own = {}
+    for name in PER_PLANE:
+        text = out.pop(name, None)
+        if text is None:
+            continue
+        for s in plane_suffixes(planes):
+            column = f"contact_force{s}_N" if name == "contact_force_N" else f"{name}{s}"
+            own[column] = f"{text}; {PLANES[s]}"
+    for s in plane_suffixes(planes):
+        own[f"hole_<x>_displacement{s}"] = f"m, the node of a hole at x, {PLANES[s]} (the orbit)"
+    return own

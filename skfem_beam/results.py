@@ -58,6 +58,9 @@ class SavedFields:
         return self.points[:, 0]
 
     def __getitem__(self, name: str) -> np.ndarray:
+        if name not in self.arrays:     # e.g. displacement in a two-plane run's folder
+            raise KeyError(f"{name!r} is not a field of this run; it holds: "
+                           f"{', '.join(self.arrays)}")
         return self.arrays[name]
 
 

@@ -266,3 +266,10 @@ def test_export_of_a_folder_that_does_not_exist_names_it(tmp_path, capsys):
     assert exit_code(export_main, [str(tmp_path / "nosuch"), "--to", "npz"]) == 2
     assert capsys.readouterr().err == f"error: {tmp_path / 'nosuch'} is not a run folder: " \
         "no such folder\n"
+
+
+def test_a_field_not_in_the_folder_says_which_are(folder):
+    run = read_run(folder)
+    with pytest.raises(KeyError, match="'displacement_v' is not a field of this run; it "
+                                       "holds: displacement, "):
+        run.fields["displacement_v"]

@@ -234,8 +234,8 @@ def force_chart(folder, data, case, about, rho_S, suffixes) -> None:
     the mass per length ρS is known (the columns ending ``_N``: λ·ρS), drawn when it is
     not all zero; ``rho_S``: named in the title (None: not named)."""
     newtons = f"contact_force{suffixes[0]}_N" in data
-    label = {"": "net contact force λ", "_v": "net contact force, v",
-             "_w": "net contact force, w"}
+    label = {"": "net contact force " + ("λρS" if newtons else "λ"),
+             "_v": "net contact force, v", "_w": "net contact force, w"}
     if not any(np.any(data[f"contact_force{s}"]) for s in suffixes):
         return
     draw(trajectory_chart, folder / "contact_force.png", data["t"],

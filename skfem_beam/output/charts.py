@@ -303,7 +303,7 @@ def bifurcation_chart(path, settings: dict, results: list[dict]) -> None:
         bad = [r["value"] for r in results if r["status"] != "success"]
         if bad:
             ax.plot(bad, [0.0] * len(bad), "x", color="tab:red", label="run failed / unstable")
-        if bad or any(periods):
+        if bad or any(periods) or ax.get_legend_handles_labels()[0]:
             ax.legend(loc="upper right", fontsize=8)
         ax.set_title(_sweep_title(settings), fontsize=9)
         ax.set_ylabel("tip displacement ũ(L, kP) (m)")
@@ -321,21 +321,30 @@ def _sections(ax, results: list[dict]) -> list[int]:
         y = np.concatenate([r["tip_displacement"] for r in rs] or [[]])
         color = "k" if p == 0 else PERIOD_COLORS[(i - (0 in periods)) % len(PERIOD_COLORS)]
         ax.plot(x, y, ",", color=color, alpha=0.8)
-        ax.plot(x, y, ".", ms=1.2 if p == 0 else 3, color=color, alpha=0.5 if p == 0 else 1,
+        ax.plot(x, y, ".", ms=2 if p == 0 else 3, color=color, alpha=0.5 if p == 0 else 1,
                 label=f"period {p}T ({len(rs)} value{'s' * (len(rs) > 1)})" if p else None)
     return periods
 
 
 def _first_frequency(ax, ax2, param: str, results: list[dict]) -> None:
-    """The beam's first natural frequency, when ω is swept and every run has the same."""
+    """The beam's first natural frequency, when ω is swept and every run has the same: a
+    line where it lies within the swept values, else a note (the axis would stretch)."""
     f1 = {(r.get("damping") or {}).get("f1") for r in results} - {None}
-    if param == "omega" and len(f1) == 1:   # the beam's first natural frequency
+    values = [r["value"] for r in results]
+    if param == "omega" and len(f1) == 1 and values:
         w1 = 2 * math.pi * f1.pop()
+        lo, hi = min(values), max(values)
+        if not lo <= w1 <= hi:
+            ax.text(0.99, 0.02, f"ω₁ = {w1:.3g} rad/s, outside the swept values",
+                    transform=ax.transAxes, ha="right", va="bottom", fontsize=8,
+                    color="0.3")
+            return
         for a in (ax, ax2):
             a.axvline(w1, color="0.4", lw=0.8, ls=":")
+        right = w1 > lo + 0.7 * (hi - lo)     # the label on the side with room
         ax.annotate(f"ω₁ = {w1:.3g}", (w1, 1.0), xycoords=("data", "axes fraction"),
-                    xytext=(2, -10), textcoords="offset points", fontsize=8,
-                    color="0.3")
+                    xytext=(-2 if right else 2, -10), textcoords="offset points",
+                    fontsize=8, color="0.3", ha="right" if right else "left")
 
 
 def _sweep_stops(ax, settings: dict, results: list[dict]) -> None:
@@ -343,10 +352,12 @@ def _sweep_stops(ax, settings: dict, results: list[dict]) -> None:
     gap = settings["fixed"].get("gap")
     if gap is not None:
         for g in (-gap, gap):
-            ax.axhline(g, color="tab:red", lw=0.8, ls="--")
+            ax.axhline(g, color="tab:red", lw=0.8, ls="--",
+                       label=f"stops ±{gap:g} m" if g > 0 else None)
     elif settings["param"] == "gap" and results:   # the stops move with the swept value
         xs = np.array([r["value"] for r in results])
-        ax.plot(xs, xs, "--", xs, -xs, "--", color="tab:red", lw=0.8)
+        ax.plot(xs, xs, "--", color="tab:red", lw=0.8, label="stops ±gap")
+        ax.plot(xs, -xs, "--", color="tab:red", lw=0.8)
 
 
 def _sweep_title(settings: dict) -> str:

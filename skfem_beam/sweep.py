@@ -51,6 +51,7 @@ import numpy as np
 from . import cli, scenes
 from .errors import InputError, SolverError
 from .output.folder import EXIT_SOLVER, Folder, atomic_write, check_output_dir, stamp
+from .output.stream import Signals
 from .checks import check_beta, check_nonnegative, check_positive
 from .sweep_cluster import dask_client, on_cluster
 
@@ -367,6 +368,14 @@ def sweep(settings: dict, values: list[float], out, client=None, progress: bool 
     (RETRIES times), then marked failed in runs.csv while the others finish.
     ``task``: what runs one value (default :func:`run_value`).
     """
+    results, timing = run_values(settings, values, out, client, progress, warm, task)
+    return assemble(out, settings, results, {"timing": timing})
+
+
+def run_values(settings: dict, values: list[float], out, client=None, progress: bool = True,
+               warm: bool = True, task=None) -> tuple[list[dict], dict]:
+    """:func:`sweep`'s runs: every value's result (those in ``out/runs`` read back) and
+    the timing."""
     task = task or run_value
     from tqdm import tqdm
     out = Path(out)
@@ -404,7 +413,7 @@ def sweep(settings: dict, values: list[float], out, client=None, progress: bool 
               "workers": 0 if client is None else len(client.nthreads()),
               "task_s_sum": sum(done[v]["timing"]["task_s"] for v in todo),
               "task_cpu_s_sum": sum(done[v]["timing"]["task_cpu_s"] for v in todo)}
-    return assemble(out, settings, results, {"timing": timing})
+    return results, timing
 
 
 # ---------------------------------------------------------------- command line
@@ -467,12 +476,19 @@ def main(argv=None) -> int:
                                    "config": {k: v for k, v in vars(args).items()}},
                              args.overwrite, resume) as folder:
                 (out / "runs").mkdir(exist_ok=True)
-                summary = folder.close(**sweep(settings, values, out, client, progress))
+                results, timing = run_values(settings, values, out, client, progress)
+                with Signals() as held:     # every value done: the files are completed
+                    summary = folder.close(**assemble(out, settings, results,
+                                                      {"timing": timing}))
     except KeyboardInterrupt as e:     # SIGINT, or SIGTERM (main_guard)
         n = sum(run_path(out, settings["param"], v).exists() for v in values)
         print(f"interrupted: {n} of {len(values)} values done in {out / 'runs'}; "
               "run the same command again to resume", file=sys.stderr)
         return getattr(e, "code", 130)
+    if held.signum is not None:
+        print(f"interrupted after its last value: every file of {out} is complete",
+              file=sys.stderr)
+        return 128 + held.signum
     tm = summary["timing"]
     failed, lost_ = summary["failed"], tm["values_lost"]
     rate = f", {tm['runs_per_s']:.3g} runs/s" if tm["runs_per_s"] else ""

@@ -119,6 +119,26 @@ def test_interrupted_sweep_resumes_without_redoing(tmp_path):
     assert json.loads((out / "sweep.json").read_text())["timing"]["values_resumed"] == 0
 
 
+def test_a_signal_after_the_last_value_lets_every_file_be_written(tmp_path, monkeypatch,
+                                                                   capsys):
+    """SIGINT while the tables and chart are written (every value done): they are written,
+    summary.json says success, exit 130 with a line saying so."""
+    from skfem_beam import sweep as module
+    real = module.assemble
+
+    def signalled(*args, **kwargs):
+        os.kill(os.getpid(), signal.SIGINT)
+        return real(*args, **kwargs)
+    monkeypatch.setattr(module, "assemble", signalled)
+    out = tmp_path / "sweep"
+    assert main(["--values", "10,12", "--transient", "0.2", "--periods", "3", "--workers",
+                 "0", "--no-progress", "--out", str(out)]) == 130
+    assert json.loads((out / "summary.json").read_text())["status"] == "success"
+    assert all((out / name).is_file() for name in OUTPUTS)
+    assert capsys.readouterr().err.endswith(f"interrupted after its last value: every file "
+                                            f"of {out} is complete\n")
+
+
 @pytest.mark.parametrize("args, word", [
     (["--scene", "moon"], "--scene 'moon'"),
     (["--param", "mass"], "--param 'mass'"),

@@ -143,7 +143,7 @@ def outcome(result, data: dict) -> dict:
     }
 
 
-class _Signals:
+class Signals:
     """SIGINT and SIGTERM set a flag, read between chunks: the run stops at a whole chunk,
     not in the middle of a write (a compiled chunk cannot be stopped anyway)."""
 
@@ -206,7 +206,7 @@ def execute(run: Run, options: OutputOptions, summary: dict, series, finish) -> 
         # checkpoint leaves a summary that still names it
         summary = {**summary, "checkpoint_step": int(ck["n"])}
     _note_last_step(run)
-    with _Signals() as stop:
+    with Signals() as stop:
         folder = Folder.open(out, summary, overwrite=options.overwrite, resume=resume)
         try:
             if restart:

@@ -305,6 +305,9 @@ def _csv(fh, header, rows):
         w.writerow(["" if v is None else repr(v) if isinstance(v, float) else v for v in row])
 
 
+PARAM_UNITS = {"omega": "rad/s", "amplitude": "m", "gap": "m", "k2": "m⁴/s²", "L": "m"}
+
+
 def assemble(out: Path, settings: dict, results: list[dict], extra: dict | None = None) -> dict:
     """poincare.csv, runs.csv, bifurcation.png, sweep.json from the finished runs."""
     param = settings["param"]
@@ -329,9 +332,18 @@ def assemble(out: Path, settings: dict, results: list[dict], extra: dict | None 
     summary = {"settings": settings, "values": len(results),
                "failed": sum(r["status"] != "success" for r in results),
                "files": ["poincare.csv", "runs.csv", "bifurcation.png", "runs/"],
-               "units": {"tip_displacement": "m", "tip_velocity": "m/s (backward difference)",
+               "units": {param: PARAM_UNITS.get(param, "the swept value"),
+                         "omega": "rad/s, the support's circular frequency",
+                         "dt": "s, the time step (a whole number of steps per period)",
+                         "k": "the forcing period of the sample (t = k·2π/ω)",
+                         "steps_per_period": "time steps in one forcing period",
+                         "transient_periods": "forcing periods skipped before sampling",
+                         "tip_displacement": "m", "tip_velocity": "m/s (backward difference)",
                          "t": "s", "contact_fraction": "fraction of time steps in contact",
                          "impacts": "contacts that start in the sampled window",
+                         "impacts_per_period": "impacts / the sampled periods",
+                         "impacts_total": "contacts that start in the whole run",
+                         "status": "the run's: success, unstable or failed",
                          "period": "smallest p such that the section repeats every p forcing "
                                    "periods (to 1e-6·gap); 0: none up to periods/2",
                          "zeta": "Rayleigh damping ratio at f1 and f2",

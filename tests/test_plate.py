@@ -129,7 +129,7 @@ def test_support_fixes_the_tangential_derivatives(dofname, support, normal_axis,
 @pytest.mark.parametrize("kwargs, named", [
     ({"nu": 0.5}, "nu=0.5"),
     ({"nu": -1.2}, "nu=-1.2"),
-    ({"h": 0.0}, "h=0.0"),
+    ({"h": 0.0}, "h=0 must be > 0"),
     ({"a": -1.0}, "a=-1.0"),
     ({"edges": {"front": "clamped"}}, "'front'"),
     ({"edges": {"left": "glued"}}, "'glued'"),

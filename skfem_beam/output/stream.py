@@ -114,7 +114,9 @@ def _import_writers(fmt: str) -> None:
 
 
 def prepare(options: OutputOptions) -> Path:
-    """Check the output folder (or the resumed one) before anything is computed; return it."""
+    """Check SKFEM_BEAM_CHARTS and the output folder (or the resumed one) before anything
+    is computed (or compiled); return the folder."""
+    chart_process.wanted()
     if options.resume:
         return _resume_folder(options.resume)
     return check_output_dir(options.out, options.overwrite)

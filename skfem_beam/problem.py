@@ -614,6 +614,7 @@ class BeamProblem:
                              f"degree of freedom on J={J} elements; use a finer mesh")
         free = np.flatnonzero(~value_fixed)   # nodes where u is free: obstacle rows live there
         lo, hi = self.obstacles.bounds(self.nodes[free])
+        self._check_acting(value_fixed)
         if self.supports:
             s_lo, s_hi = self.obstacles.bounds(np.asarray(self.supports, dtype=float))
             bad = (s_lo > 0) | (s_hi < 0)
@@ -624,6 +625,19 @@ class BeamProblem:
         if self.support.moves:
             self._check_moving_support()
         self.obstacles.carried_at(self.nodes[free])   # carried and fixed may not meet
+
+    def _check_acting(self, held: np.ndarray) -> None:
+        """Refuse an obstacle that bounds only nodes an end or a support holds (u = 0
+        there: it would never act, and the run would say nothing)."""
+        for i, part in enumerate(self.obstacles.parts or (self.obstacles,)):
+            lo, hi = part.bounds(self.nodes)
+            bounds = np.isfinite(lo) | np.isfinite(hi)
+            if bounds.any() and not bounds[~held].any():
+                x = self.nodes[np.argmax(bounds)]
+                raise InputError(f"obstacle {i} bounds u only at x={x:g}, where "
+                                 f"{'an end' if x in (0.0, self.beam.L) else 'a support'} "
+                                 "holds the beam: it would never act (move it, or free that "
+                                 "end)")
 
     def _check_kinds(self) -> None:
         """The parts' kinds, each refused in one line saying what goes there."""

@@ -55,14 +55,18 @@ SECTION_DOCS = {
         'two planes: the same on every obstacle), on every obstacle or none (rigid); '
         "summary.json `spring_supports` gives each one's largest deflection and force. "
         'Two planes: g1, g2 bound v; `hole = {...}` at `x` or over `x_from`, `x_to` bounds '
-        '(v, w): `{ radius = r }` (drilled, `centre = [cy, cz]` optional), `{ sides = n, '
+        '(v, w) of the beam\'s axis, so every size is a clearance, not the hole\'s own: '
+        '`{ radius = r }` (drilled: r the radial clearance, e.g. 0.0004 for 0.4 mm; '
+        '`centre = [cy, cz]` optional), `{ sides = n, '
         'radius = r, angle = a }` (a regular polygon, r to its faces, a in rad), `{ lands = '
         'n, land_width = deg, radius = r, angle = deg }` (broached: n lands, arcs of the '
         'circle of radius r each land_width degrees wide, centred at angle + 360k/n degrees, '
         'open lobes between them: a trefoil is 3, a quatrefoil 4), `{ '
         'polygon = [[y, z], ...] }` (convex, counter-clockwise), `{ faces = [[ny, nz, gap], '
-        '...] }` (flat bars: n·(v, w) ≤ gap). Bar: one, `x = 0` or `L`, `stiffness` for an '
-        'elastic obstacle `friction` (μ at this hole, overriding `[contact] friction`).'
+        '...] }` (flat bars: n·(v, w) ≤ gap); `friction` (μ at this hole, overriding '
+        '`[contact] friction`). An obstacle at a node the ends or supports hold is refused '
+        '(it would bound nothing). Bar: one, `x = 0` or `L`, `stiffness` for an elastic '
+        'obstacle.'
     ),
     'damping': (
         '`zeta`, `f1`, `f2` (Hz) or `alpha`, `alpha_K` (Rayleigh), or `modal = ζ` (every mode'
@@ -71,7 +75,8 @@ SECTION_DOCS = {
     ),
     'loads': (
         '`x` (a point force, N) or `distributed = true` (N/m) or `per_mass = true` (m/s², the'
-        " papers' f̃) or `gravity = 9.81`; the time: `amplitude`/`omega`, `value`, `sines`, "
+        " papers' f̃) or `gravity = 9.81`; the time: `amplitude`, `omega` (rad/s), `phase` "
+        '(rad): amplitude·sin(ωt + phase), `value`, `sines`, '
         '`table = "f.csv"`, `random = {rms, f_low, f_high, seed, count}`, `psd = "S.csv"` or '
         '`psd = { table = "S.csv", seed = 1, df = 0.1 }` (a one-sided PSD, columns f in Hz '
         'and S in N²/m²/Hz for a distributed force, synthesised with the seed: '
@@ -88,7 +93,8 @@ SECTION_DOCS = {
         'ũ_t) unless `fixed_frame = false`: no `[initial]` is at rest'
     ),
     'mesh': (
-        '`J`, `element = "hermite"\\|"bspline"`, `nodes = [...]` (non-uniform), `mass = '
+        '`J` (elements, default 19; a node must fall on every obstacle end, support and '
+        'segment step), `element = "hermite"\\|"bspline"`, `nodes = [...]` (non-uniform), `mass = '
         '"consistent"\\|"redistributed"`; bar: `J` (P1 elements), `mass = '
         '"average"\\|"consistent"\\|"lumped"\\|"redistributed"`; both: `massless = '
         '"beta"\\|"quasi-static"` (only with `mass = "redistributed"`, as `--massless`)'
@@ -115,7 +121,8 @@ SECTION_DOCS = {
     ),
     'segments': (
         'a stepped beam instead of `[geometry]`: one `[[segments]]` per part, left to right, '
-        'with `length`, `material = {E, rho}`, `section = {...}` (as `[section]`)'
+        'with `length`, `material = {E, rho}`, `section = {...}` (as `[section]`), each its '
+        'own (no shared `[material]`); the mesh needs a node at every step (`[mesh] J`)'
     ),
     'wear': (
         "Archard's law at the holes (two planes): `coefficient` K (m³/(N·m)), "
@@ -123,7 +130,8 @@ SECTION_DOCS = {
         " `radius` (the tube's outer radius, m; default from a tube or rod `[section]`; only"
         " the depth needs it); summary.json's supports get the wear volume rate and volume,"
         ' per support and per 30° sector, and with `land` the depth spread evenly and per'
-        ' sector'
+        ' sector; the rates are averaged over the whole run, its start included, then '
+        'carried over the service years: run long enough for the start not to count'
     ),
 }
 

@@ -157,6 +157,10 @@ def test_stepped_beam_needs_a_node_at_the_step():
      ["modes needs the BeamProblem (not SemiDiscrete"]),
     (lambda: skfem_beam.solve(BeamProblem(Beam(1.5, k2=282.84), J=4), 1e-4, 0.1),
      ["solve needs a semi-discrete system (beam_system(problem)", "not BeamProblem"]),
+    # a stop where an end holds the beam never acts: it ran silently, 0 impacts
+    (lambda: BeamProblem(Beam(1.5, k2=282.84), Obstacles.stops([1.5], -0.1, 0.1),
+                         ends=("clamped", "pinned"), J=10),
+     ["obstacle 0 bounds u only at x=1.5, where an end holds the beam"]),
 ])
 def test_bad_physical_input_is_refused_with_one_clear_line(make, words):
     with pytest.raises(InputError) as err:

@@ -136,10 +136,10 @@ def test_motion_table_is_relative_to_the_scene_and_stored_for_resume(tmp_path):
 def test_set_overrides_nested_keys_and_array_items(tmp_path):
     f = write(tmp_path, PIPE)
     s = load(f, ["time.dt=1e-5", "obstacles.0.g2=0.05", "mesh.element=bspline",
-                 "ends.right=pinned", "obstacles.1.x=0.7505", "obstacles.1.g1=-0.01",
+                 "ends.right=sliding", "obstacles.1.x=0.7505", "obstacles.1.g1=-0.01",
                  "mesh.J=20"])
     assert s.stepping.dt == 1e-5 and s.problem.element == "bspline"
-    assert s.problem.ends == ("clamped", "pinned")
+    assert s.problem.ends == ("clamped", "sliding")
     lo, hi = s.problem.obstacles.bounds(np.array([0.7505, 1.501]))
     assert lo.tolist() == [-0.01, -0.1] and hi.tolist() == [np.inf, 0.05]
 

@@ -134,6 +134,8 @@ def outcome(result, data: dict) -> dict:
         "max_nodal_violation": result.max_nodal_violation,
         "energy_final": float(data["energy"][-1]) if "energy" in data and data["energy"].size
         else None,
+        "energy_final_J": float(data["energy_J"][-1]) if "energy_J" in data
+        and data["energy_J"].size else None,      # where ρS (or the plate's units) gives J
         # springs (the penalty law): their compression is the supports' deflection, the
         # physics of an elastic support, not a numerical error
         "max_support_deflection": result.max_penetration if result.springs else None,

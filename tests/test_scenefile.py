@@ -851,3 +851,15 @@ def test_units_name_each_column_written_and_no_other(tmp_path, name):
     if name == "tube_round_holes_friction":
         assert units["tip_velocity_w"].endswith("; the second plane's, along z")
         assert "work_friction_J" in units and "tip_velocity" not in units
+
+
+def test_a_hole_radius_like_the_hole_s_own_warns(tmp_path, capsys):
+    """A hole's radius is the clearance round the tube's axis: one as large as the tube
+    (the hole's own radius, written there) warns in one line and runs."""
+    argv = [str(example("tube_round_holes")), "--set", "obstacles.0.hole.radius=0.013",
+            "--set", "time.T=0.005", "--format", "none", "--out", str(tmp_path / "r")]
+    assert exit_code(run_main, argv) == 0
+    err = [e for e in capsys.readouterr().err.splitlines() if e.startswith("warning")]
+    assert err == ["warning: [obstacles.0] hole radius = 0.013 m is 1.4× the tube's outer "
+                   "radius 0.009525 m: it is the radial clearance round the tube's axis "
+                   "(0.0004 for 0.4 mm), not the hole's own radius"]

@@ -15,7 +15,7 @@ from ..errors import InputError
 from ..scheme import Stepping
 from .bar import bar_problem
 from .beam import beam_problem
-from .parts import need, plane_count
+from .parts import need, outer_radius, plane_count
 from .read import Parsed, Tables, read
 from .schema import CONTACT, OUTPUT_DEFAULTS
 
@@ -193,7 +193,7 @@ def wear(scene: Scene):
     if not holes:
         raise InputError("[wear] needs holes (planes = 2 and [[obstacles]] hole = ...): wear "
                          "comes from the normal force times the sliding along a wall")
-    radius = d.get("radius", _outer_radius(scene.data.get("section", {})))
+    radius = d.get("radius", outer_radius(scene.data.get("section", {})))
     if radius is None and "land" in d:
         raise InputError("[wear] radius (m, the tube's outer radius) is needed for the depth "
                          "(land) when [section] is not a tube or a rod")
@@ -201,8 +201,3 @@ def wear(scene: Scene):
     return Wear(given["coefficient"], given["service_years"], d.get("land"), radius)
 
 
-def _outer_radius(section: dict) -> float | None:
-    """A tube's or rod's outer radius (m) from [section], else None."""
-    diameter = section.get("tube", {}).get("outer_diameter") or \
-        section.get("rod", {}).get("diameter")
-    return None if diameter is None else 0.5 * diameter

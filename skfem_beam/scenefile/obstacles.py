@@ -6,7 +6,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..problem import Obstacles
-from .parts import need, plane_count
+from .parts import need, outer_radius, plane_count
 
 
 def _g(value, where: str):
@@ -69,11 +69,25 @@ def _obstacle(o: dict, i: int) -> Obstacles:
     return Obstacles(g1, g2, carried=carried)
 
 
+def _warn_hole_size(items, tube: float | None) -> None:
+    """One warning line for a hole whose radius is half the tube's outer radius or more: a
+    hole's sizes are clearances round the tube's axis, and the hole's own radius written
+    there runs (with a tube rattling over centimetres)."""
+    from ..cli import warn
+    for i, o in items:
+        r = o.get("hole", {}).get("radius") if isinstance(o.get("hole"), dict) else None
+        if tube and isinstance(r, (int, float)) and r >= 0.5 * tube:
+            warn(f"[obstacles.{i}] hole radius = {r:g} m is {r / tube:.2g}× the tube's outer "
+                 f"radius {tube:g} m: it is the radial clearance round the tube's axis "
+                 "(0.0004 for 0.4 mm), not the hole's own radius")
+
+
 def obstacles_and_holes(data: dict) -> tuple[Obstacles, tuple]:
     """The flat obstacles (the first plane's, g1 ≤ v ≤ g2) and the holes."""
     items = list(enumerate(data.get("obstacles", [])))
     mu = data.get("contact", {}).get("friction", 0.0)
     holes = tuple(_hole(o, i, mu) for i, o in items if "hole" in o)
+    _warn_hole_size(items, outer_radius(data.get("section", {})))
     if (mu or any("friction" in o for _, o in items)) and plane_count(data) != 2:
         raise InputError("friction acts along the wall of a hole, in the cross-section: the "
                          "one-plane beam has no tangential direction (planes = 2 and a hole)")

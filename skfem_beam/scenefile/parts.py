@@ -64,3 +64,10 @@ def plane_count(data: dict) -> int:
     if planes not in (1, 2) or isinstance(planes, bool):
         raise InputError(f"planes = {planes!r} must be 1 or 2 (bending planes)")
     return int(planes)
+
+
+def outer_radius(section: dict) -> float | None:
+    """A tube's or rod's outer radius (m) from [section], else None."""
+    diameter = section.get("tube", {}).get("outer_diameter") or \
+        section.get("rod", {}).get("diameter")
+    return None if diameter is None else 0.5 * diameter

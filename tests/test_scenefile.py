@@ -863,3 +863,17 @@ def test_a_hole_radius_like_the_hole_s_own_warns(tmp_path, capsys):
     assert err == ["warning: [obstacles.0] hole radius = 0.013 m is 1.4× the tube's outer "
                    "radius 0.009525 m: it is the radial clearance round the tube's axis "
                    "(0.0004 for 0.4 mm), not the hole's own radius"]
+
+
+
+@pytest.mark.parametrize("argv, line", [
+    (["--set", "time.dt=-1e-5"], "error: scene.toml: [time] dt=-1e-05 must be > 0"),
+    (["--set", "output.frames=0"], "error: scene.toml: [output] frames=0 must be a whole "
+                                   "number ≥ 1"),
+    (["--T", "1e-6"], "error: --T 1e-06: dt=5e-05 must be at most T/2=5e-07"),
+])
+def test_a_bad_time_grid_names_its_key_or_flag(tmp_path, capsys, argv, line):
+    out = tmp_path / "out"
+    out.mkdir()
+    assert_refused(run_main, [str(write(tmp_path, PIPE)), *argv, "--out", str(out / "r")],
+                   line, capsys, out)

@@ -5,7 +5,7 @@ output options and [wear]."""
 from __future__ import annotations
 
 import tempfile
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from .. import methods
@@ -15,7 +15,7 @@ from ..errors import InputError
 from ..scheme import Stepping
 from .bar import bar_problem
 from .beam import beam_problem
-from .parts import need, outer_radius, plane_count
+from .parts import need, outer_radius, plane_count, stepping_of
 from .read import Parsed, Tables, read
 from .schema import CONTACT, OUTPUT_DEFAULTS
 
@@ -173,12 +173,12 @@ def _scene(kind, problem, data, text, files) -> Scene:
                              "takes the consistent mass")
     rows = mesh.get("massless")
     methods.check_massless(rows, mesh.get("mass", "consistent"), "[mesh] massless")
-    scene = Scene(kind, problem, Stepping(t["dt"], t["T"], massless=rows or "beta"), law, k,
-                  contact.get("restitution", 0.0), out, text, files, data, c)
+    stepping = stepping_of(t, out, load_window=t.get("load_window", "forward"),
+                           massless=rows or "beta")
+    scene = Scene(kind, problem, stepping, law, k, contact.get("restitution", 0.0), out, text,
+                  files, data, c)
     scene.beta      # the method's own checks (law, stiffness, restitution, β)
-    stepping = Stepping(t["dt"], t["T"], out["save_every"], out["frames"],
-                        t.get("load_window", "forward"), massless=rows or "beta")
-    return replace(scene, stepping=stepping)
+    return scene
 
 
 def wear(scene: Scene):

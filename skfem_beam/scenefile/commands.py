@@ -113,8 +113,15 @@ def _grid(scene, flags: dict, resume) -> tuple[OutputOptions, object]:
     options = OutputOptions(flags["out"], flags["overwrite"], resume, flags["format"],
                             flags["frames"], flags["save_every"], flags["flush_every"],
                             flags["checkpoint_every"])
-    return options, replace(scene.stepping, T=flags["T"], save_every=options.save_every,
-                            frames=options.frames)
+    try:
+        return options, replace(scene.stepping, T=flags["T"], save_every=options.save_every,
+                                frames=options.frames)
+    except InputError as e:       # a flag's value (the file's own were checked at load)
+        key = str(e).split("=")[0].strip()
+        flag = "T" if key in ("T", "dt", "T/dt") else key    # dt: "must be at most T/2"
+        if not isinstance(flags.get(flag), (int, float)):
+            raise
+        raise InputError(f"--{flag.replace('_', '-')} {flags[flag]:g}: {e}") from None
 
 
 def _spec(scene: Scene, flags: dict, resume) -> RunSpec:

@@ -71,3 +71,17 @@ def outer_radius(section: dict) -> float | None:
     diameter = section.get("tube", {}).get("outer_diameter") or \
         section.get("rod", {}).get("diameter")
     return None if diameter is None else 0.5 * diameter
+
+
+SECTIONS = {"dt": "[time] ", "T": "[time] ", "load_window": "[time] ",
+            "save_every": "[output] ", "frames": "[output] "}
+
+
+def stepping_of(t: dict, out: dict, **more):
+    """The Stepping of [time] and [output], its error lines naming the section."""
+    from ..scheme import Stepping
+    try:
+        return Stepping(t["dt"], t["T"], out["save_every"], out["frames"], **more)
+    except InputError as e:
+        message = str(e)
+        raise InputError(SECTIONS.get(message.split("=")[0], "") + message) from None

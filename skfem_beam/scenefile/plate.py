@@ -18,7 +18,7 @@ from ..errors import InputError
 from ..plate.model import EDGES, ELEMENTS, SUPPORTS, MeshPlate, Plate
 from ..scheme import Stepping
 from .forcing import _time_function
-from .parts import need, warn_implausible
+from .parts import need, stepping_of, warn_implausible
 from .read import Parsed, Tables
 from .schema import OUTPUT_DEFAULTS, PLATE_KEYS
 
@@ -280,6 +280,6 @@ def plate_scene(parsed: Parsed, tables: Tables, dynamic: bool = True) -> PlateSc
     system = plate_system(space, obstacles_of(data, space), loads_of(data, space.plate, tables),
                           initial_of(data), probes)
     out = {**OUTPUT_DEFAULTS, **data.get("output", {})}
-    stepping = Stepping(t["dt"], t["T"], out["save_every"], out["frames"])
+    stepping = stepping_of(t, out)
     return PlateScene("plate", PlateSetup(space, system, probes), stepping, method, out,
                       parsed.text, tables.read, data, tables.meshes)

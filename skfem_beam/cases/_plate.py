@@ -91,8 +91,10 @@ def plate_charts(case: str, system, setup):
         k = int(np.argmax(force)) if np.any(force) else r.frames_t.size - 1
         w = vertex_w(system, r.frames_u[k])     # not vertex_fields: no moments needed here
         points, ((_, cells),) = plate_cells(system)
+        held = (system.x_contact, system.meta["y_contact"], r.frames_force[k] != 0) \
+            if r.frames_force.size else None
         draw(deflection_chart, folder / "deflection.png", points, cells, w,
-             title=f"{case}: w at t = {r.frames_t[k]:.4g} s\n({about})")
+             title=f"{case}: w at t = {r.frames_t[k]:.4g} s\n({about})", held=held)
         return {"max_contact_force_N": float(np.max(data["contact_force_N"], initial=0.0)),
                 "max_contact_area_fraction":
                     float(np.max(data["contact_area_fraction"], initial=0.0))}

@@ -383,8 +383,9 @@ def _contact_statistics(ax2, results: list[dict], label: str) -> None:
     ax2.grid(alpha=0.3)
 
 
-def deflection_chart(path, points, cells, w, title="") -> None:
-    """w over the plate (mm, colour) at one frame, with the mesh's cells drawn."""
+def deflection_chart(path, points, cells, w, title="", held=None) -> None:
+    """w over the plate (mm, colour) at one frame, with the mesh's cells drawn; ``held``:
+    (x, y, in contact) of the obstacles' vertices, drawn hollow, those in contact red."""
     from matplotlib.collections import PolyCollection
     tall = np.ptp(points[:, 1]) > 1.5 * np.ptp(points[:, 0])
     with figure(path, figsize=(5, 6.5) if tall else (7, 5)) as (fig, ax):
@@ -399,3 +400,11 @@ def deflection_chart(path, points, cells, w, title="") -> None:
         ax.set_ylabel("y (m)")
         ax.set_title(title, fontsize=9)
         fig.colorbar(coll, ax=ax, label="w (mm), cell mean")
+        if held is not None and len(held[0]):
+            x, y, touching = (np.asarray(v) for v in held)
+            ax.plot(x, y, "o", ms=3, mfc="none", mec="0.15", mew=0.6,
+                    label="obstacles' vertices")
+            if touching.any():
+                ax.plot(x[touching], y[touching], "o", ms=3.5, color="tab:red",
+                        label="in contact")
+            ax.legend(loc="upper right", fontsize=7, framealpha=0.8)

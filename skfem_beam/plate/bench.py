@@ -26,7 +26,7 @@ import time
 import numpy as np
 import scipy.linalg
 
-from ..contact.registry import W_BUDGET
+from ..contact.registry import Auto
 from ..contact.sparse_qp import COUNTS, SparseCholesky, _one_thread, cholesky_kind
 from ..linalg import Banded, band_solve
 from ..methods import PositionLevel
@@ -64,11 +64,11 @@ def systems(n: int):
 
 
 def setup_row(system) -> dict:
-    """The band, the factor's and step_operators' times (with W and D if W fits in
-    W_BUDGET, else without), and W's and D's bytes."""
+    """The band, the factor's and step_operators' times (with W and D where "auto" builds
+    them: W within contact.registry.W_BUDGET, else without), and W's and D's bytes."""
     A = system.M + 0.5 * DT**2 * system.K
     factor = timed(lambda: Banded(A, factor=True), 3)
-    delassus = 8.0 * system.n * system.C.shape[0] <= W_BUDGET
+    delassus = Auto.before_operators(system.n, system.C) is None     # where auto builds W
     t0 = time.perf_counter()
     ops = step_operators(system, DT, 0.5, delassus=delassus)
     total = time.perf_counter() - t0

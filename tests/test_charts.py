@@ -117,6 +117,28 @@ def test_beam_shapes_show_the_physical_displacement_and_the_stops(monkeypatch, t
     plt.close(store["fig"])
 
 
+def test_elastic_stops_are_drawn_hollow_and_named(monkeypatch, tmp_path):
+    """The penalty law's stops are springs the beam presses into: the command's shapes
+    say so (run.springs), hollow markers and "elastic" in the legend; rigid ones filled."""
+    store = {}
+    monkeypatch.setattr(charts, "figure", lambda *a, **k: kept_figure(store))
+    from skfem_beam.cases import _beam
+    drawn = []
+    monkeypatch.setattr(_beam, "draw", lambda f, path, *a, **k: drawn.append(path.name)
+                        or (f(path, *a, **k) if f is shape_chart else None))
+    for law, elastic in (("penalty", True), ("projection", False)):
+        args = ["--T", "0.05", "--out", str(tmp_path / law)]
+        args += ["--law", "penalty", "--stiffness", "1e7"] if elastic else ["--solver", law]
+        assert point_stops.main(args) == 0
+        stops = [ln for ln in store["ax"].lines if ln.get_marker() in ("^", "v")]
+        assert sorted(ln.get_label() for ln in stops) == [
+            f"obstacle g1 (lower{', elastic' * elastic}) (point stop)",
+            f"obstacle g2 (upper{', elastic' * elastic}) (point stop)"]
+        assert all((ln.get_markerfacecolor() == "none") == elastic for ln in stops)
+        plt.close(store["fig"])
+    assert drawn.count("beam_shapes.png") == 2
+
+
 def test_flat_obstacles_are_lines(monkeypatch, tmp_path):
     r = solve(beam_system(scenes.flat_obstacles(J=20)), dt=1e-3, T=0.05, beta=0.5, frames=5)
     store = {}

@@ -218,7 +218,8 @@ def beam_charts(case, problem, rho_S, stops, extra, observed_x=None, wear=None):
              joules=joules)
         force_chart(folder, data, case, about, rho_S if one else None, suffixes)
         if one:
-            draw(shape_chart, folder / "beam_shapes.png", shapes(run.result()),
+            draw(shape_chart, folder / "beam_shapes.png",
+                 shapes(run.result(), elastic=run.springs),
                  title=f"{case}: displacement ũ(x, t) at saved times ({about})")
         else:
             orbit_charts(folder, data, case, problem, about)

@@ -124,23 +124,26 @@ def compare_chart(path, t, computed: dict, exact: dict, title: str, ylabel: str)
         _frame(ax, "t (s)", ylabel, title, fontsize=9)
 
 
-def _obstacle(ax, x, g, name, marker, color="k", label=True):
+def _obstacle(ax, x, g, name, marker, color="k", label=True, elastic=False):
     """g(x) as a line where it spans an interval, as markers where it is a point stop;
-    one legend entry (NaN: no obstacle; ``label`` False: none)."""
+    one legend entry (NaN: no obstacle; ``label`` False: none).  ``elastic``: the
+    obstacles are springs (the penalty law), which the beam may press into: hollow
+    markers, a dotted line."""
     finite = np.isfinite(g)
     if not finite.any():
         return
     # a run of one finite sample between NaNs is a point stop: a line would not show it
     alone = finite & ~np.r_[False, finite[:-1]] & ~np.r_[finite[1:], False]
-    text = f"obstacle {name} ({'lower' if name.startswith('g1') else 'upper'})" \
-        if label else None
+    side = "lower" if name.startswith("g1") else "upper"
+    text = f"obstacle {name} ({side}{', elastic' if elastic else ''})" if label else None
     if alone.any():
         ax.plot(x[alone], g[alone], ls="none", marker=marker, ms=11, color=color,
+                mfc="none" if elastic else color,
                 label=f"{text} (point stop)" if text else None)
         text = None
     if (finite & ~alone).any():
         ax.plot(x, np.where(alone, np.nan, g), color=color, lw=1.6,
-                ls="--" if name.startswith("g1") else "-.", label=text)
+                ls=":" if elastic else "--" if name.startswith("g1") else "-.", label=text)
 
 
 @dataclass
@@ -156,12 +159,13 @@ class Shapes:
     carried: tuple | None
     phi: np.ndarray | None
     ylim: tuple
+    elastic: bool = False       # the obstacles are springs (the penalty law)
 
 
-def shapes(result, count=14) -> Shapes:
+def shapes(result, count=14, elastic=False) -> Shapes:
     """ũ(x, t_k) = u + h(x)φ(t_k) at ``count`` saved frames of ``result`` (finite ones,
     spread over the run), with the obstacles g1, g2: what ParaView shows, support motion
-    included, for any lifting."""
+    included, for any lifting; ``elastic``: the obstacles are springs."""
     from .fields import sample_line
     line = sample_line(result.system)
     good = np.flatnonzero(np.isfinite(result.frames_u).all(axis=1))
@@ -183,7 +187,7 @@ def shapes(result, count=14) -> Shapes:
             span = [min(span[0], pick(np.nanmin(g), np.nanmax(g))),
                     max(span[1], pick(np.nanmin(g), np.nanmax(g)))]
     pad = 0.08 * (span[1] - span[0]) or 1e-3
-    return Shapes(line.x, t, u, fixed, carried, phi, (span[0] - pad, span[1] + pad))
+    return Shapes(line.x, t, u, fixed, carried, phi, (span[0] - pad, span[1] + pad), elastic)
 
 
 def shape_chart(path, shapes: Shapes, title=""):
@@ -201,9 +205,9 @@ def shape_chart(path, shapes: Shapes, title=""):
             if shapes.carried is not None:
                 for g, name, marker in zip(shapes.carried, ("g1", "g2"), ("^", "v")):
                     _obstacle(ax, shapes.x, g + shapes.phi[k], f"{name} carried", marker,
-                              cmap(norm(tk)), label=k == t.size - 1)
-        _obstacle(ax, shapes.x, shapes.fixed[0], "g1", "^")
-        _obstacle(ax, shapes.x, shapes.fixed[1], "g2", "v")
+                              cmap(norm(tk)), label=k == t.size - 1, elastic=shapes.elastic)
+        _obstacle(ax, shapes.x, shapes.fixed[0], "g1", "^", elastic=shapes.elastic)
+        _obstacle(ax, shapes.x, shapes.fixed[1], "g2", "v", elastic=shapes.elastic)
         ax.set_ylim(*shapes.ylim)
         bar = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax, pad=0.01)
         bar.set_label("t (s)")

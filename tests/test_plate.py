@@ -157,3 +157,26 @@ def test_a_point_off_the_mesh_vertices_is_refused():
     space = plate_space(Plate(nx=2, ny=2))
     with pytest.raises(InputError, match=r"\(0.3, 0.5\)"):
         deflection_at_vertex(space, np.zeros(space.basis.N), 0.3, 0.5)
+
+
+@pytest.mark.parametrize("name", ["bfs", "morley", "argyris"])
+def test_the_elements_are_skfems_to_the_bit(name):
+    """plate.space.MonomialsOnce evaluates the power basis once per point set: the basis
+    (values, gradients, Hessians) and the matrices equal skfem's own element's bit for bit,
+    on the plate's quadrature and on another point set (the moments' vertices)."""
+    from skfem import Basis, ElementQuadBFS, ElementTriArgyris, ElementTriMorley
+    from skfem_beam.plate.space import make_element, plate_mesh, stiffness_matrix
+    plate = Plate(a=1.3, b=0.7, nx=3, ny=2, element=name)
+    mesh = plate_mesh(plate)
+    skfem_element = {"bfs": ElementQuadBFS, "morley": ElementTriMorley,
+                     "argyris": ElementTriArgyris}[name]
+    points = np.array([[0.0, 1.0, 0.0, 0.3], [0.0, 0.0, 1.0, 0.3]])
+    for quadrature in ({}, {"quadrature": (points, np.ones(4))}):
+        ours = Basis(mesh, make_element(name), **quadrature)
+        theirs = Basis(mesh, skfem_element(), **quadrature)
+        for a, b in zip(ours.basis, theirs.basis):
+            (a,), (b,) = a, b       # a DiscreteField: the values, with .grad and .hess
+            for x, y in ((a, b), (a.grad, b.grad), (a.hess, b.hess)):
+                assert np.array_equal(np.asarray(x), np.asarray(y)) and np.ndim(x) >= 2
+    K1, K2 = stiffness_matrix(ours, 1.0, 0.3), stiffness_matrix(theirs, 1.0, 0.3)
+    assert (K1 != K2).nnz == 0 and K1.nnz > 0

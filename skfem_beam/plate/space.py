@@ -1,11 +1,13 @@
 """The plate's finite element space: mesh, element, basis, the dofs each edge's support
 fixes, and the matrices K (bending), M (mass) and a load vector."""
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
 from scipy import sparse
 from skfem import (Basis, BilinearForm, ElementQuadBFS, ElementTriArgyris, ElementTriMorley,
                    LinearForm, MeshQuad, MeshTri, asm)
+from skfem.element.discrete_field import DiscreteField
 from skfem.helpers import dd, ddot, trace
 
 from ..errors import InputError
@@ -69,9 +71,53 @@ def plate_mesh(plate):
     return file_mesh(plate) if isinstance(plate, MeshPlate) else rectangle_mesh(plate)
 
 
+class MonomialsOnce:
+    """scikit-fem's ``ElementGlobal.gbasis`` with each monomial of the power basis evaluated
+    once per set of points, not once per basis function: skfem builds basis function i as
+    Σ_k V[:, k, i] p_k(x) and evaluates every p_k (x^a y^b and its derivatives, up to the
+    Hessian) again for each i: 21 × 21 × 7 evaluations for Argyris, 0.5 s of a Basis on the
+    shipped disk's 216 triangles, 0.04 s once.  The same sums in the same order: the basis
+    is skfem's to the bit (tests/test_plate.py)."""
+
+    _points = None      # (mapping, X, tind) → the power basis at those points
+
+    def gbasis(self, mapping, X, i, tind=None):
+        if tind is None:
+            tind = np.arange(mapping.mesh.t.shape[1])
+        if self.V is None:
+            self._pbasis_init(self.maxdeg, self.dim, self.derivatives, self.tensorial_basis)
+            self.V = np.linalg.inv(self._eval_dofs(mapping.mesh))
+        key = (id(mapping), X.tobytes(), tind.tobytes())
+        if self._points is None or self._points[0] != key:
+            x = mapping.F(X, tind=tind)
+            self._points = (key, x[0].shape,
+                            {diff: [p(*x) for p in ps] for diff, ps in self._pbasis.items()})
+        _, shape, P = self._points
+        V = self.V[tind]
+        U = [np.zeros((self.dim,) * k + shape) for k in range(self.derivatives + 1)]
+        for k in range(self.derivatives + 1):
+            diffs = list(itertools.product(range(self.dim), repeat=k))
+            for itr in range(len(self._pbasis[()])):
+                for diff in diffs:
+                    U[k][diff] += V[:, itr, i][:, None] * P[diff][itr]
+        higher = {f"grad{k + 3}": U[k + 3] for k in range(self.derivatives - 2)}
+        return (DiscreteField(value=U[0], grad=U[1], hess=U[2], **higher),)
+
+
+class BFS(MonomialsOnce, ElementQuadBFS):
+    pass
+
+
+class Morley(MonomialsOnce, ElementTriMorley):
+    pass
+
+
+class Argyris(MonomialsOnce, ElementTriArgyris):
+    pass
+
+
 def make_element(name: str):
-    return {"bfs": ElementQuadBFS, "morley": ElementTriMorley,
-            "argyris": ElementTriArgyris}[name]()
+    return {"bfs": BFS, "morley": Morley, "argyris": Argyris}[name]()
 
 
 def is_fixed(dofname: str, support: str, normal_axis: int | None) -> bool:

@@ -180,3 +180,27 @@ def test_the_elements_are_skfems_to_the_bit(name):
                 assert np.array_equal(np.asarray(x), np.asarray(y)) and np.ndim(x) >= 2
     K1, K2 = stiffness_matrix(ours, 1.0, 0.3), stiffness_matrix(theirs, 1.0, 0.3)
     assert (K1 != K2).nnz == 0 and K1.nnz > 0
+
+
+@pytest.mark.parametrize("element", ["bfs", "morley", "argyris"])
+@pytest.mark.parametrize("edges, motions", [
+    ({}, 3),                                                    # free: w = a + bx + cy
+    ({e: "sliding" for e in ALL_EDGES}, 1),                     # w = a
+    ({"left": "sliding", "right": "sliding"}, 2),               # w = a + cy
+    ({"left": "simply_supported"}, 1),                          # w = bx, about the edge
+    ({"left": "simply_supported", "bottom": "simply_supported"}, 0),
+    ({"left": "clamped"}, 0),
+])
+def test_rigid_motions_the_supports_leave(element, edges, motions):
+    """What a static deflection must refuse: K w = f has no solution while the supports
+    leave the plate a rigid motion (a free plate's static start gave w = −1.9e11 m)."""
+    from skfem_beam.plate.static import rigid_motions, static_deflection
+    from skfem_beam.plate.space import load_vector
+    space = plate_space(Plate(a=0.4, b=1.2, nx=3, ny=5, element=element, edges=edges))
+    assert rigid_motions(space) == motions
+    f = load_vector(space, lambda x, y: np.full_like(x, 100.0))
+    if motions:
+        with pytest.raises(InputError, match="needs edges that hold the plate"):
+            static_deflection(space, f)
+    else:
+        assert np.isfinite(static_deflection(space, f)).all()

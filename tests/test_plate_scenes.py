@@ -107,6 +107,7 @@ def test_fields_read_back_with_the_run_s_deflection(shipped):
 
 
 GOOD = example("plate_on_stops").read_text()
+EDGES = 'left = "clamped"\nright = "clamped"\nbottom = "clamped"\ntop = "clamped"'
 
 
 @pytest.mark.parametrize("old, new, word", [
@@ -126,6 +127,9 @@ GOOD = example("plate_on_stops").read_text()
     ('law = "position"', 'law = "springs"', "law"),
     ('law = "position"', 'law = "penalty"', "stiffness"),
     ("static_pressure = 1.0e5 ", "static_pressure = -1.0e5 ", "initial deflection"),
+    # nothing holds the plate: K w = f has no solution (w was −1.9e11 m)
+    (EDGES, EDGES.replace('"clamped"', '"free"'), "needs edges that hold the plate"),
+    (EDGES, EDGES.replace('"clamped"', '"sliding"'), "rigid body"),
 ])
 def test_bad_plate_scene_one_line_exit_2_nothing_written(tmp_path, capsys, old, new, word):
     assert old in GOOD
@@ -191,3 +195,14 @@ def test_every_plate_key_is_in_docs_plate_md():
             if isinstance(sub, dict) else [section]
         for key in keys:
             assert f"`{key}`" in text, f"[{section}] {key}"
+
+
+def test_an_obstacle_region_may_be_a_line_of_vertices(tmp_path):
+    """docs/plate.md: an obstacle's region may have one side of zero length (a load's may
+    not): [0.2, 0.0, 0.2, 1.2] is the grid line x = 0.2 (nx = 6 on a = 0.4), whose 19
+    vertices less the 2 the clamped edges hold get a row each."""
+    text = GOOD.replace("g1 = -1.75e-4 ", "g1 = -1.75e-4\nregion = [0.2, 0.0, 0.2, 1.2] ")
+    (tmp_path / "line.toml").write_text(text)
+    system = load(tmp_path / "line.toml").problem.system
+    assert system.C.shape[0] == 17
+    assert np.allclose(system.x_contact, 0.2) and np.allclose(system.lo, -1.75e-4)

@@ -14,9 +14,46 @@ def static_deflection(space: PlateSpace, f: np.ndarray) -> np.ndarray:
     if f.shape != (space.basis.N,):
         raise InputError(f"f has shape {f.shape}: a load vector over all {space.basis.N} "
                          "dofs is needed (load_vector(space, p))")
+    if rigid_motions(space):
+        raise InputError("a static deflection needs edges that hold the plate: its free "
+                         "and sliding edges leave it free to move as a rigid body (w = a + "
+                         "bx + cy), so K w = f has no solution; clamp or simply support an "
+                         "edge, or start from rest")
     u = np.zeros(space.basis.N)
     u[free] = spsolve(space.K[free][:, free].tocsc(), f[free])
     return u
+
+
+def rigid_motions(space: PlateSpace) -> int:
+    """How many independent rigid motions w = a + bx + cy the supports leave the plate
+    (0: K is positive definite on the free dofs): the rank that the fixed dofs' values of
+    1, x/L and y/L (:func:`rigid_dofs`) leave out of 3."""
+    if space.fixed_dofs.size == 0:
+        return 3
+    s = np.linalg.svd(rigid_dofs(space)[space.fixed_dofs], compute_uv=False)
+    return 3 - int(np.sum(s > 1e-9 * s[0]))
+
+
+def rigid_dofs(space: PlateSpace) -> np.ndarray:
+    """The dofs of w = 1, x/L, y/L (N × 3, L the plate's size) by the dofs' names: u the
+    value, u_x and u_y the slopes, the second derivatives 0, u_n at an edge's midpoint
+    the slope along a normal of the edge, up to skfem's sign for it (a row's sign does
+    not change the rank rigid_motions takes).  skfem's own L² projection of them is off
+    by 1e-9 to 1e-6 (the dofs' scales differ), too much to tell a zero by."""
+    basis, L = space.basis, space.plate.size
+    mesh, names = basis.mesh, basis.elem.dofnames
+    R = np.zeros((basis.N, 3))
+    x, y = mesh.p
+    rows = {"u": (np.ones_like(x), x / L, y / L), "u_x": (0.0, 1.0 / L, 0.0),
+            "u_y": (0.0, 0.0, 1.0 / L)}
+    for k in range(basis.elem.nodal_dofs):
+        if names[k] in rows:
+            R[basis.nodal_dofs[k]] = np.column_stack(np.broadcast_arrays(*rows[names[k]]))
+    if basis.elem.facet_dofs:
+        t = mesh.p[:, mesh.facets[1]] - mesh.p[:, mesh.facets[0]]
+        n = np.array([t[1], -t[0]]) / np.hypot(t[0], t[1])
+        R[basis.facet_dofs[0], 1:] = n.T / L
+    return R
 
 
 def deflection_at_vertex(space: PlateSpace, u: np.ndarray, x: float, y: float) -> float:

@@ -46,27 +46,44 @@ def _inside(region, x, y, tol: float) -> np.ndarray:
     return (x >= x0 - tol) & (x <= x1 + tol) & (y >= y0 - tol) & (y <= y1 + tol)
 
 
-def checked_region(what: str, region, plate, area: bool):
+def checked_region(what: str, region, plate, area: bool, written=None):
     """``region`` = (x0, x1, y0, y1) (m) on the plate's bounding box, x0 ≤ x1 and y0 ≤ y1
-    (``area``: both strict; else one side may be zero, a line of vertices, but not both:
-    a point is ``points``), or None; else one line naming it and the order, which is not
-    a scene file's [x0, y0, x1, y1]."""
+    (``area``: both strict, a load's; else one side may be zero, a line of vertices, but
+    not both: a point is ``points``), or None; else one line naming it and the order.
+    ``written``: the region as a scene file writes it, [x0, y0, x1, y1], ``what`` its key."""
     if region is None:
         return None
-    order = "(x0, x1, y0, y1) in m (a scene file writes [x0, y0, x1, y1])"
+    if written is None:
+        label, order = f"{what} region={region!r}", \
+            "(x0, x1, y0, y1) in m (a scene file writes [x0, y0, x1, y1])"
+    else:
+        label, order = f"{what} = {written!r}", "[x0, y0, x1, y1] in m"
     try:
         x0, x1, y0, y1 = (check_finite("region", v) for v in region)
     except (TypeError, ValueError, InputError):
-        raise InputError(f"{what} region={region!r} must be four numbers {order}") from None
+        raise InputError(f"{label} must be four numbers {order}") from None
     bx0, bx1, by0, by1 = plate.box
     tol = 1e-9 * plate.size
     sides = (x1 - x0, y1 - y0)
     if min(sides) < 0 or (max(sides) == 0 if not area else min(sides) == 0):
         need = "x0 < x1 and y0 < y1" if area else "x0 ≤ x1 and y0 ≤ y1, not one point"
-        raise InputError(f"{what} region={region!r} needs {need}: {order}")
+        raise InputError(f"{label} needs {need}: {order}")
     if x0 < bx0 - tol or y0 < by0 - tol or x1 > bx1 + tol or y1 > by1 + tol:
-        raise InputError(f"{what} region={region!r} is off {plate.outline()}: {order}")
+        raise InputError(f"{label} is off {plate.outline()}: {order}")
     return x0, x1, y0, y1
+
+
+def region_vertices(space, region) -> np.ndarray:
+    """Whether each vertex lies in ``region`` (checked, (x0, x1, y0, y1); None: all)."""
+    x, y = space.vertices
+    return _inside(region, x, y, 1e-9 * space.plate.size)
+
+
+def region_holds_plate(space, region) -> bool:
+    """Whether some of the plate lies in ``region`` (checked; one of its quadrature points
+    of the mesh does): a pressure there loads it."""
+    x, y = space.basis.mapping.F(space.basis.X)
+    return bool(_inside(region, x, y, 1e-9 * space.plate.size).any())
 
 
 @dataclass(frozen=True)
@@ -87,7 +104,7 @@ class PlateObstacle:
             where[[vertex_index(space, px, py) for px, py in self.points]] = True
         else:
             region = checked_region("PlateObstacle", self.region, space.plate, area=False)
-            where = _inside(region, x, y, 1e-9 * space.plate.size)
+            where = region_vertices(space, region)
             if not where.any():
                 raise InputError(f"PlateObstacle region={self.region!r} holds no vertex of "
                                  "the mesh")
@@ -114,6 +131,9 @@ class Pressure:
         """b = ∫ p·1_region φ (N), all dofs."""
         tol = 1e-9 * space.plate.size
         region = checked_region("Pressure", self.region, space.plate, area=True)
+        if region is not None and not region_holds_plate(space, region):
+            raise InputError(f"Pressure region={self.region!r} holds no part of the plate "
+                             "(no point of its mesh lies in it)")
         return load_vector(space, lambda x, y: _values(self.p, x, y)
                            * _inside(region, x, y, tol))
 

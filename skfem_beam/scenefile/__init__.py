@@ -12,8 +12,8 @@ the file's shape: an unknown section or key is refused in one line naming it and
 allowed ones, and a value the schema marks as a number (N), or an array of numbers
 (ListOf), that is not one (``"0.5m"``) in one line naming its key path (with the index
 inside an array: ``output.probes[0]``).  Relative paths (tables) are relative to the
-scene file.  The keys are :data:`BEAM_KEYS` and :data:`BAR_KEYS` (docs/scene_files.md,
-generated from them).
+scene file.  The keys are :data:`BEAM_KEYS`, :data:`BAR_KEYS` and :data:`PLATE_KEYS`
+(docs/scene_files.md, docs/plate.md, generated from them).
 
 Choices a TOML file forces:
 
@@ -38,10 +38,11 @@ The modules, each one job, in the order a file goes through them:
   inference (contact law, β, output options, [wear]) as one :class:`Scene`;
 - ``commands``: the ``run`` and ``modes`` subcommands.
 """
-from .schema import BAR_KEYS, BEAM_KEYS, KINDS, N, ListOf, NumberOr, NumberOrWord  # noqa: F401
+from .schema import (BAR_KEYS, BEAM_KEYS, KINDS, PLATE_KEYS, N, ListOf, NumberOr,  # noqa: F401
+                     NumberOrWord)
 from .read import apply_set, example
 from .build import Scene, load
 from .commands import modes_main, run_main
 
 __all__ = ["Scene", "load", "apply_set", "run_main", "modes_main", "example", "BEAM_KEYS",
-           "BAR_KEYS"]
+           "BAR_KEYS", "PLATE_KEYS"]

@@ -114,10 +114,11 @@ def _mesh_plate(data: dict, base) -> MeshPlate:
     if not isinstance(name, str):
         raise InputError(f"[geometry] mesh = {name!r} must be a file name (a string)")
     grid = data.get("mesh", {})
-    element = check_choice("[mesh] element", grid.get("element", "argyris"), ELEMENTS)
+    element = grid.get("element", "argyris")
     if element == "bfs":
         raise InputError("[mesh] element = 'bfs' needs the rectangle's grid ([geometry] a, "
                          "b); a mesh file's plate takes morley or argyris")
+    element = check_choice("[mesh] element", element, tuple(e for e in ELEMENTS if e != "bfs"))
     if "nx" in grid or "ny" in grid:
         raise InputError("[mesh] nx, ny are the rectangle's grid; a mesh file's plate has "
                          "its own triangles")
@@ -137,19 +138,15 @@ def _mesh_plate(data: dict, base) -> MeshPlate:
                      element=element)
 
 
-def _region(value, plate: Plate, where: str) -> tuple:
+def _region(value, plate: Plate, where: str, area: bool) -> tuple:
     """region = [x0, y0, x1, y1] (m) on the plate (a mesh file's: in its bounding box),
-    as (x0, x1, y0, y1)."""
+    as (x0, x1, y0, y1) (plate.system.checked_region: ``area``, a load's, has both sides;
+    an obstacle's may be a line of vertices)."""
+    from ..plate.system import checked_region
     if len(value) != 4:
         raise InputError(f"{where} = {value!r} must be [x0, y0, x1, y1] (m)")
     x0, y0, x1, y1 = value
-    bx0, bx1, by0, by1 = plate.box
-    tol = 1e-9 * plate.size
-    if not (x0 < x1 and y0 < y1):
-        raise InputError(f"{where} = {value!r} needs x0 < x1 and y0 < y1")
-    if x0 < bx0 - tol or y0 < by0 - tol or x1 > bx1 + tol or y1 > by1 + tol:
-        raise InputError(f"{where} = {value!r} is off {plate.outline()} (m)")
-    return (x0, x1, y0, y1)
+    return checked_region(where, (x0, x1, y0, y1), plate, area, written=value)
 
 
 def _point(value, plate: Plate, where: str) -> tuple[float, float]:
@@ -168,7 +165,7 @@ def _point(value, plate: Plate, where: str) -> tuple[float, float]:
 def obstacles_of(data: dict, space) -> list:
     """[[obstacles]] g1, g2 (m, at least one) over region or at points (a point must be
     a vertex of the mesh)."""
-    from ..plate.system import PlateObstacle, vertex_index
+    from ..plate.system import PlateObstacle, region_vertices, vertex_index
     out = []
     for i, d in enumerate(data.get("obstacles", [])):
         where = f"obstacles.{i}"
@@ -176,8 +173,10 @@ def obstacles_of(data: dict, space) -> list:
             raise InputError(f"[{where}] needs g1 and/or g2 (m)")
         if "region" in d and "points" in d:
             raise InputError(f"[{where}] give region or points, not both")
-        region = _region(d["region"], space.plate, f"{where}.region") if "region" in d \
-            else None
+        region = _region(d["region"], space.plate, f"{where}.region", area=False) \
+            if "region" in d else None
+        if region is not None and not region_vertices(space, region).any():
+            raise InputError(f"{where}.region = {d['region']!r} holds no vertex of the mesh")
         points = tuple(_point(p, space.plate, f"{where}.points[{k}]")
                        for k, p in enumerate(d.get("points", [])))
         for k, (x, y) in enumerate(points):
@@ -195,15 +194,19 @@ def _vertex(space, x: float, y: float, where: str, vertex_index) -> int:
         raise InputError(f"{where} = [{x:g}, {y:g}]: {e}") from None
 
 
-def loads_of(data: dict, plate: Plate, tables: Tables) -> list:
+def loads_of(data: dict, space, tables: Tables) -> list:
     """[[loads]] pressure (Pa) × a(t) (a time function of the beam's; none: a = 1),
     over region (none: the whole plate)."""
-    from ..plate.system import Pressure, one
+    from ..plate.system import Pressure, one, region_holds_plate
     out = []
     for i, d in enumerate(data.get("loads", [])):
         where = f"loads.{i}"
         p = need(d, ("pressure",), where)["pressure"]
-        region = _region(d["region"], plate, f"{where}.region") if "region" in d else None
+        region = _region(d["region"], space.plate, f"{where}.region", area=True) \
+            if "region" in d else None
+        if region is not None and not region_holds_plate(space, region):
+            raise InputError(f"{where}.region = {d['region']!r} holds no part of the plate "
+                             "(no point of its mesh lies in it)")
         time = {k: d[k] for k in TIME_FORMS if k in d}
         if "omega" in time and "amplitude" not in time:
             time["amplitude"] = 1.0          # the pressure is the amplitude
@@ -277,7 +280,7 @@ def plate_scene(parsed: Parsed, tables: Tables, dynamic: bool = True) -> PlateSc
         raise InputError("[time] needs dt and T (s)")
     method = method_of(data)
     probes = probes_of(data, space)
-    system = plate_system(space, obstacles_of(data, space), loads_of(data, space.plate, tables),
+    system = plate_system(space, obstacles_of(data, space), loads_of(data, space, tables),
                           initial_of(data), probes)
     out = {**OUTPUT_DEFAULTS, **data.get("output", {})}
     stepping = stepping_of(t, out)

@@ -37,9 +37,11 @@ from pathlib import Path
 import numpy as np
 
 from .errors import InputError
+from .lock import check_not_busy
 from .parser import Parser
 
 SERIES, SUMMARY, IMPACTS = "timeseries.csv", "summary.json", "impacts.csv"
+CHECKPOINT = "checkpoint.npz"       # what --resume reads (output.checkpoint)
 FORMATS = ("npz", "mat")
 
 
@@ -283,7 +285,8 @@ def _matlab_value(value):
 
 def variables(run: SavedRun, matlab: bool = True) -> dict:
     """The run as flat named arrays: series columns under their own names, field arrays
-    as ``fields_<name>`` (frames × points) with ``fields_t`` and ``fields_x``, impacts as
+    as ``fields_<name>`` (frames × points) with ``fields_t``, ``fields_x`` and (a plate's)
+    ``fields_y``, impacts as
     ``impacts_<column>``, other tables as ``<stem>_<column>``; with ``matlab`` every name
     made MATLAB-valid (``probe_0.6_displacement`` → ``probe_0_6_displacement``)."""
     out: dict = {}
@@ -296,6 +299,8 @@ def variables(run: SavedRun, matlab: bool = True) -> dict:
     if run.fields is not None:
         put("fields_t", run.fields.t)
         put("fields_x", run.fields.x)
+        if np.any(run.fields.points[:, 1]):         # a plate's vertices
+            put("fields_y", run.fields.points[:, 1])
         for k, v in run.fields.arrays.items():
             put(f"fields_{k}", v)
     for prefix, table in [("impacts", run.impacts or {})] + list(run.tables.items()):
@@ -314,9 +319,13 @@ def export(folder, to: str, out=None) -> Path:
     folder = Path(folder)
     if not folder.is_dir():             # before --out, which defaults to a file inside it
         raise InputError(f"{folder} is not a run folder: no such folder")
+    check_not_busy(folder)              # a run writing it: its files are half there
     out = Path(out) if out is not None else folder / f"{folder.resolve().name}.{to}"
     if out.suffix != f".{to}":
         raise InputError(f"--out {out} must end in .{to} for --to {to}")
+    if out.resolve() == (folder / CHECKPOINT).resolve():
+        raise InputError(f"--out {out} is the run's own checkpoint (what --resume reads): "
+                         "choose another file")
     if not out.parent.is_dir():
         raise InputError(f"--out {out}: folder {out.parent} does not exist")
     run = read_run(folder)

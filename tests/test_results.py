@@ -172,7 +172,7 @@ def test_npz_export_reads_back(folder, tmp_path):
         for k, v in saved.series.items():
             assert np.array_equal(z[k], v)
         assert np.array_equal(z["fields_t"], saved.fields.t)
-        assert np.array_equal(z["fields_x"], saved.fields.x)
+        assert np.array_equal(z["fields_x"], saved.fields.x) and "fields_y" not in z
         assert np.array_equal(z["fields_g2"], saved.fields["g2"], equal_nan=True)
         assert np.array_equal(z["fields_displacement"], saved.fields["displacement"])
 
@@ -273,3 +273,48 @@ def test_a_field_not_in_the_folder_says_which_are(folder):
     with pytest.raises(KeyError, match="'displacement_v' is not a field of this run; it "
                                        "holds: displacement, "):
         run.fields["displacement_v"]
+
+
+def test_export_does_not_overwrite_the_checkpoint(folder, capsys):
+    """`--out DIR/checkpoint.npz` replaced what --resume reads (a stopped run could no
+    longer be resumed): refused, the checkpoint as it was."""
+    before = (folder / "checkpoint.npz").read_bytes()
+    argv = [str(folder), "--to", "npz", "--out", str(folder / "checkpoint.npz")]
+    assert exit_code(export_main, argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "the run's own checkpoint" in err, err
+    assert (folder / "checkpoint.npz").read_bytes() == before
+
+
+def test_export_of_a_folder_a_run_is_writing_is_refused(folder, tmp_path, capsys):
+    """A run holds DIR/.lock while it writes: its files are half there, so export waits
+    for it as a resume does."""
+    run = tmp_path / "live"
+    shutil.copytree(folder, run)
+    holder = subprocess.Popen(
+        [sys.executable, "-c", "import fcntl, os, sys, time; fd = os.open(sys.argv[1], "
+         "os.O_RDWR | os.O_CREAT); fcntl.flock(fd, fcntl.LOCK_EX); print('held', flush=True);"
+         " time.sleep(60)", str(run / ".lock")], stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "held"
+        assert exit_code(export_main, [str(run), "--to", "npz"]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "is being written by another run" in err, err
+        assert not (run / "live.npz").exists()
+    finally:
+        holder.kill()
+        holder.wait()
+    assert exit_code(export_main, [str(run), "--to", "npz"]) == 0     # once it has ended
+
+
+def test_a_plate_export_places_its_fields(tmp_path):
+    """A plate's field arrays are per vertex: the export gives the vertices' x and y."""
+    from skfem_beam.scenefile import example, run_main
+    out = tmp_path / "plate"
+    assert exit_code(run_main, [str(example("plate_on_stops")), "--out", str(out),
+                                "--T", "0.002", "--format", "xdmf"]) == 0
+    saved = read_run(out)
+    with np.load(export(out, "npz")) as z:
+        assert np.array_equal(z["fields_x"], saved.fields.points[:, 0])
+        assert np.array_equal(z["fields_y"], saved.fields.points[:, 1])
+        assert z["fields_w"].shape == (saved.fields.t.size, z["fields_y"].size)

@@ -17,11 +17,11 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
+from ..results import CHECKPOINT  # noqa: F401 (the name a folder's reader knows too)
 from ..scheme import Run
 from .folder import SUMMARY, _plain
 from .series import SeriesFile, file_crc
 
-CHECKPOINT = "checkpoint.npz"
 CHECKPOINT_FORMAT = 3       # 3: impact events hold their first step off (State.impact)
 BUFFERS = ("obs", "obsv", "energy", "work", "lam")   # saved series (not in the Run's checkpoint)
 

@@ -13,7 +13,6 @@ blocks the next one); a second run or resume into the same folder is refused.
 """
 from __future__ import annotations
 
-import errno
 import fcntl
 import json
 import os
@@ -29,55 +28,12 @@ import orjson
 from .._version import __version__
 from ..errors import (EXIT_INPUT, EXIT_SOLVER, EXIT_UNSTABLE,  # noqa: F401 (here too)
                       InputError, Interrupted, SolverError)
+from ..lock import LOCK, check_not_busy, lock_folder, release  # noqa: F401 (here too)
 
 SUMMARY = "summary.json"
-LOCK = ".lock"          # flock'ed by the one process writing the folder
 RESERVE = ".reserve"    # a little disk kept back, freed to write the final summary
 OURS = (LOCK, RESERVE)
-
-
-_HELD: dict[Path, int] = {}     # folder → descriptor of its locked .lock, in this process
 OPENED: list[Path] = []         # the folders this process opened (for the interrupt line)
-
-
-def _busy(out: Path) -> InputError:
-    return InputError(f"{out} is being written by another run (its {LOCK} is locked); "
-                      "wait for it to end or choose another folder")
-
-
-def lock_folder(out: Path) -> None:
-    """Take the exclusive lock of folder ``out`` (which exists) for this process, or refuse
-    (InputError naming the folder) when another process holds it.  Held until
-    :func:`release`, or the process ends."""
-    key = Path(out).resolve()
-    if key in _HELD:
-        return
-    fd = os.open(key / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError as e:
-        os.close(fd)
-        if e.errno in (errno.EWOULDBLOCK, errno.EAGAIN):
-            raise _busy(out) from None
-        raise
-    _HELD[key] = fd
-
-
-def release(out=None) -> None:
-    """Drop the lock of ``out`` (every lock this process holds when None)."""
-    keys = list(_HELD) if out is None else [Path(out).resolve()]
-    for key in keys:
-        fd = _HELD.pop(key, None)
-        if fd is not None:
-            os.close(fd)     # closing the descriptor releases the flock
-
-
-def check_not_busy(out: Path) -> None:
-    """Refuse a folder another process is writing (probe its lock, hold nothing)."""
-    if Path(out).resolve() in _HELD or not (Path(out) / LOCK).exists():
-        return
-    lock_folder(out)
-    release(out)
 
 
 def _make_locked(out: Path) -> None:

@@ -175,13 +175,29 @@ def section_plan(settings: dict, value: float) -> tuple[float, int, int, float]:
 
 
 def check_values(settings: dict, values: list[float]) -> None:
-    """Fail before any run: every value must give a valid scene and forcing period."""
+    """Fail before any run: the solver must exist, and every value must give a valid
+    scene, forcing period and time grid."""
+    from .contact import resolve
+    try:
+        resolve(settings["solver"])
+    except InputError as e:
+        raise InputError(f"--solver: {e}") from None
     for v in values:
         try:
-            section_plan(settings, v)
+            stepping_of(settings, v)
             build_problem(settings, v, damping_of(settings, v))
         except InputError as e:
-            raise InputError(f"--values: {e}") from None
+            raise InputError(f"--values {v:g}: {e}") from None
+
+
+def stepping_of(settings: dict, value: float):
+    """The time grid of ``value``'s run: the transient's periods and the sampled ones,
+    a save at each period's end; T half a step short of n·dt, so that the run takes
+    ceil(T/dt) = n steps whatever the round-off."""
+    from .scheme import Stepping
+    dt, spp, ntr, _ = section_plan(settings, value)
+    n_total = (ntr + settings["periods"]) * spp
+    return Stepping(dt, (n_total - 0.5) * dt, save_every=spp, frames=1)
 
 
 # ---------------------------------------------------------------- one task
@@ -194,7 +210,7 @@ def run_value(settings: dict, value: float) -> dict:
     are read when the run reaches the end of the transient, and subtracted.
     """
     from .methods import PositionLevel
-    from .scheme import Stepping, drive
+    from .scheme import drive
     from .semidiscrete import beam_system
     t_start, cpu_start = time.perf_counter(), time.process_time()
     dt, spp, ntr, omega = section_plan(settings, value)
@@ -209,9 +225,8 @@ def run_value(settings: dict, value: float) -> dict:
     try:
         out["damping"] = damping_of(settings, value)
         system = beam_system(build_problem(settings, value, out["damping"]))
-        # T half a step short of n·dt: the run takes ceil(T/dt) = n steps whatever the round-off
         run = PositionLevel(settings["solver"], beta=settings["beta"]).build(
-            system, Stepping(dt, (n_total - 0.5) * dt, save_every=spp, frames=1))
+            system, stepping_of(settings, value))
         pre = {"impacts": 0, "contacts": 0}
         while not run.done and run.n < n_trans:
             run.advance(min(run.n + CHUNK, n_trans))
@@ -280,13 +295,18 @@ def load_run(out: Path, settings: dict, value: float) -> dict | None:
         result = json.loads(path.read_text())
     except (OSError, ValueError):
         return None   # unreadable: run it again
-    if result.get("settings") != settings:
-        theirs = result.get("settings") or {}
+    same_settings(out, result.get("settings"), settings)
+    return result
+
+
+def same_settings(out: Path, theirs, settings: dict) -> None:
+    """Refuse a sweep folder ``out`` whose runs were made with other ``settings``."""
+    if theirs != settings:
+        theirs = theirs if isinstance(theirs, dict) else {}
         diff = [k for k in settings if theirs.get(k) != settings[k]]
         raise InputError(f"--out {out} holds a sweep with other settings "
                          f"({', '.join(diff) or 'format'} differ); use another --out or "
                          "--overwrite")
-    return result
 
 
 def check_out(out, overwrite: bool) -> Path:
@@ -296,6 +316,19 @@ def check_out(out, overwrite: bool) -> Path:
     if overwrite or not (out / "runs").is_dir():
         check_output_dir(out, overwrite)
     return out
+
+
+def stored_settings(out: Path) -> dict | None:
+    """The settings of the sweep in ``out``: its summary.json's, else a run's (None:
+    neither is readable)."""
+    for path in [out / "summary.json", *sorted((out / "runs").glob("*.json"))]:
+        try:
+            settings = json.loads(path.read_text()).get("settings")
+        except (OSError, ValueError, AttributeError):
+            continue
+        if isinstance(settings, dict):
+            return settings
+    return None
 
 
 def _csv(fh, header, rows):
@@ -482,6 +515,9 @@ def main(argv=None) -> int:
     serial = (scheduler is None and workers == 0) or not args.overwrite and all(
         run_path(out, settings["param"], v).exists() for v in values)   # nothing left to run
     resume = not args.overwrite and (out / "runs").is_dir()
+    stored = stored_settings(out) if resume else None
+    if stored is not None:  # its runs are named by their parameter: others' would mix in
+        same_settings(out, stored, settings)
     try:
         with contextlib.nullcontext() if serial else dask_client(workers, scheduler) as client:
             with Folder.open(out, {"case": "sweep", "settings": settings,

@@ -165,6 +165,9 @@ def test_a_signal_after_the_last_value_lets_every_file_be_written(tmp_path, monk
     (["--periods", "x"], "--periods"),
     (["--zeta", "-0.01"], "zeta=-0.01 must be ≥ 0"),
     (["--zeta", "nan"], "zeta=nan"),
+    # each value's run failed alone, and the sweep said "success" with exit 0
+    (["--solver", "foo"], "--solver: solver='foo' is not one of: auto"),
+    (["--values", "8,1e-9"], "--values 1e-09: T/dt"),
 ])
 def test_bad_input_one_line_no_output(tmp_path, capsys, args, word):
     base = ["--values", "8,9", "--out", str(tmp_path / "sweep")]
@@ -179,6 +182,22 @@ def test_bad_input_through_python_m(tmp_path):
                                 "in MATLAB); write linspace(5, 40, 200) for 200 values from 5 "
                                 "to 40, or a comma list 5,10,20")
     assert not list(tmp_path.iterdir())
+
+
+def test_a_sweep_of_another_parameter_is_refused_in_its_folder(tmp_path, capsys):
+    """Runs are named by their parameter (omega=8.0.json): a --param gap sweep resumed in
+    an omega sweep's folder ran beside them and replaced its tables.  Refused, unchanged."""
+    out = tmp_path / "sweep"
+    base = ["--transient", "0.2", "--periods", "3", "--workers", "0", "--no-progress",
+            "--out", str(out)]
+    assert exit_code(main, ["--values", "8,9"] + base) == 0
+    before = {f.name: f.read_bytes() for f in out.rglob("*") if f.is_file()}
+    capsys.readouterr()
+    assert exit_code(main, ["--param", "gap", "--values", "0.05,0.1"] + base) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "other settings (param, fixed differ)" in err, err
+    assert {f.name: f.read_bytes() for f in out.rglob("*") if f.is_file()} == before
+    assert exit_code(main, ["--values", "8,9"] + base) == 0     # its own: resumed
 
 
 def test_refuses_a_folder_that_is_not_a_sweep(tmp_path, capsys):

@@ -258,6 +258,24 @@ def _as_given(k: str, v) -> str:
     return " ".join(f"--{k.replace('_', '-')} {x}" for x in values)
 
 
+def _same_command(out: Path, summary: dict, prog: str) -> None:
+    """Refuse a folder another command wrote (its flags are not this command's): a scene
+    file's run (its config holds the scene) is `python -m skfem_beam run`'s, a case's is
+    its own module's (``prog`` skfem_beam.cases.<case>)."""
+    case, theirs = prog.rsplit(".", 1)[-1], summary.get("case")
+    scene = "scene_text" in summary.get("config", {})
+    if (prog.endswith(" run") if scene else theirs == case):
+        return
+    if scene:
+        how = f"python -m skfem_beam run --resume {out}"
+    elif isinstance(theirs, str) and theirs.isidentifier():
+        how = f"python -m skfem_beam.cases.{theirs} --resume {out}"
+    else:
+        how = "the command that wrote it"
+    raise InputError(f"--resume {out}: a run of {theirs!r}, not of {prog}: resume it with "
+                     f"{how}")
+
+
 def stored_args(args, parser, argv=None):
     """For ``--resume DIR``: the flags of the run stored in DIR/summary.json, once DIR is
     locked and its summary, checkpoint and rows agree.  ``--T`` may grow (extending the
@@ -269,6 +287,7 @@ def stored_args(args, parser, argv=None):
     out = _resume_folder(args.resume)
     lock_folder(out)
     summary = read_summary(out)
+    _same_command(out, summary, parser.prog)
     ck = read_checkpoint(out) if has_checkpoint(out) else None
     config = summary["config"]
     given = _given(parser, argv)

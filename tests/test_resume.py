@@ -349,3 +349,25 @@ def test_a_run_again_from_step_0_keeps_nothing_of_the_stopped_run(tmp_path, caps
                                                       "timeseries.csv"]
     run_again_from_step_0(point_stops.main, out, capsys)
     assert_same_run(out, ref)
+
+
+def test_a_folder_another_command_wrote_names_the_command_that_resumes_it(tmp_path,
+                                                                           capsys):
+    """A case's --resume took a scene-file run's folder (or another case's) and failed on
+    a flag the user never gave ("--massless 'beta' applies to ..."): now one line naming
+    the command that wrote it, the folder untouched."""
+    from skfem_beam.cases import flat_obstacles
+    scene, case = tmp_path / "scene", tmp_path / "case"
+    assert exit_code(run_main, [str(skfem_beam.scenefile.example("point_stops")), "--out",
+                                str(scene), "--set", "time.T=0.01"]) == 0
+    assert exit_code(point_stops.main, ["--T", "0.01", "--out", str(case)]) == 0
+    capsys.readouterr()
+    for main, folder, how in (
+            (point_stops.main, scene, f"python -m skfem_beam run --resume {scene}"),
+            (flat_obstacles.main, case,
+             f"python -m skfem_beam.cases.point_stops --resume {case}")):
+        before = {f.name: f.read_bytes() for f in folder.iterdir() if f.is_file()}
+        assert exit_code(main, ["--resume", str(folder), "--T", "0.02"]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and err.rstrip().endswith(how), err
+        assert {f.name: f.read_bytes() for f in folder.iterdir() if f.is_file()} == before

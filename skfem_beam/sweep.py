@@ -303,10 +303,11 @@ def same_settings(out: Path, theirs, settings: dict) -> None:
     """Refuse a sweep folder ``out`` whose runs were made with other ``settings``."""
     if theirs != settings:
         theirs = theirs if isinstance(theirs, dict) else {}
-        diff = [k for k in settings if theirs.get(k) != settings[k]]
+        diff = [f"{k} {settings[k]!r} where it has {theirs.get(k)!r}" for k in settings
+                if theirs.get(k) != settings[k]]
         raise InputError(f"--out {out} holds a sweep with other settings "
-                         f"({', '.join(diff) or 'format'} differ); use another --out or "
-                         "--overwrite")
+                         f"({'; '.join(diff) or 'its format differs'}); use another --out "
+                         "or --overwrite")
 
 
 def check_out(out, overwrite: bool) -> Path:

@@ -195,7 +195,8 @@ def test_a_sweep_of_another_parameter_is_refused_in_its_folder(tmp_path, capsys)
     capsys.readouterr()
     assert exit_code(main, ["--param", "gap", "--values", "0.05,0.1"] + base) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "other settings (param, fixed differ)" in err, err
+    assert err.count("\n") == 1 and "other settings (param 'gap' where it has 'omega'; " \
+        "fixed {'omega'" in err, err
     assert {f.name: f.read_bytes() for f in out.rglob("*") if f.is_file()} == before
     assert exit_code(main, ["--values", "8,9"] + base) == 0     # its own: resumed
 

@@ -292,6 +292,9 @@ SPOIL = {
         (d / "timeseries.csv").read_bytes()[:-500])),
     "edited series": ("are not the ones the checkpoint was written with",
                       lambda d: edit_row(d / "timeseries.csv", 100)),
+    "no series": ("timeseries.csv is missing", lambda d: (d / "timeseries.csv").unlink()),
+    "no summary": ("no summary.json there: its checkpoint.npz alone cannot say how",
+                   lambda d: (d / "summary.json").unlink()),
 }
 
 

@@ -138,8 +138,11 @@ def _check_rows(folder: Path, ck: dict) -> None:
     csv = Path(folder) / "timeseries.csv"
     size = csv.stat().st_size if csv.is_file() else -1
     nbytes = int(ck["nbytes"])
+    if size < 0:
+        raise InputError(f"{csv} is missing: the checkpoint's {int(ck['rows'])} rows are "
+                         "not there; cannot resume")
     if size < nbytes:
-        raise InputError(f"{csv} has {max(size, 0)} bytes, fewer than the {nbytes} of the "
+        raise InputError(f"{csv} has {size} bytes, fewer than the {nbytes} of the "
                          f"checkpoint's {int(ck['rows'])} rows; cannot resume")
     if file_crc(csv, nbytes) != int(ck["crc"]):
         raise InputError(f"{csv}: its first {int(ck['rows'])} rows are not the ones the "
@@ -180,8 +183,10 @@ def _resume_folder(out) -> Path:
     checkpoint alone cannot say how to rebuild the run)."""
     out = Path(out)
     if not (out / SUMMARY).is_file():
-        raise InputError(f"--resume {out}: no {SUMMARY} (nor {CHECKPOINT}) there: not the "
-                         "folder of a run, nothing to resume from")
+        why = (f"its {CHECKPOINT} alone cannot say how to rebuild the run"
+               if (out / CHECKPOINT).is_file() else "not the folder of a run")
+        raise InputError(f"--resume {out}: no {SUMMARY} there: {why}; nothing to resume "
+                         "from")
     return out
 
 

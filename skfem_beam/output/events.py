@@ -143,6 +143,10 @@ def spring_supports(table: dict, obstacles, stiffness, damping) -> list[dict]:
     return out
 
 
+# impact_statistics' contact_fraction, as summary.json's units say it
+EPISODES = ("of the run's time: each episode from its first state in contact to its first "
+            "state off, one still open at the end to its last state (so one step less than "
+            "the run's contact_fraction, which counts every step that ends in contact)")
 # peak_force's unit under exact contact
 RIGID_PEAK = ("; rigid (exact) contact: the largest one-step force, which grows as dt "
               "shrinks: quote the impulse")
@@ -199,7 +203,7 @@ def _write_impacts(folder, run, units, scale, sign, obstacles, last, wear) -> tu
     stats["units"] = {"t_start": "s", "t_end": "s", "x": "m", "bound": "1 = g1 (lower), "
                       "2 = g2 (upper)", "velocity": "m/s", "peak_force": f, "impulse": i,
                       "max_violation": "m", "open": "1 = not over at the last state",
-                      "contact_fraction": "of the run's time"}
+                      "contact_fraction": EPISODES}
     if planes == 2:
         from ..scheme.beta import disk_rows
         stats["supports"] = support_statistics(table, run, scale, duration, last * run.dt,

@@ -206,3 +206,46 @@ def test_an_obstacle_region_may_be_a_line_of_vertices(tmp_path):
     system = load(tmp_path / "line.toml").problem.system
     assert system.C.shape[0] == 17
     assert np.allclose(system.x_contact, 0.2) and np.allclose(system.lo, -1.75e-4)
+
+
+SHAPED = """
+[[obstacles]]
+g1 = { poly = [[-5e-4, 0.0, 1e-3], [0.0], [1e-3]], about = [0.2, 0.6] }
+[[obstacles]]
+g2 = { x = [0.0, 0.2, 0.4], y = [0.0, 1.2], g = [[1e-3, 2e-3, 4e-3], [1e-3, 2e-3, 4e-3]] }
+region = [0.0, 0.0, 0.4, 1.2]
+"""
+
+
+def test_plate_obstacles_as_polynomials_and_tables(tmp_path):
+    """docs/plate.md: g1, g2 of a plate's obstacle may be Σ c_ij (x − x0)^i (y − y0)^j
+    ({poly, about}) or a table on an x, y grid, bilinear ({x, y, g}), as a beam's are
+    polynomials and tables of x; at every vertex with a row, the bounds are those
+    functions (a paraboloid's bowl under the plate, a ramp above it)."""
+    text = GOOD.replace("[[obstacles]]\ng1 = -1.75e-4", SHAPED + "[[obstacles]]\ng1 = -1.75e-4")
+    assert text != GOOD
+    (tmp_path / "shaped.toml").write_text(text)
+    system = load(tmp_path / "shaped.toml").problem.system
+    x, y = system.x_contact, system.meta["y_contact"]
+    bowl = -5e-4 + 1e-3 * (y - 0.6) ** 2 + 1e-3 * (x - 0.2) ** 2
+    assert np.array_equal(system.lo, np.maximum(bowl, -1.75e-4))
+    assert np.allclose(system.hi, np.interp(x, [0.0, 0.2, 0.4], [1e-3, 2e-3, 4e-3]),
+                       rtol=0, atol=1e-18)
+    assert np.ptp(system.hi) > 2e-3 and system.C.shape[0] == 85
+
+
+@pytest.mark.parametrize("g2, word", [
+    ("{ x = [0.0, 0.2], y = [0.0, 1.2], g = [[1e-4, 2e-4], [1e-4, 2e-4]] }",
+     "lies outside its table's x [0, 0.2]"),
+    ("{ x = [0.0, 0.2, 0.4], y = [0.0, 1.2], g = [[1e-4, 2e-4], [1e-4, 2e-4]] }",
+     "g needs one row per y (2) of one value per x (3)"),
+    ("{ x = [0.0, 0.4, 0.2], y = [0.0, 1.2], g = [[1, 2, 3], [1, 2, 3]] }", "must increase"),
+    ("{ poly = [[1e-4]], about = [0.5] }", "about a point [x0, y0]"),
+    ("{ x = [0.0, 0.4], g = [1e-4, 2e-4] }", "obstacles.0.g2.g[0] = 0.0001"),
+    ('"1e-4 + x"', "must be a number or a table ({ poly"),
+])
+def test_bad_plate_obstacle_shape_one_line(tmp_path, capsys, g2, word):
+    shaped = SHAPED.replace(SHAPED.splitlines()[4], f"g2 = {g2}")
+    text = GOOD.replace("[[obstacles]]\ng1 = -1.75e-4", shaped + "[[obstacles]]\ng1 = -1.75e-4")
+    assert_scene_refused(tmp_path, capsys, {"plate.toml": text}, "plate.toml",
+                         word.replace("obstacles.0", "obstacles.1"))

@@ -108,8 +108,9 @@ class PlateObstacle:
             if not where.any():
                 raise InputError(f"PlateObstacle region={self.region!r} holds no vertex of "
                                  "the mesh")
-        lo = np.where(where, _values(self.g1, x, y), -np.inf)
-        hi = np.where(where, _values(self.g2, x, y), np.inf)
+        lo, hi = np.full(x.size, -np.inf), np.full(x.size, np.inf)
+        lo[where] = _values(self.g1, x[where], y[where])    # g where it acts only: a table
+        hi[where] = _values(self.g2, x[where], y[where])    # need not cover the plate
         return lo, hi
 
 

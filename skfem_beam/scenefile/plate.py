@@ -183,8 +183,65 @@ def obstacles_of(data: dict, space) -> list:
             _vertex(space, x, y, f"{where}.points[{k}]", vertex_index)
         if "points" in d and not points:
             raise InputError(f"[{where}] points = [] names no vertex")
-        out.append(PlateObstacle(d.get("g1", -np.inf), d.get("g2", np.inf), region, points))
+        g1, g2 = (_g(d[k], f"{where}.{k}") if k in d else default
+                  for k, default in (("g1", -np.inf), ("g2", np.inf)))
+        out.append(PlateObstacle(g1, g2, region, points))
     return out
+
+
+def _g(value, where: str):
+    """A plate's obstacle g(x, y): a number; { poly = [[c00, c01, ...], [c10, ...], ...],
+    about = [x0, y0] }, Σ c_ij (x − x0)^i (y − y0)^j (row i: the power of x); or a table
+    { x = [...], y = [...], g = [[...], ...] }, one row of g per y and one column per x,
+    bilinear between them (a vertex outside the grid is refused where it is used)."""
+    if not isinstance(value, dict):
+        return value
+    if set(value) in ({"poly"}, {"poly", "about"}):
+        c = [[float(v) for v in row] for row in value["poly"]]
+        about = value.get("about", (0.0, 0.0))
+        if not c or not all(c) or len(about) != 2:
+            raise InputError(f"{where} = {{poly, about}}: poly is rows of numbers (row i: "
+                             "the power of x) and about a point [x0, y0] (m)")
+        x0, y0 = (float(v) for v in about)
+
+        def poly(x, y):
+            dx, dy = np.asarray(x, dtype=float) - x0, np.asarray(y, dtype=float) - y0
+            return sum(cij * dx**i * dy**j for i, row in enumerate(c)
+                       for j, cij in enumerate(row)) + 0.0 * dx
+        return poly
+    if set(value) == {"x", "y", "g"}:
+        return _grid(value, where)
+    raise InputError(f"{where} must be a number, {{ poly = [[c00, c01, ...], [c10, ...]], "
+                     f"about = [x0, y0] }} or {{ x = [...], y = [...], g = [[...], ...] }} "
+                     f"(got keys {', '.join(value)})")
+
+
+def _grid(value, where: str):
+    """The table g(x, y) = { x, y, g }, bilinear (scipy's RegularGridInterpolator)."""
+    from scipy.interpolate import RegularGridInterpolator
+    xs, ys = (np.asarray(value[k], dtype=float) for k in ("x", "y"))
+    g = value["g"]
+    if (xs.ndim != 1 or ys.ndim != 1 or min(xs.size, ys.size) < 2
+            or np.any(np.diff(xs) <= 0) or np.any(np.diff(ys) <= 0)):
+        raise InputError(f"{where} = {{x, y, g}}: x and y must increase, two values each "
+                         "at least")
+    if len(g) != ys.size or any(len(row) != xs.size for row in g):
+        raise InputError(f"{where} = {{x, y, g}}: g needs one row per y ({ys.size}) of one "
+                         f"value per x ({xs.size})")
+    table = RegularGridInterpolator((ys, xs), np.asarray(g, dtype=float))
+    tol = 1e-9 * max(np.ptp(xs), np.ptp(ys))
+
+    def grid(x, y):
+        x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+        off = (x < xs[0] - tol) | (x > xs[-1] + tol) | (y < ys[0] - tol) | (y > ys[-1] + tol)
+        if np.any(off):
+            k = np.flatnonzero(off)[0]
+            raise InputError(f"{where}: the vertex ({x.flat[k]:g}, {y.flat[k]:g}) lies outside "
+                             f"its table's x [{xs[0]:g}, {xs[-1]:g}], y [{ys[0]:g}, "
+                             f"{ys[-1]:g}]")
+        return table(np.column_stack([np.clip(y, ys[0], ys[-1]).ravel(),
+                                      np.clip(x, xs[0], xs[-1]).ravel()])).reshape(x.shape)
+    return grid
 
 
 def _vertex(space, x: float, y: float, where: str, vertex_index) -> int:

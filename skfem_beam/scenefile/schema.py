@@ -111,6 +111,12 @@ class ContactKeys(dict):
 CONTACT = ContactKeys(law=V, stiffness=N, restitution=N, friction=N, theta=N)
 G = NumberOr({"poly": NUMBERS, "about": N, "x": NUMBERS, "g": NUMBERS},   # the rest: obstacles._g
              "{ poly = [...] } or { x = [...], g = [...] }")
+# a plate's obstacle: a number, Σ c_ij (x − x0)^i (y − y0)^j or a table on an x, y grid
+# (the rest: plate._g)
+G_PLATE = NumberOr({"poly": ListOf(NUMBERS), "about": NUMBERS, "x": NUMBERS, "y": NUMBERS,
+                    "g": ListOf(NUMBERS)},
+                   "{ poly = [[...], ...], about = [x0, y0] } or { x = [...], y = [...], "
+                   "g = [[...], ...] }")
 HOLE = {"radius": N, "sides": N, "angle": N, "centre": NUMBERS,     # the rest: holes.py
         "polygon": ListOf(NUMBERS), "faces": ListOf(NUMBERS), "lands": N, "land_width": N}
 
@@ -152,7 +158,8 @@ PLATE_KEYS = {
     "material": {"E": N, "rho": N, "nu": N},
     "edges": Names("left", "right", "bottom", "top"),
     "mesh": {"nx": N, "ny": N, "element": V},
-    "obstacles": [{"g1": N, "g2": N, "region": NUMBERS, "points": ListOf(NUMBERS)}],
+    "obstacles": [{"g1": G_PLATE, "g2": G_PLATE, "region": NUMBERS,
+                   "points": ListOf(NUMBERS)}],
     "loads": [{"pressure": N, "region": NUMBERS, **TIME}],
     "initial": {"static_pressure": N, "velocity": N},
     "time": {"dt": N, "T": N, "beta": N},

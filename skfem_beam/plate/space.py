@@ -87,12 +87,12 @@ class MonomialsOnce:
         if self.V is None:
             self._pbasis_init(self.maxdeg, self.dim, self.derivatives, self.tensorial_basis)
             self.V = np.linalg.inv(self._eval_dofs(mapping.mesh))
-        key = (id(mapping), X.tobytes(), tind.tobytes())
-        if self._points is None or self._points[0] != key:
-            x = mapping.F(X, tind=tind)
-            self._points = (key, x[0].shape,
+        key = (X.tobytes(), tind.tobytes())
+        if self._points is None or self._points[0] is not mapping or self._points[1] != key:
+            x = mapping.F(X, tind=tind)         # (the mapping kept: its id stays its own)
+            self._points = (mapping, key, x[0].shape,
                             {diff: [p(*x) for p in ps] for diff, ps in self._pbasis.items()})
-        _, shape, P = self._points
+        _, _, shape, P = self._points
         V = self.V[tind]
         U = [np.zeros((self.dim,) * k + shape) for k in range(self.derivatives + 1)]
         for k in range(self.derivatives + 1):

@@ -3,20 +3,21 @@ coulomb_lands: the arc as a round hole's contact, a lobe's line as a face, a lob
 as two faces): one contact's exact local solve, full lands as the round hole with
 friction, μ = 0 as the frictionless broached run, no node out of K, the cone and the
 dissipation at every step, and the energy identity with the friction's work."""
+import json
 import math
 from dataclasses import replace
 
 import numpy as np
 import pytest
 
-from conftest import assert_exact_with_friction, random_broached
+from conftest import assert_exact_with_friction, exit_code, random_broached
 from skfem_beam import methods
 from skfem_beam.contact.lands import land_split
 from skfem_beam.contact.round_hole_friction import (CORNER, FALLBACK, FRICTIONLESS, SEPARATE,
                                                     RoundHoleFriction, coulomb_lands)
 from skfem_beam.holes import Hole, HoleAt, land_excess
 from skfem_beam.problem import Beam, BeamProblem, Damping, Load, Material, Plane, Section
-from skfem_beam.scenefile import example, load
+from skfem_beam.scenefile import example, load, run_main
 from skfem_beam.scheme import Run, Stepping, solve
 from skfem_beam.scheme.beta import BetaScheme
 from skfem_beam.semidiscrete import beam_system
@@ -168,3 +169,25 @@ def test_the_friction_scene_in_broached_holes_closes_its_energy_identity():
     for x in (0.5, 1.0):
         assert excess(TREFOIL, orbit(r, x)).max() <= 1e-12 * R
         assert np.hypot(*orbit(r, x).T).max() > 1.01 * R       # into a lobe
+
+
+def test_a_broached_hole_wears_where_its_lands_are(tmp_path):
+    """The wear per sector follows the wall's normal: in a trefoil hole (three 40° lands at
+    0°, 120°, 240°) the tube bears on a land's arc or, from a lobe's corner, on a land's
+    edge; the lobes have no metal.  Binned by the node's angle, 70 % of the volume fell in
+    sectors wholly inside the lobes (the deepest one too)."""
+    out = tmp_path / "tref"
+    assert exit_code(run_main, [str(example("tube_trefoil_holes")), "--set", "time.T=0.2",
+                                "--set", "wear.coefficient=1e-14", "--set",
+                                "wear.service_years=40", "--set", "wear.land=0.019",
+                                "--out", str(out), "--format", "none"]) == 0
+    supports = json.loads((out / "summary.json").read_text())["impact_statistics"]["supports"]
+    lands = [(np.radians(c - 20), np.radians(c + 20)) for c in (0, 120, -120)]
+    for s in supports:
+        sectors = s["wear"]["sectors"]
+        on_land = [any(k["from_rad"] < b and k["to_rad"] > a for a, b in lands)
+                   for k in sectors]
+        assert all(k["volume"] == 0.0 for k, land in zip(sectors, on_land) if not land)
+        assert sum(k["volume"] for k in sectors) == pytest.approx(s["wear"]["volume"],
+                                                                  rel=1e-12)
+        assert s["wear"]["volume"] > 0 and sum(on_land) == 6

@@ -473,8 +473,8 @@ def track_holes(ops, st, step, p, lands, friction):
 def hole_kinematics(pair, Nc, nodes, at, force, tallies, step, dt, p, lands, friction):
     """Two planes, after state step+1: every row's node position, its impact angle and
     velocities when a contact starts, and its work rates' sums (State.pos, rowwork,
-    sectors: |F_n||v_t|Δt with F_n the force's normal part, in the sector of the node's
-    angle).  ``nodes``: Ops' (Np, Ni, Nx); ``at``: (uⁿ⁺¹, φ(t_{n+1})); ``force``:
+    sectors: |F_n||v_t|Δt with F_n the force's normal part, in the sector the wall's
+    normal points to).  ``nodes``: Ops' (Np, Ni, Nx); ``at``: (uⁿ⁺¹, φ(t_{n+1})); ``force``:
     State's (mu, dy, y_cur, lo, hi); ``tallies``: State's (work, rowwork, impact, pos,
     sectors).  ``lands``: None (no broached hole: their code is not compiled), or Ops.Nc;
     ``friction``: None (no row with Coulomb's μ in Nc's FRICTION_COLUMN: the friction
@@ -512,7 +512,13 @@ def hole_kinematics(pair, Nc, nodes, at, force, tallies, step, dt, p, lands, fri
             vy = (p[1] - pos[j, 1]) / (2.0 * dt)
             w = f / (dt * dt) * abs(-vx * ny + vy * nx) * dt
             rowwork[j, 1] += w
-            k = int((np.arctan2(p[3], p[2]) + np.pi) / (2.0 * np.pi) * SECTORS)
+            # the sector the wall's normal points to: in a round hole the node's angle; on
+            # a face or a broached hole's land edge (the node in a lobe's corner) the face's
+            if Nc[j, 4] == 0.0 and Nc[j, 5] == 0.0 and (lands is None or Nc[j, 6] <= 0.0):
+                angle = np.arctan2(p[3], p[2])
+            else:
+                angle = np.arctan2(ny, nx)
+            k = int((angle + np.pi) / (2.0 * np.pi) * SECTORS)
             sectors[j, min(max(k, 0), SECTORS - 1)] += w
         pos[j, 0], pos[j, 1] = pos[j, 2], pos[j, 3]
         pos[j, 2], pos[j, 3] = p[0], p[1]

@@ -52,7 +52,7 @@ from .beta import (disk_rows, friction_of, hole_arrays, observers, penetration_s
 from ..contact.friction import MAX_SWEEPS, nsgs
 from .kernels import (EVENT_COLUMNS, FAILED, FRICTION, IMPACT_FIELDS, ITERATIONS, ROW0,
                       STOPPED_AT, UNSTABLE, Inputs, Series, csr_product, track_holes,
-                      track_impacts)
+                      track_impacts, violation)
 from .operators import csr_arrays, load_norms, step_operators
 from .stepping import Stepping
 
@@ -91,6 +91,8 @@ def mj_record(n, ops, st, out):
     stats = st.stats
     for r in range(st.y_cur.size):
         stats[0] = max(stats[0], st.lo[r] - st.y_cur[r], st.y_cur[r] - st.hi[r])
+    for r in ops.disks:     # round holes: beyond the circle (the box is the disk's square)
+        stats[0] = max(stats[0], violation(ops.pair, None, st.lo, st.hi, st.y_cur, r))
     for r in range(st.slo.size):
         s = 0.0
         for q in range(ops.Sp[r], ops.Sp[r + 1]):

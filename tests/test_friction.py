@@ -449,3 +449,17 @@ def test_moreau_jean_reports_its_penetration_beyond_the_circle(tmp_path):
     assert beyond > 1.5e-5                       # measured 1.707e-5 at t = 0.3997
     assert run.summary["max_nodal_violation"] == pytest.approx(beyond, rel=1e-9)
     assert run.summary["max_nodal_violation"] == max(run.impacts["max_violation"])
+
+
+@pytest.mark.parametrize("mu, word", [("-0.3", "[contact] friction=-0.3 must be ≥ 0"),
+                                      ("nan", "[contact] friction=nan must be a finite")])
+def test_a_bad_scene_friction_is_refused_where_every_hole_sets_its_own(tmp_path, capsys,
+                                                                      mu, word):
+    """[contact] friction is checked where a hole takes it; with every hole's own μ it was
+    taken by none and a negative or NaN μ ran without a word."""
+    from conftest import assert_scene_refused
+    text = example("tube_round_holes_friction").read_text()
+    text = text.replace("hole = { radius = 0.0004 }", "hole = { radius = 0.0004 }\nfriction = 0.2")
+    text = text.replace("friction = 0.3 ", f"friction = {mu} ")
+    assert text.count("friction = 0.2") == 2 and f"friction = {mu} " in text
+    assert_scene_refused(tmp_path, capsys, {"t.toml": text}, "t.toml", word)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..checks import check_finite
 from ..errors import InputError
 from ..problem import Obstacles
 from .parts import need, outer_radius, plane_count
@@ -86,6 +87,8 @@ def obstacles_and_holes(data: dict) -> tuple[Obstacles, tuple]:
     """The flat obstacles (the first plane's, g1 ≤ v ≤ g2) and the holes."""
     items = list(enumerate(data.get("obstacles", [])))
     mu = data.get("contact", {}).get("friction", 0.0)
+    if check_finite("[contact] friction", mu) < 0:     # also where every hole sets its own
+        raise InputError(f"[contact] friction={mu:g} must be ≥ 0 (Coulomb's μ)")
     holes = tuple(_hole(o, i, mu) for i, o in items if "hole" in o)
     _warn_hole_size(items, outer_radius(data.get("section", {})))
     if (mu or any("friction" in o for _, o in items)) and plane_count(data) != 2:

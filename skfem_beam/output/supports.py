@@ -125,10 +125,10 @@ def support_statistics(table: dict, run, scale: float, duration: float, T: float
             "contact_fraction": union_length(table["t_start"][ev], table["t_end"][ev])
             / duration if ev.size and duration > 0 else 0.0,
             "impact_angle_histogram": {"edges_rad": edges.tolist(), "counts": counts.tolist()},
-            "impact_work_rate": -scale * float(work[rows, 0].sum()) / T,
+            "impact_work_rate": -scale * float(work[rows, 0].sum()) / T + 0.0,  # not -0.0
             "normal_work_rate": _normal_work_rate(run, rows, scale, T)}
         if record.friction_tallied:
-            entry["friction_work_rate"] = -scale * float(work[rows, 2].sum()) / T
+            entry["friction_work_rate"] = -scale * float(work[rows, 2].sum()) / T + 0.0
         if wear is not None:
             entry["wear"] = support_wear(run, x, scale, T, wear)
         out.append(entry)

@@ -294,7 +294,9 @@ def units(rho_S, system, friction: bool = False) -> dict:
     terms = WORK_TERMS + (("friction",) if friction else ())
     works = ("work lost in damping (≥ 0)", "work of the loads (the support's motion included)",
              "work of the contact forces (≤ 0 for exact contact)",
-             "work of Coulomb friction (≤ 0)")
+             "work of Coulomb friction (≤ 0; Moreau–Jean's, taken on each step's "
+             "displacement while Coulomb's law holds for v^{n+1}, may rise on a step whose "
+             "slip reverses, its total ≤ 0)")
     out = {"t": "s", "displacement": "m",
            "tip_displacement": f"m, {held}{frame}",
            "tip_velocity": "m/s, backward difference of tip_displacement"

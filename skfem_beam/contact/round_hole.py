@@ -260,7 +260,7 @@ def _polish(D, yf, lo, hi, kind, lands, piece, mu, tol):
         y = yf + D @ mu_new
         F = np.zeros(k)
         J = np.zeros((k, k))
-        i = 0
+        i = k - k       # 0, typed int64: a literal 0 compiled _piece_rows a second time
         while i < k:
             j = act[i]
             if kind[j] == 0:                 # a box row on its bound

@@ -208,6 +208,8 @@ def read_run(folder, fields: str = "auto") -> SavedRun:
     """
     if fields not in ("auto", "xdmf", "vtu", "none"):
         raise InputError(f"fields={fields!r} is not one of: auto, xdmf, vtu, none")
+    if not isinstance(folder, (str, Path)):
+        raise InputError(f"read_run needs a run folder's path, not {folder!r}")
     folder = Path(folder)
     if not folder.is_dir():
         raise InputError(f"{folder} is not a run folder: no such folder")

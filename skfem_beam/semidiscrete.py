@@ -135,6 +135,9 @@ def beam_system(problem: BeamProblem, samples_per_element: int = 20) -> SemiDisc
     """Discretise a beam scene (the papers' V_h, K_h of (8), loads with the lifting), in one
     bending plane or two (skfem_beam.two_planes): the planes' systems stacked
     block-diagonally, every obstacle a row at a node (skfem_beam.constraints)."""
+    if not isinstance(problem, BeamProblem):
+        raise InputError(f"beam_system needs a BeamProblem, not {type(problem).__name__} "
+                         "(a plate's system is skfem_beam.plate.plate_system)")
     one_plane = plane_problems(problem)
     spaces = [beam_space(p) for p in one_plane]
     rows = constraint_rows(problem, spaces[0])

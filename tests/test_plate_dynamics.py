@@ -216,3 +216,49 @@ def test_modes_and_statics_check_their_arguments():
     ("u_yy", 1, False), ("u_n", 0, True), ("u_xx", 0, False)])
 def test_a_sliding_edge_fixes_the_dofs_with_one_normal_derivative(dofname, normal_axis, fixed):
     assert is_fixed(dofname, "sliding", normal_axis) is fixed
+
+
+def _boom(x, y):
+    return 1 / 0
+
+
+@pytest.mark.parametrize("call, message", [
+    # silent wrong answers before: a NaN point read vertex 0, NaN data ran to a NaN energy
+    (lambda S: deflection_at_vertex(S, np.zeros(S.basis.N), np.nan, 0.5), "x=nan"),
+    (lambda S: plate_system(S, observe=[(np.nan, np.nan)]), "x=nan must be a finite"),
+    (lambda S: plate_system(S, loads=[Pressure(lambda x, y: np.nan * x)]),
+     r"Pressure p is nan at \(.*\): it must be a finite number there"),
+    (lambda S: plate_system(S, initial=PlateInitial(v0=lambda x, y: np.nan * x)),
+     "PlateInitial v0 is nan"),
+    # errors from inside numpy, the user's own function or the scheme before
+    (lambda S: plate_system(S, loads=[Pressure(lambda x, y: np.ones(3))]),
+     "Pressure p: its function of x, y at the 784 points must return one number per point"),
+    (lambda S: plate_system(S, obstacles=[PlateObstacle(g1=_boom)]),
+     "PlateObstacle g1: .* gave ZeroDivisionError"),
+    (lambda S: Pressure(1e3, time=lambda t: 1.0), "Pressure time must be vectorised"),
+    (lambda S: PlateObstacle(points=(0.5, 0.5)), r"points=\(0.5, 0.5\) must be vertices"),
+    (lambda S: plate_system(S, observe=(0.5, 0.5)), "observe=.* must be vertices"),
+    (lambda S: PlateObstacle(g1="abc"), "g1='abc' must be a number"),
+    (lambda S: plate_system(S, obstacles=None), "obstacles= must be a list"),
+])
+def test_python_values_are_checked_in_one_line(call, message):
+    S = plate_space(Plate(nx=4, ny=4))
+    with pytest.raises(InputError, match=message):
+        call(S)
+    # points as an array of rows is one point stop ("ambiguous truth value" before)
+    stop = PlateObstacle(g1=-1e-3, points=np.array([[0.5, 0.5]]))
+    assert plate_system(S, obstacles=[stop]).C.shape == (1, 64)
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda: Plate(a=None), "plate side a=None is not a number"),
+    (lambda: Plate(b=np.inf), "plate side b=inf must be a finite number"),
+    (lambda: Plate(nx=[4, 4]), r"plate nx=\[4, 4\] must be a whole number ≥ 1"),
+    (lambda: beam_system(Plate()), "beam_system needs a BeamProblem, not Plate"),
+    (lambda: plate_space("x"), "plate_space needs a Plate or a MeshPlate"),
+    (lambda: full_dofs(plate_system(plate_space(Plate(nx=2, ny=2))), np.zeros(3)),
+     "its last axis must be the system's"),
+])
+def test_plate_api_calls_check_their_arguments(call, message):
+    with pytest.raises(InputError, match=message):
+        call()

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..checks import check_count, check_positive
 from ..errors import InputError
 
 
@@ -77,6 +78,8 @@ def _read(path: Path):
 def read_plate_mesh(path, source: str | None = None) -> PlateMesh:
     """The plate's mesh in the file ``path`` (``source``: the name as written, for the
     summary and the error lines)."""
+    if not isinstance(path, (str, Path)):
+        raise InputError(f"read_plate_mesh needs a file name, not {path!r}")
     path = Path(path)
     m = _read(path)
     tri = [b.data for b in m.cells if b.type == "triangle"]
@@ -112,6 +115,7 @@ def disk(radius: float, rings: int, boundary: str = "rim") -> PlateMesh:
     6k vertices (k = 1..rings, radius·k/rings), Delaunay triangles, the outer ring's lines
     named ``boundary``: the mesh of the shipped plate_disk.msh and of the tests."""
     from scipy.spatial import Delaunay
+    radius, rings = check_positive("disk radius", radius), check_count("disk rings", rings)
     xy = [np.zeros((1, 2))]
     for k in range(1, rings + 1):
         angle = np.arange(6 * k) * 2 * np.pi / (6 * k)
@@ -129,6 +133,11 @@ def write_msh(mesh: PlateMesh, path) -> None:
     each boundary's lines as a named physical line, so that :func:`read_plate_mesh` reads
     back the same vertices, triangles and names."""
     import meshio
+    if not isinstance(mesh, PlateMesh):
+        raise InputError(f"write_msh needs a PlateMesh (disk(...), read_plate_mesh(...)), "
+                         f"not {mesh!r}")
+    if not Path(path).parent.is_dir():
+        raise InputError(f"write_msh: the folder of {path} does not exist")
     names = list(mesh.boundaries)
     lines = [mesh.boundaries[k].T for k in names]
     tags = [np.full(len(c), i + 1) for i, c in enumerate(lines)]

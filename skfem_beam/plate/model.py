@@ -2,7 +2,7 @@
 (:class:`MeshPlate`), its material, the support of each edge and the element."""
 from dataclasses import dataclass, field
 
-from ..checks import check_finite, check_positive
+from ..checks import check_count, check_finite, check_positive
 from ..errors import InputError
 
 EDGES = ("left", "right", "bottom", "top")
@@ -22,8 +22,10 @@ class _Plate:
         self.h = check_positive("plate thickness h", self.h)
         self.E = check_positive("plate E", self.E)
         self.rho = check_positive("plate rho", self.rho)
-        if not -1.0 < check_finite("plate nu", self.nu) < 0.5:
+        nu = check_finite("plate nu", self.nu)
+        if not -1.0 < nu < 0.5:
             raise InputError(f"plate nu={self.nu!r} must lie in (-1, 0.5)")
+        self.nu = nu
 
     @property
     def size(self) -> float:
@@ -82,14 +84,14 @@ class Plate(_Plate):
 
     def __post_init__(self):
         self._check_section()
-        if not (self.a > 0 and self.b > 0):
-            raise InputError(f"plate sides a={self.a!r}, b={self.b!r} must be > 0")
+        self.a = check_positive("plate side a", self.a)
+        self.b = check_positive("plate side b", self.b)
         _check_supports(self.edges, EDGES)
         if self.element not in ELEMENTS:
             raise InputError(f"plate element {self.element!r} is not one of: "
                              f"{', '.join(ELEMENTS)}")
-        if not (int(self.nx) == self.nx >= 1 and int(self.ny) == self.ny >= 1):
-            raise InputError(f"plate nx={self.nx!r}, ny={self.ny!r} must be whole numbers ≥ 1")
+        self.nx = check_count("plate nx", self.nx)
+        self.ny = check_count("plate ny", self.ny)
 
     @property
     def boundary_names(self) -> tuple[str, ...]:
@@ -123,6 +125,10 @@ class MeshPlate(_Plate):
     element: str = "argyris"
 
     def __post_init__(self):
+        from .meshfile import PlateMesh
+        if not isinstance(self.mesh, PlateMesh):
+            raise InputError(f"MeshPlate mesh={self.mesh!r} must be a PlateMesh: "
+                             "read_plate_mesh(path) reads one from a file")
         self._check_section()
         if self.element == "bfs":
             raise InputError("plate element 'bfs' needs the rectangle's grid ([geometry] a, "

@@ -5,6 +5,7 @@ from scipy.sparse.linalg import eigsh
 
 from ..errors import InputError
 from .space import PlateSpace
+from .static import check_space
 
 DENSE_UP_TO = 200   # free dofs below which a dense eigh is quicker than shift-invert
 
@@ -12,6 +13,7 @@ DENSE_UP_TO = 200   # free dofs below which a dense eigh is quicker than shift-i
 def natural_frequencies(space: PlateSpace, n: int = 6) -> tuple[np.ndarray, np.ndarray]:
     """The n lowest circular frequencies ω (rad/s), ascending, and their mode shapes
     (all dofs, one column each, M-normalised)."""
+    check_space(space, "natural_frequencies")
     free = space.free_dofs
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 1 <= n < len(free):
         raise InputError(f"n={n!r} must be a whole number in [1, {len(free) - 1}] (the "

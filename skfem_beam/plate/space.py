@@ -211,6 +211,8 @@ def load_vector(space: PlateSpace, pressure) -> np.ndarray:
 def plate_space(plate) -> PlateSpace:
     """The mesh, basis and matrices of ``plate`` (a :class:`Plate` or a
     :class:`MeshPlate`)."""
+    if not isinstance(plate, (Plate, MeshPlate)):
+        raise InputError(f"plate_space needs a Plate or a MeshPlate, not {plate!r}")
     mesh = plate_mesh(plate)
     basis = Basis(mesh, make_element(plate.element))
     fixed = fixed_dofs(basis, plate)

@@ -2,18 +2,29 @@
 import numpy as np
 from scipy.sparse.linalg import spsolve
 
+from ..checks import check_finite
 from ..errors import InputError
 from .space import PlateSpace
+
+
+def check_space(space, what: str) -> None:
+    """One line when ``space`` is not a plate's (a beam's system, a Plate itself)."""
+    if not isinstance(space, PlateSpace):
+        raise InputError(f"{what} needs the plate's space, plate_space(plate), not "
+                         f"{type(space).__name__}")
 
 
 def static_deflection(space: PlateSpace, f: np.ndarray) -> np.ndarray:
     """All the dofs' values (w, its derivatives) under the load vector f (all dofs:
     :func:`~skfem_beam.plate.space.load_vector`)."""
+    check_space(space, "static_deflection")
     free = space.free_dofs
     f = np.asarray(f, dtype=float)
     if f.shape != (space.basis.N,):
         raise InputError(f"f has shape {f.shape}: a load vector over all {space.basis.N} "
                          "dofs is needed (load_vector(space, p))")
+    if not np.isfinite(f).all():
+        raise InputError("f is not finite: the load vector has NaN or infinite entries")
     if rigid_motions(space):
         raise InputError("a static deflection needs edges that hold the plate: its free "
                          "and sliding edges leave it free to move as a rigid body (w = a + "
@@ -58,6 +69,11 @@ def rigid_dofs(space: PlateSpace) -> np.ndarray:
 
 def deflection_at_vertex(space: PlateSpace, u: np.ndarray, x: float, y: float) -> float:
     """w at the mesh vertex (x, y); a point that is not a vertex is an InputError."""
+    check_space(space, "deflection_at_vertex")
+    if np.shape(u) != (space.basis.N,):
+        raise InputError(f"u has shape {np.shape(u)}: all {space.basis.N} dofs are needed "
+                         "(full_dofs(system, u) gives them from a system's unknowns)")
+    x, y = check_finite("x", x), check_finite("y", y)
     distance = np.hypot(space.vertices[0] - x, space.vertices[1] - y)
     nearest = int(np.argmin(distance))
     if distance[nearest] > 1e-9 * space.plate.size:

@@ -24,7 +24,7 @@ from ..checks import check_finite
 from ..errors import InputError
 from ..system import SemiDiscrete
 from .space import PlateSpace, load_vector
-from .static import static_deflection
+from .static import check_space, static_deflection
 
 
 def one(t):
@@ -32,10 +32,26 @@ def one(t):
     return np.ones(np.shape(t))
 
 
-def _values(g, x, y) -> np.ndarray:
-    """g (a number or a vectorised function of x, y) at the points (x, y)."""
-    v = g(x, y) if callable(g) else g
-    return np.broadcast_to(np.asarray(v, dtype=float), np.shape(x)).copy()
+def _values(g, x, y, what: str, bounds: bool = False) -> np.ndarray:
+    """g (a number or a vectorised function of x, y) at the points (x, y); a function
+    that raises, returns a value per point of another shape or something not a number,
+    or a value that is NaN (infinite, unless ``bounds``: an obstacle's ±inf is one-sided)
+    is one line naming ``what``."""
+    try:
+        v = g(x, y) if callable(g) else g
+        v = np.broadcast_to(np.asarray(v, dtype=float), np.shape(x)).copy()
+    except InputError:
+        raise
+    except Exception as e:      # noqa: BLE001  (the user's function, whatever it raised)
+        raise InputError(f"{what}: its function of x, y at the {np.size(x)} points must "
+                         f"return one number per point (a vectorised function); it gave "
+                         f"{type(e).__name__}: {e}") from None
+    bad = (np.isnan(v) if bounds else ~np.isfinite(v)).ravel()
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise InputError(f"{what} is {v.ravel()[i]} at ({np.ravel(x)[i]:g}, "
+                         f"{np.ravel(y)[i]:g}): it must be a finite number there")
+    return v
 
 
 def _inside(region, x, y, tol: float) -> np.ndarray:
@@ -96,6 +112,14 @@ class PlateObstacle:
     region: tuple[float, float, float, float] | None = None
     points: tuple[tuple[float, float], ...] = ()
 
+    def __post_init__(self):
+        for name in ("g1", "g2"):
+            g = getattr(self, name)
+            if not callable(g) and not _number(g):
+                raise InputError(f"PlateObstacle {name}={g!r} must be a number (m; ±inf: no "
+                                 "bound) or a vectorised function of x, y")
+        object.__setattr__(self, "points", _points("PlateObstacle points", self.points))
+
     def bounds(self, space: PlateSpace) -> tuple[np.ndarray, np.ndarray]:
         """(g1, g2) at every vertex of the mesh, ±inf where this obstacle does not act."""
         x, y = space.vertices
@@ -109,8 +133,9 @@ class PlateObstacle:
                 raise InputError(f"PlateObstacle region={self.region!r} holds no vertex of "
                                  "the mesh")
         lo, hi = np.full(x.size, -np.inf), np.full(x.size, np.inf)
-        lo[where] = _values(self.g1, x[where], y[where])    # g where it acts only: a table
-        hi[where] = _values(self.g2, x[where], y[where])    # need not cover the plate
+        # g where it acts only: a table need not cover the plate
+        lo[where] = _values(self.g1, x[where], y[where], "PlateObstacle g1", bounds=True)
+        hi[where] = _values(self.g2, x[where], y[where], "PlateObstacle g2", bounds=True)
         return lo, hi
 
 
@@ -127,6 +152,15 @@ class Pressure:
         _number_or_function("Pressure p", self.p, "Pa", "x, y")
         if not callable(self.time):
             raise InputError(f"Pressure time={self.time!r} must be a function of t")
+        t = np.array([0.0, 1e-3])       # the scheme calls a(t) on arrays of times
+        try:
+            a = np.asarray(self.time(t), dtype=float)
+        except Exception as e:          # noqa: BLE001  (the user's function)
+            a = e
+        if not isinstance(a, np.ndarray) or a.shape != t.shape:
+            raise InputError(f"Pressure time must be vectorised: a(t) of an array of times "
+                             f"returns one number per time (e.g. lambda t: np.sin(50 * t)); "
+                             f"for t = [0, 0.001] it gave {a!r}")
 
     def vector(self, space: PlateSpace) -> np.ndarray:
         """b = ∫ p·1_region φ (N), all dofs."""
@@ -135,7 +169,7 @@ class Pressure:
         if region is not None and not region_holds_plate(space, region):
             raise InputError(f"Pressure region={self.region!r} holds no part of the plate "
                              "(no point of its mesh lies in it)")
-        return load_vector(space, lambda x, y: _values(self.p, x, y)
+        return load_vector(space, lambda x, y: _values(self.p, x, y, "Pressure p")
                            * _inside(region, x, y, tol))
 
 
@@ -154,6 +188,22 @@ class PlateInitial:
         _number_or_function("PlateInitial v0", self.v0, "m/s", "x, y")
 
 
+def _number(value) -> bool:
+    """Whether ``value`` is a number, ±inf included, not NaN."""
+    try:
+        return not np.isnan(float(value))
+    except (TypeError, ValueError):
+        return False
+
+
+def _points(what: str, points) -> tuple:
+    """``points`` as ((x, y), ...) of floats, else one line naming them."""
+    try:
+        return tuple((float(x), float(y)) for x, y in points)
+    except (TypeError, ValueError):
+        raise InputError(f"{what}={points!r} must be vertices ((x, y), ...) in m") from None
+
+
 def _number_or_function(name: str, value, unit: str, of: str) -> None:
     """A finite number or a function (of ``of``), else one line naming it."""
     if callable(value):
@@ -167,6 +217,7 @@ def _number_or_function(name: str, value, unit: str, of: str) -> None:
 
 def vertex_index(space: PlateSpace, x: float, y: float) -> int:
     """The mesh vertex at (x, y); a point that is not a vertex is an InputError."""
+    x, y = check_finite("vertex x", x), check_finite("vertex y", y)
     distance = np.hypot(space.vertices[0] - x, space.vertices[1] - y)
     nearest = int(np.argmin(distance))
     if distance[nearest] > 1e-9 * space.plate.size:
@@ -193,7 +244,13 @@ def half_bandwidth(A) -> int:
 def full_dofs(system: SemiDiscrete, u: np.ndarray) -> np.ndarray:
     """The system's coefficients (last axis) as all of skfem's dofs (fixed ones 0):
     for :func:`~skfem_beam.plate.deflection_at_vertex`, plotting, skfem's tools."""
+    if not isinstance(system, SemiDiscrete) or system.meta.get("kind") != "plate":
+        raise InputError(f"full_dofs needs a plate's system, plate_system(...), not "
+                         f"{type(system).__name__}")
     u = np.asarray(u, dtype=float)
+    if u.shape[-1:] != system.meta["dofs"].shape:
+        raise InputError(f"u has shape {u.shape}: its last axis must be the system's "
+                         f"{system.meta['dofs'].size} unknowns")
     full = np.zeros(u.shape[:-1] + (system.meta["space"].basis.N,))
     full[..., system.meta["dofs"]] = u
     return full
@@ -228,7 +285,8 @@ def _initial(space, initial: PlateInitial, dofs: np.ndarray, M: sp.csr_matrix):
     v0 = np.zeros(dofs.size)
     if not (np.isscalar(initial.v0) and initial.v0 == 0.0):
         rho_h = space.plate.rho * space.plate.h      # M carries ρh: (ρh v0, φ) on the right
-        b = load_vector(space, lambda x, y: rho_h * _values(initial.v0, x, y))[dofs]
+        b = load_vector(space, lambda x, y: rho_h * _values(initial.v0, x, y,
+                                                            "PlateInitial v0"))[dofs]
         v0 = spsolve(M.tocsc(), b)
     return u0, v0
 
@@ -252,12 +310,11 @@ def _observers(space, points, position) -> dict[str, np.ndarray]:
 
 def _check_parts(space, obstacles, loads, initial) -> None:
     """The arguments' kinds, each refused in one line saying what goes there."""
-    if not isinstance(space, PlateSpace):
-        raise InputError(f"plate_system needs the plate's space, plate_space(plate), not "
-                         f"{type(space).__name__}")
+    check_space(space, "plate_system")
     for name, items, kind in (("obstacles", obstacles, PlateObstacle),
                               ("loads", loads, Pressure)):
-        if isinstance(items, kind) or not all(isinstance(i, kind) for i in items):
+        if isinstance(items, (kind, str)) or not hasattr(items, "__iter__") \
+                or not all(isinstance(i, kind) for i in items):
             raise InputError(f"{name}= must be a list of {kind.__name__} (got {items!r})")
     if initial is not None and not isinstance(initial, PlateInitial):
         raise InputError(f"initial={initial!r} must be a PlateInitial or None")
@@ -272,6 +329,8 @@ def plate_system(space: PlateSpace, obstacles=(), loads=(), initial: PlateInitia
     centre).  ``meta``: "dofs" (skfem's dof of each unknown), "contact_vertices",
     "y_contact" (x_contact holds the x of each constrained vertex)."""
     _check_parts(space, obstacles, loads, initial)
+    if observe is not None:
+        observe = _points("plate_system observe", observe)
     dofs = grid_order(space)
     position = np.full(space.basis.N, -1)
     position[dofs] = np.arange(dofs.size)

@@ -23,7 +23,7 @@ from .output.options import OutputOptions
 from .output.folder import lock_folder
 from .output.checkpoint import (_resume_folder, check_resumable, has_checkpoint,
                                 read_checkpoint, read_summary)
-from .parser import Parser
+from .parser import Defaults, Parser
 from .scheme.stepping import MASSLESS, Stepping
 from .spec import RunSpec
 
@@ -45,7 +45,7 @@ def parser(prog: str, description: str, **defaults) -> Parser:
     d = {**SHARED, **defaults}
     J, dt, T, beta, mass = d["J"], d["dt"], d["T"], d["beta"], d["mass"]
     p = Parser(prog=prog, description=description,
-               formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+               formatter_class=Defaults)
     if J is not None:
         p.add_argument("--J", type=int, default=J, help="number of elements")
         p.add_argument("--mesh", default=None, metavar="FILE",

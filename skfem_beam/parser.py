@@ -11,3 +11,13 @@ class Parser(argparse.ArgumentParser):
 
     def error(self, message):
         self.exit(EXIT_INPUT, f"{self.prog}: error: {message}\n")
+
+
+class Defaults(argparse.ArgumentDefaultsHelpFormatter):
+    """--help with each flag's default, once: none where the help names it already or
+    where the default is None (the help says what not giving it means)."""
+
+    def _get_help_string(self, action):
+        if action.default is None or "default" in (action.help or ""):
+            return action.help
+        return super()._get_help_string(action)

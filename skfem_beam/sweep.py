@@ -37,6 +37,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import csv
+import importlib.util
 import inspect
 import json
 import math
@@ -466,7 +467,7 @@ def run_values(settings: dict, values: list[float], out, client=None, progress: 
 
 def parser():
     p = cli.Parser(prog="skfem_beam.sweep", description=__doc__.splitlines()[0],
-                   formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+                   formatter_class=cli.Defaults)
     p.add_argument("--scene", default="point_stops", help=" | ".join(SCENES))
     p.add_argument("--param", default="omega", help="the swept parameter: "
                    + " | ".join(SCENES["point_stops"][1]))
@@ -489,7 +490,8 @@ def parser():
         p.add_argument(f"--{name}", type=float, default=argparse.SUPPRESS,
                        help=f"fixed value of {name} when not swept (default {default:g})")
     p.add_argument("--workers", type=int, default=argparse.SUPPRESS,
-                   help="local Dask worker processes (default: one per core); 0 = no Dask")
+                   help="local Dask worker processes (default: one per core; without "
+                        "Dask installed, none); 0 = no Dask")
     p.add_argument("--scheduler", default=argparse.SUPPRESS,
                    help="address of an existing Dask scheduler, e.g. tcp://10.0.0.5:8786")
     p.add_argument("--out", default="out/sweep", help="output folder (resumed if it exists)")
@@ -508,6 +510,10 @@ def main(argv=None) -> int:
     scheduler, workers = getattr(args, "scheduler", None), getattr(args, "workers", None)
     if scheduler and workers is not None:
         raise InputError("give either --workers or --scheduler, not both")
+    if workers is None and not scheduler and importlib.util.find_spec("distributed") is None:
+        print("note: Dask is not installed (pip install \"skfem_beam[cluster]\" for one "
+              "worker per core): the values run one after the other", file=sys.stderr)
+        workers = 0
     workers = (os.cpu_count() or 1) if workers is None else workers
     if workers < 0:
         raise InputError(f"--workers {workers} must be ≥ 0")

@@ -322,6 +322,20 @@ def test_animation_gif(run, tmp_path):
         animate(tmp_path / "run.avi", run)
 
 
+def test_a_folder_read_back_is_refused_by_the_renders_in_one_line(tmp_path):
+    """render_beam and animate draw a Result's frames in memory: a SavedRun (read_run)
+    was an AttributeError from inside; one line, with or without PyVista."""
+    from skfem_beam import read_run
+    from skfem_beam.cases import point_stops
+    from skfem_beam.output.render import animate, render_beam
+    assert point_stops.main(["--T", "0.01", "--out", str(tmp_path / "run")]) == 0
+    saved = read_run(tmp_path / "run")
+    for draw, name in ((render_beam, "x.png"), (animate, "x.gif")):
+        with pytest.raises(InputError, match="needs the Result of a beam's solve.* not "
+                                             "SavedRun"):
+            draw(tmp_path / name, saved)
+
+
 # ----------------------------------------------------------------------------- meshes
 MESH_DIR = os.path.join(os.path.dirname(__file__), "..", "meshes")
 

@@ -308,3 +308,19 @@ def test_damped_section_collapses_to_the_charts_orbit(tmp_path, omega, period):
     v = np.array(bare["tip_displacement"])
     assert bare["damping"]["alpha"] == bare["damping"]["alpha_K"] == 0.0
     assert detect_period(v, 1e-7) == 0 and np.abs(v[period:] - v[:-period]).max() > 1e-3
+
+
+def test_without_dask_a_sweep_runs_its_values_in_turn(tmp_path, capsys, monkeypatch):
+    """The base install has no Dask: a bare sweep (no --workers, no --scheduler) was
+    refused; it now runs the values one after the other, saying so in one line."""
+    import importlib.util
+    from skfem_beam import sweep as module
+    real = importlib.util.find_spec
+    monkeypatch.setattr(module.importlib.util, "find_spec",
+                        lambda name, *a: None if name == "distributed" else real(name, *a))
+    out = tmp_path / "sweep"
+    assert exit_code(main, ["--values", "8,9", "--transient", "0.2", "--periods", "3",
+                            "--no-progress", "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "note: Dask is not installed" in err and "one after the other" in err, err
+    assert len(list((out / "runs").glob("*.json"))) == 2

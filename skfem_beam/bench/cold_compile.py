@@ -275,4 +275,5 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from ..cli import main_guard
+    main_guard(main)

@@ -121,4 +121,5 @@ def stiffness_chart(system, out: Path):
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    from ..cli import main_guard
+    main_guard(main)

@@ -52,4 +52,5 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    from ..cli import main_guard
+    main_guard(main)

@@ -358,4 +358,5 @@ def main(argv=None) -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from ..cli import main_guard
+    main_guard(main)

@@ -151,6 +151,15 @@ class _Scene:
         return f"{head}L = {self.L:g} m, {scheme}, dt = {r.dt:g} s{sc}"
 
 
+def _check_result(result, what: str) -> None:
+    """One line when ``result`` is not a line's run in memory (a folder read back, a
+    plate's)."""
+    if not hasattr(result, "frames_t") or getattr(result.system, "view", None) is None:
+        raise InputError(f"{what} needs the Result of a beam's solve(...) with its frames "
+                         f"in memory, not {type(result).__name__} (a saved folder's fields "
+                         "open in ParaView: docs/getting_started.md)")
+
+
 def render_beam(path, result, times=None, scale=None, samples_per_element: int = 8,
                 window_size=(1600, 640), case: str | None = None) -> np.ndarray:
     """Write an off-screen PNG of the beam at the saved frames nearest to ``times``
@@ -159,6 +168,7 @@ def render_beam(path, result, times=None, scale=None, samples_per_element: int =
     ``scale`` multiplies the transverse values (displacement and obstacles alike);
     None picks 1, 2 or 5 × 10^k so that the picture is about 1/4 as tall as long.
     """
+    _check_result(result, "render_beam")
     pv = _pyvista()
     if times is None:
         n = result.frames_t.size
@@ -196,6 +206,7 @@ def animate(path, result, fps: float = 20, every: int = 1, scale=None,
             case: str | None = None) -> Path:
     """Write an animation of every ``every``-th saved frame: ``.gif`` (pyvista + imageio)
     or ``.mp4`` (needs ``imageio-ffmpeg``).  The scale and the camera stay fixed."""
+    _check_result(result, "animate")
     pv = _pyvista()
     path = Path(path)
     if isinstance(every, bool) or int(every) != every or every < 1:
@@ -225,7 +236,8 @@ def animate(path, result, fps: float = 20, every: int = 1, scale=None,
         if suffix == ".gif":
             plotter.open_gif(str(path), fps=fps)
         else:
-            plotter.open_movie(str(path), framerate=fps)
+            # yuv420p needs even sizes only: no resizing to 16's multiples (and its warning)
+            plotter.open_movie(str(path), framerate=fps, macro_block_size=2)
         for k in frames:
             beam.copy_from(sc.beam(pv, k))
             clock.SetText(clock.RightEdge, f"t = {result.frames_t[k]:.4f} s")

@@ -59,4 +59,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from ..cli import main_guard
+    main_guard(main)

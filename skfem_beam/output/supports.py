@@ -24,9 +24,9 @@ covers: uniformly round the tube, d = V/(2πRb); per 30° sector k of the hole (
 direction of the wall's normal where the work is done: in a round hole the node's angle,
 as Code_Aster's POST_USURE sums it per sector; on a face, or on a broached hole's land
 edge while the node sits in a lobe's corner, the face's or the edge's normal: wear only
-where there is metal), d_k = V_k/(R·(π/6)·b).  The tube does not turn about its axis, so a sector of the hole
-wears the same sector of the tube.  Without a land the volumes and volume rates alone
-(per support and per sector): they need only K and the service years.
+where there is metal), d_k = V_k/(R·(π/6)·b).  The tube does not turn about its axis, so
+a sector of the hole wears the same sector of the tube.  Without a land the volumes and
+volume rates alone (per support and per sector): they need only K and the service years.
 """
 from __future__ import annotations
 

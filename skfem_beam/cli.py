@@ -6,6 +6,7 @@ Exit codes: 0 success, 2 bad input, 3 a solver failed, 4 the run went unstable
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import signal
 import sys
 import threading
@@ -268,7 +269,10 @@ def _same_command(out: Path, summary: dict, prog: str) -> None:
         return
     if scene:
         how = f"python -m skfem_beam run --resume {out}"
-    elif isinstance(theirs, str) and theirs.isidentifier():
+    elif theirs == "sweep":
+        how = f"python -m skfem_beam.sweep, the same values and --out {out}"
+    elif isinstance(theirs, str) and theirs.isidentifier() \
+            and importlib.util.find_spec(f"skfem_beam.cases.{theirs}") is not None:
         how = f"python -m skfem_beam.cases.{theirs} --resume {out}"
     else:
         how = "the command that wrote it"

@@ -204,3 +204,10 @@ def test_rigid_motions_the_supports_leave(element, edges, motions):
             static_deflection(space, f)
     else:
         assert np.isfinite(static_deflection(space, f)).all()
+
+
+def test_a_zero_static_load_is_the_flat_start_whatever_the_supports():
+    """static_pressure = 0 on a free plate is the flat start the refusal points to."""
+    from skfem_beam.plate.static import static_deflection
+    space = plate_space(Plate(nx=3, ny=3, edges={}))
+    assert not static_deflection(space, np.zeros(space.basis.N)).any()

@@ -7,7 +7,7 @@ import pytest
 from skfem_beam import Beam, BeamProblem, InitialState, InputError, Load, Obstacles, beam_system
 from skfem_beam.methods import make
 from skfem_beam.plate import Plate, deflection_at_vertex, plate_space
-from skfem_beam.plate.space import is_fixed
+from skfem_beam.plate.space import is_fixed, load_vector
 from skfem_beam.plate.system import (PlateInitial, PlateObstacle, Pressure, full_dofs,
                                      half_bandwidth, plate_system)
 from skfem_beam.scheme import solve
@@ -240,6 +240,10 @@ def _boom(x, y):
     (lambda S: plate_system(S, observe=(0.5, 0.5)), "observe=.* must be vertices"),
     (lambda S: PlateObstacle(g1="abc"), "g1='abc' must be a number"),
     (lambda S: plate_system(S, obstacles=None), "obstacles= must be a list"),
+    (lambda S: PlateObstacle(g1=-1e-3, points=[(0.5, 0.5)], region=(0, 0.25, 0, 0.25)),
+     "give region or points, not both"),
+    (lambda S: Pressure(1e3, time=lambda t: np.nan * t), "Pressure time gives"),
+    (lambda S: load_vector(S, lambda x, y: np.nan * x), "load_vector p is nan"),
 ])
 def test_python_values_are_checked_in_one_line(call, message):
     S = plate_space(Plate(nx=4, ny=4))

@@ -130,6 +130,9 @@ EDGES = 'left = "clamped"\nright = "clamped"\nbottom = "clamped"\ntop = "clamped
     # nothing holds the plate: K w = f has no solution (w was −1.9e11 m)
     (EDGES, EDGES.replace('"clamped"', '"free"'), "needs edges that hold the plate"),
     (EDGES, EDGES.replace('"clamped"', '"sliding"'), "rigid body"),
+    # a strip round the grid line x = 0.4/6 (between the quadrature points) loads nothing
+    ("g1 = -1.75e-4 ", "g1 = -1.75e-4\n[[loads]]\npressure = 1e3\nregion = [0.06665, 0.0, "
+     "0.06668, 1.2] ", "narrower than an element"),
 ])
 def test_bad_plate_scene_one_line_exit_2_nothing_written(tmp_path, capsys, old, new, word):
     assert old in GOOD
@@ -241,6 +244,10 @@ def test_plate_obstacles_as_polynomials_and_tables(tmp_path):
      "g needs one row per y (2) of one value per x (3)"),
     ("{ x = [0.0, 0.4, 0.2], y = [0.0, 1.2], g = [[1, 2, 3], [1, 2, 3]] }", "must increase"),
     ("{ poly = [[1e-4]], about = [0.5] }", "about a point [x0, y0]"),
+    ("{ poly = [[nan]], about = [0.2, 0.6] }", "obstacles.0.g2 = {poly, about}: poly is rows "
+     "of finite numbers"),
+    ("{ x = [0.0, 0.4], y = [0.0, 1.2], g = [[nan, 1e-3], [1e-3, 1e-3]] }",
+     "x, y and g must be finite"),
     ("{ x = [0.0, 0.4], g = [1e-4, 2e-4] }", "obstacles.0.g2.g[0] = 0.0001"),
     ('"1e-4 + x"', "must be a number or a table ({ poly"),
 ])

@@ -371,3 +371,15 @@ def test_a_folder_another_command_wrote_names_the_command_that_resumes_it(tmp_pa
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and err.rstrip().endswith(how), err
         assert {f.name: f.read_bytes() for f in folder.iterdir() if f.is_file()} == before
+
+
+def test_a_sweep_folder_given_to_resume_names_the_sweep_command(tmp_path, capsys):
+    """A sweep's folder is resumed by running the sweep again (there is no cases.sweep)."""
+    from skfem_beam.sweep import main as sweep_main
+    out = tmp_path / "sw"
+    assert exit_code(sweep_main, ["--values", "8", "--transient", "0.2", "--periods", "3",
+                                  "--workers", "0", "--no-progress", "--out", str(out)]) == 0
+    capsys.readouterr()
+    assert exit_code(point_stops.main, ["--resume", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "python -m skfem_beam.sweep, the same values" in err, err

@@ -10,6 +10,7 @@ from skfem import (Basis, BilinearForm, ElementQuadBFS, ElementTriArgyris, Eleme
 from skfem.element.discrete_field import DiscreteField
 from skfem.helpers import dd, ddot, trace
 
+from ..checks import check_finite
 from ..errors import InputError
 from .model import MeshPlate, Plate
 
@@ -198,13 +199,40 @@ def mass_matrix(basis: Basis, rho_h: float) -> sparse.csr_matrix:
     return asm(mass, basis).tocsr()
 
 
+def values_at(g, x, y, what: str, bounds: bool = False) -> np.ndarray:
+    """g (a number or a vectorised function of x, y) at the points (x, y); a function
+    that raises, returns a value per point of another shape or something not a number,
+    or a value that is NaN (infinite, unless ``bounds``: an obstacle's ±inf is one-sided)
+    is one line naming ``what``."""
+    try:
+        v = g(x, y) if callable(g) else g
+        v = np.broadcast_to(np.asarray(v, dtype=float), np.shape(x)).copy()
+    except InputError:
+        raise
+    except Exception as e:      # noqa: BLE001  (the user's function, whatever it raised)
+        raise InputError(f"{what}: its function of x, y at the {np.size(x)} points must "
+                         f"return one number per point (a vectorised function); it gave "
+                         f"{type(e).__name__}: {e}") from None
+    bad = (np.isnan(v) if bounds else ~np.isfinite(v)).ravel()
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise InputError(f"{what} is {v.ravel()[i]} at ({np.ravel(x)[i]:g}, "
+                         f"{np.ravel(y)[i]:g}): it must be a finite number there")
+    return v
+
+
+
 def load_vector(space: PlateSpace, pressure) -> np.ndarray:
     """f from a pressure p(x, y) (Pa, positive along w; a number: uniform): f_i = ∫ p φ_i."""
-    p = pressure if callable(pressure) else (lambda x, y, c=pressure: c + 0.0 * x)
+    if not isinstance(space, PlateSpace):
+        raise InputError(f"load_vector needs the plate's space, plate_space(plate), not "
+                         f"{type(space).__name__}")
+    p = pressure if callable(pressure) else \
+        (lambda x, y, c=check_finite("load_vector p", pressure): c + 0.0 * x)
 
     @LinearForm
     def load(v, w):
-        return p(w.x[0], w.x[1]) * v
+        return values_at(p, w.x[0], w.x[1], "load_vector p") * v
     return asm(load, space.basis)
 
 

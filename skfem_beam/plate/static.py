@@ -25,6 +25,8 @@ def static_deflection(space: PlateSpace, f: np.ndarray) -> np.ndarray:
                          "dofs is needed (load_vector(space, p))")
     if not np.isfinite(f).all():
         raise InputError("f is not finite: the load vector has NaN or infinite entries")
+    if not f.any():         # no load: flat, whatever the supports
+        return np.zeros(space.basis.N)
     if rigid_motions(space):
         raise InputError("a static deflection needs edges that hold the plate: its free "
                          "and sliding edges leave it free to move as a rigid body (w = a + "

@@ -23,35 +23,13 @@ from scipy.sparse.linalg import spsolve
 from ..checks import check_finite
 from ..errors import InputError
 from ..system import SemiDiscrete
-from .space import PlateSpace, load_vector
+from .space import PlateSpace, load_vector, values_at
 from .static import check_space, static_deflection
 
 
 def one(t):
     """a(t) = 1, vectorised."""
     return np.ones(np.shape(t))
-
-
-def _values(g, x, y, what: str, bounds: bool = False) -> np.ndarray:
-    """g (a number or a vectorised function of x, y) at the points (x, y); a function
-    that raises, returns a value per point of another shape or something not a number,
-    or a value that is NaN (infinite, unless ``bounds``: an obstacle's ±inf is one-sided)
-    is one line naming ``what``."""
-    try:
-        v = g(x, y) if callable(g) else g
-        v = np.broadcast_to(np.asarray(v, dtype=float), np.shape(x)).copy()
-    except InputError:
-        raise
-    except Exception as e:      # noqa: BLE001  (the user's function, whatever it raised)
-        raise InputError(f"{what}: its function of x, y at the {np.size(x)} points must "
-                         f"return one number per point (a vectorised function); it gave "
-                         f"{type(e).__name__}: {e}") from None
-    bad = (np.isnan(v) if bounds else ~np.isfinite(v)).ravel()
-    if bad.any():
-        i = int(np.argmax(bad))
-        raise InputError(f"{what} is {v.ravel()[i]} at ({np.ravel(x)[i]:g}, "
-                         f"{np.ravel(y)[i]:g}): it must be a finite number there")
-    return v
 
 
 def _inside(region, x, y, tol: float) -> np.ndarray:
@@ -119,6 +97,8 @@ class PlateObstacle:
                 raise InputError(f"PlateObstacle {name}={g!r} must be a number (m; ±inf: no "
                                  "bound) or a vectorised function of x, y")
         object.__setattr__(self, "points", _points("PlateObstacle points", self.points))
+        if self.points and self.region is not None:
+            raise InputError("PlateObstacle: give region or points, not both")
 
     def bounds(self, space: PlateSpace) -> tuple[np.ndarray, np.ndarray]:
         """(g1, g2) at every vertex of the mesh, ±inf where this obstacle does not act."""
@@ -134,8 +114,8 @@ class PlateObstacle:
                                  "the mesh")
         lo, hi = np.full(x.size, -np.inf), np.full(x.size, np.inf)
         # g where it acts only: a table need not cover the plate
-        lo[where] = _values(self.g1, x[where], y[where], "PlateObstacle g1", bounds=True)
-        hi[where] = _values(self.g2, x[where], y[where], "PlateObstacle g2", bounds=True)
+        lo[where] = values_at(self.g1, x[where], y[where], "PlateObstacle g1", bounds=True)
+        hi[where] = values_at(self.g2, x[where], y[where], "PlateObstacle g2", bounds=True)
         return lo, hi
 
 
@@ -158,18 +138,22 @@ class Pressure:
         except Exception as e:          # noqa: BLE001  (the user's function)
             a = e
         if not isinstance(a, np.ndarray) or a.shape != t.shape:
+            got = f"shape {a.shape}" if isinstance(a, np.ndarray) else repr(a)
             raise InputError(f"Pressure time must be vectorised: a(t) of an array of times "
                              f"returns one number per time (e.g. lambda t: np.sin(50 * t)); "
-                             f"for t = [0, 0.001] it gave {a!r}")
+                             f"for t = [0, 0.001] it gave {got}")
+        if not np.isfinite(a).all():
+            raise InputError(f"Pressure time gives {a} at t = [0, 0.001]: a(t) must be finite")
 
     def vector(self, space: PlateSpace) -> np.ndarray:
         """b = ∫ p·1_region φ (N), all dofs."""
         tol = 1e-9 * space.plate.size
         region = checked_region("Pressure", self.region, space.plate, area=True)
         if region is not None and not region_holds_plate(space, region):
-            raise InputError(f"Pressure region={self.region!r} holds no part of the plate "
-                             "(no point of its mesh lies in it)")
-        return load_vector(space, lambda x, y: _values(self.p, x, y, "Pressure p")
+            raise InputError(f"Pressure region={self.region!r} holds no quadrature point of "
+                             "the plate's mesh, where the load is integrated (off the plate, "
+                             "or narrower than an element: widen it or refine the mesh)")
+        return load_vector(space, lambda x, y: values_at(self.p, x, y, "Pressure p")
                            * _inside(region, x, y, tol))
 
 
@@ -285,7 +269,7 @@ def _initial(space, initial: PlateInitial, dofs: np.ndarray, M: sp.csr_matrix):
     v0 = np.zeros(dofs.size)
     if not (np.isscalar(initial.v0) and initial.v0 == 0.0):
         rho_h = space.plate.rho * space.plate.h      # M carries ρh: (ρh v0, φ) on the right
-        b = load_vector(space, lambda x, y: rho_h * _values(initial.v0, x, y,
+        b = load_vector(space, lambda x, y: rho_h * values_at(initial.v0, x, y,
                                                             "PlateInitial v0"))[dofs]
         v0 = spsolve(M.tocsc(), b)
     return u0, v0

@@ -199,9 +199,10 @@ def _g(value, where: str):
     if set(value) in ({"poly"}, {"poly", "about"}):
         c = [[float(v) for v in row] for row in value["poly"]]
         about = value.get("about", (0.0, 0.0))
-        if not c or not all(c) or len(about) != 2:
-            raise InputError(f"{where} = {{poly, about}}: poly is rows of numbers (row i: "
-                             "the power of x) and about a point [x0, y0] (m)")
+        if not c or not all(c) or len(about) != 2 \
+                or not np.isfinite(np.concatenate([np.ravel(r) for r in c] + [about])).all():
+            raise InputError(f"{where} = {{poly, about}}: poly is rows of finite numbers (row "
+                             "i: the power of x) and about a point [x0, y0] (m)")
         x0, y0 = (float(v) for v in about)
 
         def poly(x, y):
@@ -228,6 +229,8 @@ def _grid(value, where: str):
     if len(g) != ys.size or any(len(row) != xs.size for row in g):
         raise InputError(f"{where} = {{x, y, g}}: g needs one row per y ({ys.size}) of one "
                          f"value per x ({xs.size})")
+    if not (np.isfinite(xs).all() and np.isfinite(ys).all() and np.isfinite(g).all()):
+        raise InputError(f"{where} = {{x, y, g}}: x, y and g must be finite numbers (m)")
     table = RegularGridInterpolator((ys, xs), np.asarray(g, dtype=float))
     tol = 1e-9 * max(np.ptp(xs), np.ptp(ys))
 
@@ -262,8 +265,9 @@ def loads_of(data: dict, space, tables: Tables) -> list:
         region = _region(d["region"], space.plate, f"{where}.region", area=True) \
             if "region" in d else None
         if region is not None and not region_holds_plate(space, region):
-            raise InputError(f"{where}.region = {d['region']!r} holds no part of the plate "
-                             "(no point of its mesh lies in it)")
+            raise InputError(f"{where}.region = {d['region']!r} holds no quadrature point of "
+                             "the plate's mesh, where the load is integrated (off the plate, "
+                             "or narrower than an element: widen it or refine the mesh)")
         time = {k: d[k] for k in TIME_FORMS if k in d}
         if "omega" in time and "amplitude" not in time:
             time["amplitude"] = 1.0          # the pressure is the amplitude

@@ -173,3 +173,16 @@ def test_impulses_are_the_contact_impulse_applied_along_the_span(tmp_path, law):
     assert not lam[~owned].any()                  # no force outside an event
     # the force after the node has left: a spring's, none for exact contact
     assert (tail > 0) == (law == "penalty")
+
+
+def test_a_bar_that_starts_on_its_obstacle_opens_its_event_at_the_first_step(tmp_path):
+    """impacting_bar's default starts at u0 = 0 on the obstacle with v0 = −1: the start
+    step's law holds it there, so its event starts at t₁ with the velocity it hits with,
+    −1 (it read t₂ and 0: the start step's contact opened no event)."""
+    import csv
+    out = tmp_path / "bar"
+    assert impacting_bar.main(["--T", "0.01", "--out", str(out), "--format", "none"]) == 0
+    with open(out / "impacts.csv", newline="") as fh:
+        first = next(csv.DictReader(fh))
+    assert float(first["t_start"]) == pytest.approx(1e-3, rel=1e-12)
+    assert float(first["velocity"]) == -1.0

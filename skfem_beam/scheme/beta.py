@@ -25,7 +25,7 @@ from ..linalg import band_solve, row_layout_of, rows_matvec
 from .kernels import (CALLEES, EVENT_COLUMNS, FRICTION_COLUMN, IMPACT_FIELDS, NC_COLUMNS,
                       SECTORS, TANGENT_COLUMN, Inputs, Ops, PythonLaw, Series, State,
                       csr_product, energy_beta, friction_of_ops, lands_of, move_bounds,
-                      record, run_steps, run_steps_python)
+                      record, run_steps, run_steps_python, track_impacts)
 from .operators import csr_arrays, load_norms, step_operators
 from .stepping import Stepping
 
@@ -398,7 +398,24 @@ class BetaScheme:
         u1 = self._first_free_step(u0, first_params)
         self._first_contact(u1, first_params)
         self._record_first_states(out)
+        self._open_first_events(out)
         return 1
+
+    def _open_first_events(self, out) -> None:
+        """A value the start step's law held on its obstacle opens its event at state 1,
+        with the velocity it had, C v⁰ (it opened at state 2 with velocity 0): the loop's
+        track_impacts at step 0, without a force (state 1 records none)."""
+        st = self.st
+        if not self.first_active.any():
+            return
+        saved = st.active.copy(), st.dy.copy(), st.mu.copy()
+        v0 = np.zeros(st.mu.size)
+        csr_product(self.ops.Cp, self.ops.Ci, self.ops.Cx, self.system.v0.astype(float), v0)
+        st.active[:] = self.first_active
+        st.dy[:] = st.y_cur - st.y_prev + self.dt * v0   # (yⁿ − yⁿ⁻¹)/Δt reads v0 at n = 0
+        st.mu[:] = 0.0
+        uncompiled(track_impacts)(self.ops, st, out, 0, self.lands)
+        (st.active[:], st.dy[:], st.mu[:]) = saved
 
     def _first_free_step(self, u0, first_params) -> np.ndarray:
         """The start step's solution without the law's multipliers (docstring of start)."""
@@ -426,18 +443,21 @@ class BetaScheme:
         """u¹ = the free solution + W μ with the chosen law's μ (state 1 records no
         contact force)."""
         op, st = self.op, self.st
+        self.first_active = np.zeros(st.mu.size, dtype=bool)
         if st.mu.size:
             st.x[:] = u1
             csr_product(self.ops.Cp, self.ops.Ci, self.ops.Cx, u1, st.yf)
             if self.pysolver is not None:
                 mu, _ = self.pysolver.solve(u1, st.yf.copy(), st.lo, st.hi)
                 st.mu[:] = mu
+                self.first_active[:] = st.mu != 0.0
             else:
                 st.y_cur[:] = st.y_prev
                 if self.law.kernel.func(self.ops.D, st.yf, st.y_cur, st.y_prev, st.lo, st.hi,
                                         first_params, st.law_state, st.mu, st.active) < 0:
                     raise SolverError("the first step's contact problem could not be solved")
                 st.law_state[:] = 0
+                self.first_active[:] = st.active
                 st.active[:] = False
             if op.W.shape[1] == st.mu.size:     # else an x-space law wrote u¹ into u1
                 # W in C order: the BLAS call, and so the bits, of the pinned runs; with

@@ -463,3 +463,57 @@ def test_a_bad_scene_friction_is_refused_where_every_hole_sets_its_own(tmp_path,
     text = text.replace("friction = 0.3 ", f"friction = {mu} ")
     assert text.count("friction = 0.2") == 2 and f"friction = {mu} " in text
     assert_scene_refused(tmp_path, capsys, {"t.toml": text}, "t.toml", word)
+
+
+PUSHED = """kind = "beam"
+planes = 2
+[material]
+E = 2.0e11
+rho = 8000.0
+[section]
+tube = { outer_diameter = 0.01905, wall = 0.00165 }
+[geometry]
+L = 1.5
+[ends]
+left = "pinned"
+right = "pinned"
+[[obstacles]]
+x = 0.75
+hole = { sides = 4, radius = 0.0004, angle = 0.1 }
+[[loads]]
+distributed = true
+direction = [-1.0, 0.0]
+value = 200.0
+[[loads]]
+distributed = true
+direction = [0.0, 1.0]
+amplitude = 300.0
+omega = 300.0
+[contact]
+friction = 0.3
+[wear]
+coefficient = 1e-14
+service_years = 40
+land = 0.019
+[mesh]
+J = 30
+[time]
+dt = 1e-4
+T = 0.2
+"""
+
+
+def test_a_square_hole_wears_on_the_face_the_tube_is_pushed_onto(tmp_path):
+    """A face row bounds two opposite faces (lo ≤ n·p ≤ hi): its wear goes to the face
+    touched, n's or −n's.  Pushed along −v onto the face at 180° + 5.7°, the wear fell in
+    the opposite sector, [0°, 30°), before."""
+    (tmp_path / "push.toml").write_text(PUSHED)
+    out = tmp_path / "out"
+    assert exit_code(run_main, [str(tmp_path / "push.toml"), "--out", str(out),
+                                "--format", "none"]) == 0
+    sup, = json.loads((out / "summary.json").read_text())["impact_statistics"]["supports"]
+    sectors = sup["wear"]["sectors"]
+    worst = max(sectors, key=lambda k: k["volume"])
+    assert worst["from_rad"] == pytest.approx(-np.pi) and worst["volume"] > 0.9 * sum(
+        k["volume"] for k in sectors)
+    assert sectors[6]["volume"] == 0.0          # [0°, 30°): no face is touched there

@@ -512,10 +512,13 @@ def hole_kinematics(pair, Nc, nodes, at, force, tallies, step, dt, p, lands, fri
             vy = (p[1] - pos[j, 1]) / (2.0 * dt)
             w = f / (dt * dt) * abs(-vx * ny + vy * nx) * dt
             rowwork[j, 1] += w
-            # the sector the wall's normal points to: in a round hole the node's angle; on
-            # a face or a broached hole's land edge (the node in a lobe's corner) the face's
+            # the sector the wall's outward normal points to: in a round hole the node's
+            # angle; on a broached hole's land edge (the node in a lobe's corner) the edge's;
+            # a face row bounds two opposite faces, n·p ≤ hi (μ < 0 there) and n·p ≥ lo
             if Nc[j, 4] == 0.0 and Nc[j, 5] == 0.0 and (lands is None or Nc[j, 6] <= 0.0):
                 angle = np.arctan2(p[3], p[2])
+            elif pair[j] == 0 and mu[j] > 0.0:
+                angle = np.arctan2(-ny, -nx)
             else:
                 angle = np.arctan2(ny, nx)
             k = int((angle + np.pi) / (2.0 * np.pi) * SECTORS)

@@ -100,6 +100,10 @@ class Hole:
             i = int(np.argmax(cross <= 0))
             raise InputError(f"hole polygon is not convex and counter-clockwise at vertex "
                              f"{(i + 1) % len(p)} ({p[(i + 1) % len(p)].tolist()})")
+        turning = np.sum(np.arctan2(cross, np.einsum("ij,ij->i", e, np.roll(e, -1, axis=0))))
+        if turning > 2 * np.pi * (1 + 1e-9):    # left turns all, but round more than once
+            raise InputError(f"hole polygon crosses itself (its edges turn {turning / np.pi:g}π, "
+                             "a convex polygon's 2π): give its vertices once round, in order")
         n = np.column_stack([e[:, 1], -e[:, 0]])      # outward: the edge turned clockwise
         n /= np.hypot(n[:, 0], n[:, 1])[:, None]
         return cls.faces(np.column_stack([n, np.einsum("ij,ij->i", n, p)]), (0.0, 0.0),

@@ -314,6 +314,9 @@ def test_the_trefoil_scene_runs_in_its_lands(tmp_path):
     ('planes = 2\n[[obstacles]]\nx = 0.5\nhole = { radius = 4e-4, angle = 1 }\n', "angle"),
     ('planes = 2\n[[obstacles]]\nx = 0.5\nhole = { polygon = [[0, 1], [1, 0], [1, 1], [-1, 0]] }\n',
      "convex"),
+    # a pentagram: every turn to the left, but twice round (it ran as its inner pentagon)
+    ('planes = 2\n[[obstacles]]\nx = 0.5\nhole = { polygon = [[0.0, 4e-4], [-2.35e-4, -3.24e-4], '
+     '[3.8e-4, 1.24e-4], [-3.8e-4, 1.24e-4], [2.35e-4, -3.24e-4]] }\n', "crosses itself"),
     ('planes = 2\n[[obstacles]]\nx = 0.5\nhole = { radius = 4e-4, centre = [1e-3, 0] }\n',
      "rest position"),
     ('planes = 2\n[[obstacles]]\nx = 0.0\nhole = { radius = 4e-4 }\n', "held there"),

@@ -177,9 +177,10 @@ class GivesUp(ContactLaw):
 def test_failed_solver_keeps_the_impacts_so_far(tmp_path, monkeypatch, capsys):
     """A solver failing at its 430th call (a step in contact, 6 tenths into the run):
     exit 3, status "failed", impacts.csv holds the events up to the state before the
-    failed step, their rows those of the same run with the compiled projection, and the
-    field series the frames up to the last whole chunk (a run's first second keeps its
-    frames in memory: the failure writes them, stream._Stream)."""
+    failed step, their rows those of the same run with the compiled projection,
+    timeseries.csv the rows up to that state too (it stopped at the last whole chunk), and
+    the field series the frames so far (a run's first second keeps its frames in memory:
+    the failure writes them, stream._Stream)."""
     argv = ["--dt", "1e-4", "--T", "1", "--flush-every", "200", "--format", "xdmf",
             "--frames", "10"]
     ref = tmp_path / "ref"
@@ -194,6 +195,8 @@ def test_failed_solver_keeps_the_impacts_so_far(tmp_path, monkeypatch, capsys):
     s = summary(out)
     t_fail = int(re.search(r"failed at step (\d+)", s["message"])[1]) * 1e-4
     assert s["status"] == "failed" and s["steps"] * 1e-4 < t_fail and 0.4 < t_fail < 0.8
+    t = read_run(out, fields="none").series["t"]
+    assert t[-1] == pytest.approx(t_fail - 1e-4) and s["steps"] == round(t[-1] / 1e-4)
     imp = read_run(out).impacts
     assert imp["t_start"].size > 10 and imp["t_end"].max() == pytest.approx(t_fail - 1e-4) \
         or imp["open"].sum() == 0

@@ -312,12 +312,16 @@ class _Stream:
         self.kept = run.n
         folder.write(checkpoint_step=run.n)
 
-    def on_chunk(self, run) -> None:
+    def write_rows(self, run) -> None:
+        """The saved rows up to the run's state n not written yet."""
         k1 = self.series.rows_ready(run)
         if k1 > self.used:
             self.rows.append(self.series.columns(run, self.used, k1))
             self.used = k1
             run.release(self.used - 1)   # written: memory stays flat (one row kept before)
+
+    def on_chunk(self, run) -> None:
+        self.write_rows(run)
         stopping = self.stop.signum is not None and not run.done
         # the last frames, and a short run's: after the charts (class docstring)
         if not run.done and (stopping or time.monotonic() - self.started >= FRAMES_AFTER):
@@ -345,7 +349,8 @@ class _Stream:
             try:
                 drive(run, chunk=self.options.flush_every, on_chunk=self.on_chunk)
             except (SolverError, InputError):   # a failed step (not a write refused: no
-                self.write_frames()             # more writes) keeps the whole chunks' frames
+                self.write_rows(run)            # more writes) keeps the rows and frames up
+                self.write_frames()             # to the last good saved state
                 raise
             data = self.rows.data()
             entries = outcome(run.result(), data)

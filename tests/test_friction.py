@@ -467,16 +467,12 @@ def test_a_bad_scene_friction_is_refused_where_every_hole_sets_its_own(tmp_path,
 
 PUSHED = """kind = "beam"
 planes = 2
-[material]
-E = 2.0e11
-rho = 8000.0
-[section]
-tube = { outer_diameter = 0.01905, wall = 0.00165 }
-[geometry]
-L = 1.5
-[ends]
-left = "pinned"
-right = "pinned"
+material = { E = 2.0e11, rho = 8000.0 }
+section = { tube = { outer_diameter = 0.01905, wall = 0.00165 } }
+geometry = { L = 1.5 }
+ends = { left = "pinned", right = "pinned" }
+mesh = { J = 30 }
+time = { dt = 1e-4, T = 0.2 }
 [[obstacles]]
 x = 0.75
 hole = { sides = 4, radius = 0.0004, angle = 0.1 }
@@ -495,11 +491,6 @@ friction = 0.3
 coefficient = 1e-14
 service_years = 40
 land = 0.019
-[mesh]
-J = 30
-[time]
-dt = 1e-4
-T = 0.2
 """
 
 

@@ -4,8 +4,7 @@ from scipy.linalg import eigh
 from scipy.sparse.linalg import eigsh
 
 from ..errors import InputError
-from .space import PlateSpace
-from .static import check_space
+from .space import PlateSpace, check_space
 
 DENSE_UP_TO = 200   # free dofs below which a dense eigh is quicker than shift-invert
 

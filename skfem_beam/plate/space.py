@@ -221,12 +221,16 @@ def values_at(g, x, y, what: str, bounds: bool = False) -> np.ndarray:
     return v
 
 
+def check_space(space, what: str) -> None:
+    """One line when ``space`` is not a plate's (a beam's system, a Plate itself)."""
+    if not isinstance(space, PlateSpace):
+        raise InputError(f"{what} needs the plate's space, plate_space(plate), not "
+                         f"{type(space).__name__}")
+
 
 def load_vector(space: PlateSpace, pressure) -> np.ndarray:
     """f from a pressure p(x, y) (Pa, positive along w; a number: uniform): f_i = ∫ p φ_i."""
-    if not isinstance(space, PlateSpace):
-        raise InputError(f"load_vector needs the plate's space, plate_space(plate), not "
-                         f"{type(space).__name__}")
+    check_space(space, "load_vector")
     p = pressure if callable(pressure) else \
         (lambda x, y, c=check_finite("load_vector p", pressure): c + 0.0 * x)
 

@@ -4,14 +4,7 @@ from scipy.sparse.linalg import spsolve
 
 from ..checks import check_finite
 from ..errors import InputError
-from .space import PlateSpace
-
-
-def check_space(space, what: str) -> None:
-    """One line when ``space`` is not a plate's (a beam's system, a Plate itself)."""
-    if not isinstance(space, PlateSpace):
-        raise InputError(f"{what} needs the plate's space, plate_space(plate), not "
-                         f"{type(space).__name__}")
+from .space import PlateSpace, check_space
 
 
 def static_deflection(space: PlateSpace, f: np.ndarray) -> np.ndarray:

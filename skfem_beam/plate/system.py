@@ -23,8 +23,8 @@ from scipy.sparse.linalg import spsolve
 from ..checks import check_finite
 from ..errors import InputError
 from ..system import SemiDiscrete
-from .space import PlateSpace, load_vector, values_at
-from .static import check_space, static_deflection
+from .space import PlateSpace, check_space, load_vector, values_at
+from .static import static_deflection
 
 
 def one(t):

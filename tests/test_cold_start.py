@@ -97,3 +97,10 @@ def test_a_plate_run_sends_the_callees_and_its_law_aside(tmp_path):
     assert compiled == "1 1", p.stdout
     assert callees.split() == [f.py_func.__name__ for f, _ in CALLEES], p.stdout
     assert law == "active_set_kernel active-set", p.stdout
+
+
+def test_cold_compile_bench_runs_by_its_path():
+    """Its listener child runs the file by path, outside the package: it must import."""
+    path = Path(skfem_beam.__file__).parent / "bench" / "cold_compile.py"
+    p = subprocess.run([sys.executable, str(path), "--help"], capture_output=True, text=True)
+    assert p.returncode == 0 and "--one-core" in p.stdout, p.stderr

@@ -275,5 +275,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    from ..cli import main_guard
+    # absolute: the listener child runs this file by its path, outside the package
+    from skfem_beam.cli import main_guard
     main_guard(main)

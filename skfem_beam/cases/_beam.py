@@ -51,8 +51,7 @@ def run_beam_case(case: str, problem, spec: RunSpec, stops=(), extra=None) -> in
         "config": spec.config,
     }
 
-    springs = (spec.method.stiffness, spec.method.damping) \
-        if penalty and system.planes == 1 else None
+    springs = (spec.method.stiffness, spec.method.damping) if penalty else None
 
     def events(folder: Path, run, last: int) -> dict:
         return beam_impacts(folder, run, problem, last, spec.wear, springs)

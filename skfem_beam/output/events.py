@@ -143,6 +143,19 @@ def spring_supports(table: dict, obstacles, stiffness, damping) -> list[dict]:
     return out
 
 
+def hole_springs(table: dict, supports, stiffness: float, damping: float) -> list[dict]:
+    """:func:`spring_supports` of a two-plane run: one stiffness and damping on every
+    support, one entry per support (a hole or faces at x, ``supports`` in order)."""
+    out = []
+    for i, x in enumerate(supports):
+        rows = np.flatnonzero(np.asarray(table["x"], dtype=float) == x)
+        out.append({"obstacle": i, "where": f"support at x={x:g}", "stiffness": float(stiffness),
+                    "damping": float(damping), "impacts": int(rows.size),
+                    "max_deflection": float(table["max_violation"][rows].max(initial=0.0)),
+                    "max_force": float(table["peak_force"][rows].max(initial=0.0))})
+    return out
+
+
 # impact_statistics' contact_fraction, as summary.json's units say it
 EPISODES = ("of the run's time: each episode from its first state in contact to its first "
             "state off, one still open at the end to its last state (so one step less than "
@@ -163,11 +176,13 @@ def write_impacts(folder: Path, run, units: dict, scale: float = 1.0, sign: floa
 
 
 def _add_spring_supports(out: dict, table: dict, obstacles, springs: tuple,
-                         force_unit: str) -> None:
+                         force_unit: str, supports=()) -> None:
     """Add to ``out`` (of :func:`_write_impacts`, with its impacts ``table``) the entry
-    ``spring_supports`` (:func:`spring_supports`) of the supports' springs ``springs`` =
-    (stiffness, damping), N/m and N·s/m (a penalty run on ``obstacles``)."""
-    out["spring_supports"] = spring_supports(table, obstacles, *springs)
+    ``spring_supports`` of the supports' springs ``springs`` = (stiffness, damping), N/m
+    and N·s/m: a penalty run on ``obstacles`` (:func:`spring_supports`), or, two planes,
+    on the ``supports`` at those x (:func:`hole_springs`)."""
+    out["spring_supports"] = spring_supports(table, obstacles, *springs) \
+        if obstacles is not None else hole_springs(table, supports, *springs)
     out["impact_statistics"]["units"]["spring_supports"] = (
         "per obstacle: stiffness N/m, damping N·s/m (as given), max_deflection m (the "
         f"largest compression of its spring), max_force {force_unit} (its largest "
@@ -237,7 +252,10 @@ def beam_impacts(folder: Path, run, problem, last: int | None = None, wear=None,
         {"force": "m²/s² (N per kg/m)", "impulse": "m²/s (N·s per kg/m)"}
     out, table = _write_impacts(folder, run, units, rho_S or 1.0, 1.0, problem.obstacles,
                                 last, wear)
-    if springs is not None and problem.obstacles is not None:   # (springs: no friction)
+    if springs is not None and getattr(run.system, "planes", 1) == 2:   # (no friction)
+        supports = np.unique(np.asarray(run.system.x_contact, dtype=float))
+        _add_spring_supports(out, table, None, springs, units["force"], supports)
+    elif springs is not None and problem.obstacles is not None:
         _add_spring_supports(out, table, problem.obstacles, springs, units["force"])
     return out
 

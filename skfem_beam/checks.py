@@ -19,6 +19,21 @@ def check_finite(name: str, value) -> float:
     return value
 
 
+def check_bound(name: str, value, of: str) -> None:
+    """An obstacle's bound: a number (±inf: none; not NaN, not complex) or a vectorised
+    function (of ``of``), else one line naming it."""
+    if callable(value):
+        return
+    try:
+        ok = not np.iscomplexobj(value) and not math.isnan(float(value))
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        value = value.item() if isinstance(value, np.generic) else value
+        raise InputError(f"{name}={value!r} must be a number (m; ±inf: no bound) or a "
+                         f"vectorised function of {of}")
+
+
 def check_positive(name: str, value) -> float:
     value = check_finite(name, value)
     if value <= 0:

@@ -12,8 +12,8 @@ from typing import Callable
 
 import numpy as np
 
-from .checks import (check_beta, check_choice, check_count, check_finite,  # noqa: F401
-                     check_nonnegative, check_positive, check_ratio)
+from .checks import (check_beta, check_bound, check_choice, check_count,  # noqa: F401
+                     check_finite, check_nonnegative, check_positive, check_ratio)
 from .errors import InputError
 from .timefunctions import Constant, derivative
 from .spaces.ends import DEFAULT_ENDS, END_CONDITIONS, check_ends, fixed_dofs, support_nodes
@@ -295,13 +295,7 @@ class Obstacles:
         if not isinstance(self.carried, (bool, np.bool_)):
             raise InputError(f"carried={self.carried!r} must be True or False")
         for name in ("g1", "g2"):
-            g = getattr(self, name)
-            if not callable(g):
-                try:
-                    float(g)
-                except (TypeError, ValueError):
-                    raise InputError(f"{name}={g!r} must be a number (m; ±inf: none) or a "
-                                     "vectorised function of x") from None
+            check_bound(name, getattr(self, name), "x")
 
     @classmethod
     def stops(cls, x, g1, g2, carried: bool = False) -> "Obstacles":
@@ -361,8 +355,11 @@ class Obstacles:
     def point_stops(cls, x: float, g1: float, g2: float, carried: bool = False) \
             -> "Obstacles":
         """Two stops at one abscissa x (the first paper's scene at x = L)."""
-        g1 = check_finite("g1", g1) if np.isfinite(g1) else g1
-        g2 = check_finite("g2", g2) if np.isfinite(g2) else g2
+        for name, g in (("g1", g1), ("g2", g2)):
+            if callable(g):
+                raise InputError(f"point stops: {name} must be a number (m; ±inf: no bound)")
+            check_bound(name, g, "x")
+        g1, g2 = float(g1), float(g2)
 
         def lower(z, x=x, g=g1):
             return np.where(np.isclose(z, x, rtol=0, atol=1e-12 * max(1.0, abs(x))), g, -np.inf)

@@ -151,7 +151,11 @@ def test_stepped_beam_needs_a_node_at_the_step():
     # the kinds of a problem's parts (before: AttributeError or TypeError from inside)
     (lambda: BeamProblem(Beam(1.5, k2=282.84), (-0.1, 0.1), J=10),
      ["BeamProblem obstacles= is a tuple: it takes Obstacles(g1=-0.01, g2=0.01)"]),
-    (lambda: Obstacles(g1="a", g2=0.1), ["g1='a' must be a number (m; ±inf: none)"]),
+    (lambda: Obstacles(g1="a", g2=0.1), ["g1='a' must be a number (m; ±inf: no bound)"]),
+    # a NaN or complex bound ran as if there were none (NaN) or cast to its real part
+    (lambda: Obstacles(g1=float("nan")), ["g1=nan must be a number"]),
+    (lambda: Obstacles.stops([0.5, 1.0], [-0.1, np.nan], 0.1), ["g1=nan must be a number"]),
+    (lambda: Obstacles(g2=np.complex128(0.1)), ["g2=(0.1+0j) must be a number"]),
     (lambda: InitialState(v0=np.zeros(5)), ["InitialState v0=", "must be a function of x"]),
     (lambda: skfem_beam.modes(beam_system(BeamProblem(Beam(1.5, k2=282.84), J=4)), 2),
      ["modes needs the BeamProblem (not SemiDiscrete"]),

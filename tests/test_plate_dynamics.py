@@ -239,6 +239,7 @@ def _boom(x, y):
     (lambda S: PlateObstacle(points=(0.5, 0.5)), r"points=\(0.5, 0.5\) must be vertices"),
     (lambda S: plate_system(S, observe=(0.5, 0.5)), "observe=.* must be vertices"),
     (lambda S: PlateObstacle(g1="abc"), "g1='abc' must be a number"),
+    (lambda S: PlateObstacle(g2=np.nan), "PlateObstacle g2=nan must be a number"),
     (lambda S: plate_system(S, obstacles=None), "obstacles= must be a list"),
     (lambda S: PlateObstacle(g1=-1e-3, points=[(0.5, 0.5)], region=(0, 0.25, 0, 0.25)),
      "give region or points, not both"),

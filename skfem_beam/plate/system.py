@@ -20,7 +20,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
 
-from ..checks import check_finite
+from ..checks import check_bound, check_finite
 from ..errors import InputError
 from ..system import SemiDiscrete
 from .space import PlateSpace, check_space, load_vector, values_at
@@ -92,10 +92,7 @@ class PlateObstacle:
 
     def __post_init__(self):
         for name in ("g1", "g2"):
-            g = getattr(self, name)
-            if not callable(g) and not _number(g):
-                raise InputError(f"PlateObstacle {name}={g!r} must be a number (m; ±inf: no "
-                                 "bound) or a vectorised function of x, y")
+            check_bound(f"PlateObstacle {name}", getattr(self, name), "x, y")
         object.__setattr__(self, "points", _points("PlateObstacle points", self.points))
         if self.points and self.region is not None:
             raise InputError("PlateObstacle: give region or points, not both")
@@ -170,14 +167,6 @@ class PlateInitial:
             raise InputError(f"PlateInitial static={self.static!r} must be a Pressure (the "
                              "load whose static deflection starts the run) or None")
         _number_or_function("PlateInitial v0", self.v0, "m/s", "x, y")
-
-
-def _number(value) -> bool:
-    """Whether ``value`` is a number, ±inf included, not NaN."""
-    try:
-        return not np.isnan(float(value))
-    except (TypeError, ValueError):
-        return False
 
 
 def _points(what: str, points) -> tuple:

@@ -40,13 +40,16 @@ def _inside(region, x, y, tol: float) -> np.ndarray:
     return (x >= x0 - tol) & (x <= x1 + tol) & (y >= y0 - tol) & (y <= y1 + tol)
 
 
-def checked_region(what: str, region, plate, area: bool, written=None):
+def checked_region(what: str, region, space, area: bool, written=None):
     """``region`` = (x0, x1, y0, y1) (m) on the plate's bounding box, x0 ≤ x1 and y0 ≤ y1
     (``area``: both strict, a load's; else one side may be zero, a line of vertices, but
-    not both: a point is ``points``), or None; else one line naming it and the order.
-    ``written``: the region as a scene file writes it, [x0, y0, x1, y1], ``what`` its key."""
+    not both: a point is ``points``), or None; else one line naming it and the order.  It
+    must hold what it acts on: a load's (``area``) a quadrature point of the mesh, where
+    the load is integrated, an obstacle's a vertex.  ``written``: the region as a scene
+    file writes it, [x0, y0, x1, y1], ``what`` its key."""
     if region is None:
         return None
+    plate = space.plate
     if written is None:
         label, order = f"{what} region={region!r}", \
             "(x0, x1, y0, y1) in m (a scene file writes [x0, y0, x1, y1])"
@@ -64,7 +67,14 @@ def checked_region(what: str, region, plate, area: bool, written=None):
         raise InputError(f"{label} needs {need}: {order}")
     if x0 < bx0 - tol or y0 < by0 - tol or x1 > bx1 + tol or y1 > by1 + tol:
         raise InputError(f"{label} is off {plate.outline()}: {order}")
-    return x0, x1, y0, y1
+    region = x0, x1, y0, y1
+    if area and not region_holds_plate(space, region):
+        raise InputError(f"{label} holds no quadrature point of the plate's mesh, where the "
+                         "load is integrated (off the plate, or narrower than an element: "
+                         "widen it or refine the mesh)")
+    if not area and not region_vertices(space, region).any():
+        raise InputError(f"{label} holds no vertex of the mesh")
+    return region
 
 
 def region_vertices(space, region) -> np.ndarray:
@@ -104,11 +114,8 @@ class PlateObstacle:
             where = np.zeros(x.size, dtype=bool)
             where[[vertex_index(space, px, py) for px, py in self.points]] = True
         else:
-            region = checked_region("PlateObstacle", self.region, space.plate, area=False)
+            region = checked_region("PlateObstacle", self.region, space, area=False)
             where = region_vertices(space, region)
-            if not where.any():
-                raise InputError(f"PlateObstacle region={self.region!r} holds no vertex of "
-                                 "the mesh")
         lo, hi = np.full(x.size, -np.inf), np.full(x.size, np.inf)
         # g where it acts only: a table need not cover the plate
         lo[where] = values_at(self.g1, x[where], y[where], "PlateObstacle g1", bounds=True)
@@ -145,11 +152,7 @@ class Pressure:
     def vector(self, space: PlateSpace) -> np.ndarray:
         """b = ∫ p·1_region φ (N), all dofs."""
         tol = 1e-9 * space.plate.size
-        region = checked_region("Pressure", self.region, space.plate, area=True)
-        if region is not None and not region_holds_plate(space, region):
-            raise InputError(f"Pressure region={self.region!r} holds no quadrature point of "
-                             "the plate's mesh, where the load is integrated (off the plate, "
-                             "or narrower than an element: widen it or refine the mesh)")
+        region = checked_region("Pressure", self.region, space, area=True)
         return load_vector(space, lambda x, y: values_at(self.p, x, y, "Pressure p")
                            * _inside(region, x, y, tol))
 

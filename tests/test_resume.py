@@ -383,3 +383,21 @@ def test_a_sweep_folder_given_to_resume_names_the_sweep_command(tmp_path, capsys
     assert exit_code(point_stops.main, ["--resume", str(out)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "python -m skfem_beam.sweep, the same values" in err, err
+
+
+def test_resume_of_a_modes_folder_says_it_is_not_a_run(tmp_path, capsys):
+    """`modes` writes a summary.json without a run's config: --resume of its folder said
+    "not a readable summary (ValueError: no 'config' object)"."""
+    from skfem_beam.__main__ import main as skfem_main
+    scene = Path(point_stops.__file__).parents[1] / "scene_files" / "point_stops.toml"
+    out = tmp_path / "modes"
+    assert exit_code(skfem_main, ["modes", str(scene), "--out", str(out)]) == 0
+    capsys.readouterr()
+    before = snapshot(out)
+    for main, argv in ((point_stops.main, ["--resume", str(out)]),
+                       (skfem_main, ["run", str(scene), "--resume", str(out)])):
+        assert exit_code(main, argv) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert err == [f"error: {out} holds the results of `python -m skfem_beam modes`, not a "
+                       "run: there is nothing to resume, nothing was changed"], err
+    assert snapshot(out) == before

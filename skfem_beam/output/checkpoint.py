@@ -83,11 +83,16 @@ def read_summary(folder: Path) -> dict:
     path = Path(folder) / SUMMARY
     try:
         summary = json.loads(path.read_bytes().decode("utf-8"))
-        if not isinstance(summary, dict) or not isinstance(summary.get("config"), dict):
-            raise ValueError("no 'config' object")
     except (OSError, ValueError) as e:   # UnicodeDecodeError and JSONDecodeError included
+        summary = e
+    if isinstance(summary, dict) and "config" not in summary \
+            and isinstance(summary.get("command"), str):     # `modes`' folder
+        raise InputError(f"{folder} holds the results of `{summary['command']}`, not a run: "
+                         "there is nothing to resume, nothing was changed")
+    if not isinstance(summary, dict) or not isinstance(summary.get("config"), dict):
+        e = summary if isinstance(summary, Exception) else ValueError("no 'config' object")
         raise InputError(f"{path} is not a readable summary ({type(e).__name__}: {e}); "
-                         "cannot resume, nothing was changed") from None
+                         "cannot resume, nothing was changed")
     return summary
 
 
@@ -187,6 +192,7 @@ def _resume_folder(out) -> Path:
                if (out / CHECKPOINT).is_file() else "not the folder of a run")
         raise InputError(f"--resume {out}: no {SUMMARY} there: {why}; nothing to resume "
                          "from")
+    read_summary(out)       # before its lock: a folder of `modes` is not a run's
     return out
 
 

@@ -44,6 +44,44 @@ def test_contact_scheme_fails_where_linear_newmark_does(pipe_system, beta):
     assert np.isfinite(bad.energy).all()
 
 
+def _kept_sound(r):
+    """Every kept row finite, the tip within the stops, the running diagnostics of kept
+    states only (they counted the discarded ones: contact_fraction 44, penetration 1e79)."""
+    tip = r.observed["tip_displacement"]
+    assert np.isfinite(tip).all() and np.isfinite(r.energy).all()
+    assert np.abs(tip).max() <= 0.1 * (1 + 1e-12) and r.energy.min() >= 0, (tip, r.energy)
+    assert 0 <= r.contact_fraction <= 1 and r.max_nodal_violation < 1e-12
+
+
+@pytest.mark.parametrize("beta, ratio, save_every, word", [
+    # the loop tests saved states only: one saved state in 4,000 steps was none tested,
+    # and the run ended "success" with NaN fields
+    (0.0, 4.0, 100_000, "the state is not finite"),
+    # just above the limit the tip jumped from stop to stop every step, ½E_β fell to
+    # −5,400, inside the a-priori bound: "success"
+    (0.24, 1.05, 1, "< 0 (½E_β is positive while stable)"),
+    (0.2, 1.01, 1, "< 0 (½E_β is positive while stable)"),
+])
+def test_instability_the_energy_bound_missed_is_detected(pipe_system, beta, ratio,
+                                                          save_every, word):
+    dt = ratio * linear_limit(kappa_h(pipe_system), beta)
+    r = solve(pipe_system, dt, 0.2, beta, save_every=save_every, frames=2)
+    assert r.status == "unstable" and word in r.message, r.message
+    _kept_sound(r)
+
+
+def test_a_runaway_the_energy_hides_keeps_no_row_of_it(pipe_system):
+    """β = 0 beyond the limit, no contact: ½E_β is conserved exactly while the unstable
+    mode grows, so the loop's test fired only at ~1e4 m/s and kept rows with the tip at
+    8,000 m; only the states the kinetic-energy test vouched for are kept."""
+    free = beam_system(scenes.point_stops(gap=1e6))
+    dt = 2 * linear_limit(kappa_h(free), 0.0)
+    r = solve(free, dt, 0.5, 0.0, frames=2)
+    assert r.status == "unstable"
+    tip = r.observed["tip_displacement"]
+    assert np.isfinite(tip).all() and np.abs(tip).max() < 0.01, tip
+
+
 @pytest.mark.parametrize("beta", [0.25, 0.5])
 def test_unconditional_for_beta_at_least_a_quarter(pipe_system, beta):
     paper_kappa = PAPER_KAPPA_BOUNDS["hermite"]["first paper (5.2), 24·420·19²/37"] * 282.84 \
@@ -81,3 +119,25 @@ def test_stability_map_refuses_a_grid_over_budget(tmp_path, capsys):
     assert_refused(stability_map.main, ["--ratios", "0.01", "--T", "2", "--max-seconds", "1",
                                         "--out", str(tmp_path / "m")], "--max-seconds=1", capsys,
                    tmp_path)
+
+
+@pytest.mark.parametrize("scene, setting", [
+    ("flat_obstacles.toml", "loads.0.amplitude=1e200"),      # OverflowError traceback
+    ("flat_obstacles.toml", "loads.0.amplitude=1e308"),      # numpy warnings, a folder left
+    ("plates/plate_rattling.toml", "loads.0.pressure=1e200"),
+])
+def test_a_load_too_large_for_floats_is_one_line_and_no_folder(tmp_path, capfd, scene,
+                                                               setting):
+    """The run finds it at its first chunk: one line, exit 2, and the folder it had made
+    is removed (it was left "running", with rows)."""
+    from pathlib import Path
+    import skfem_beam
+    from skfem_beam.scenefile import run_main
+    path = Path(skfem_beam.__file__).parent / "scene_files" / scene
+    out = tmp_path / "run"
+    assert exit_code(run_main, [str(path), "--out", str(out), "--set", setting,
+                                "--format", "none"]) == 2
+    err = capfd.readouterr().err.strip().splitlines()
+    assert err[-1].startswith("error: the load is too large for floating point"), err
+    assert not any("Warning" in line for line in err), err
+    assert not out.exists()

@@ -212,6 +212,15 @@ class Folder:
         in the middle of this must still find it."""
         _empty(self.path, keep=(*OURS, SUMMARY))
 
+    def discard(self) -> None:
+        """Remove the folder this command made or emptied, with all it wrote: a run
+        refused once it started (bad input found by the run itself) leaves no folder."""
+        _empty(self.path, keep=())
+        try:
+            self.path.rmdir()
+        except OSError:
+            pass
+
     def reserve(self, size: int = 1 << 16) -> None:
         """Keep ``size`` bytes of disk, so that the final summary fits when the disk fills."""
         try:

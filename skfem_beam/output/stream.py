@@ -221,6 +221,9 @@ def execute(run: Run, options: OutputOptions, summary: dict, series, finish) -> 
                       file=sys.stderr)
             return _stream(_Stream(run, folder, options, series, stop, used, ck,
                                    can_checkpoint), finish)
+        except InputError as e:     # found by the run itself (a load too large for floats)
+            folder.fail(e) if resume else folder.discard()
+            raise
         finally:
             folder.release()
 

@@ -60,7 +60,8 @@ def load_norms(system, dt: float, beta: float) -> np.ndarray:
         return np.zeros(0)
     N = system.M if massless_rows(system.M).size == 0 else system.M + beta * dt**2 * system.K
     N = N.tocsc()
-    return np.sqrt(np.array([lv @ spla.spsolve(N, lv) for lv in system.loads.T]))
+    with np.errstate(over="ignore", invalid="ignore"):   # inf: Run refuses the load
+        return np.sqrt(np.array([lv @ spla.spsolve(N, lv) for lv in system.loads.T]))
 
 
 def step_operators(system, dt: float, beta: float, massless: str = "beta",

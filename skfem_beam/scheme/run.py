@@ -14,6 +14,7 @@ from ..stability import kappa_h, linear_limit
 from .kernels import (CONTACT_STEPS, EVENT_COLUMNS, EVENTS_FULL, EVENTS_WRITTEN, FAILED, ROW0,
                       STOPPED_AT, UNSTABLE, WORK_TERMS, Inputs, PythonLaw)
 from .stepping import Named, Result
+from .watch import Watch
 
 FIRST_ROWS = 1 << 15      # saved rows allocated at first; more as a chunk needs them
 SAVED = ("obs", "obsv", "energy", "work", "lam", "resid")   # the saved series, by row
@@ -123,6 +124,7 @@ class Run:
         self.status, self.message = "running", ""
         self.n = scheme.start(self.out)     # the last computed state
         self.E1 = float(self.out.energy[0])
+        self.watch = Watch(self)
         self._steps(self.n, self.n, 0.0)
         if self.n == 0:                     # a scheme that starts from the data itself
             self.advance(1)
@@ -259,16 +261,21 @@ class Run:
         if self.done or n1 <= n0:
             return
         t0 = time.perf_counter()
-        inputs = (self._next if self._next[0] == (n0, n1) else self.scheme.inputs(n0, n1))[1]
-        G = inputs.G
-        self.load_bound += float((np.abs(G) @ self.load_norm).sum()) * self.dt \
-            if G.shape[1] else 0.0
+        with np.errstate(over="ignore", invalid="ignore"):     # a load's inf: refused below
+            inputs = (self._next if self._next[0] == (n0, n1)
+                      else self.scheme.inputs(n0, n1))[1]
+            G = inputs.G
+            self.load_bound += float((np.abs(G) @ self.load_norm).sum()) * self.dt \
+                if G.shape[1] else 0.0
         # the bound grows with n: its chunk-end value is the loosest for the chunk
-        Ebound = self.stepping.growth_limit * (math.sqrt(abs(self.E1)) + self.load_bound) ** 2 \
-            + 1e-300
+        root = math.sqrt(abs(self.E1)) + self.load_bound
+        Ebound = self.stepping.growth_limit * root * root + 1e-300     # inf, not OverflowError
         if not math.isfinite(Ebound):
             raise InputError(f"the load is too large for floating point: its work by step {n1} "
-                             f"is {self.load_bound:g}")
+                             f"is {self.load_bound:g}" if math.isfinite(self.load_bound) else
+                             "the load is too large for floating point: its work overflows")
+        # the running diagnostics before the chunk: an unstable chunk's are not the run's
+        self._before = self.st.stats.copy(), self.st.counters[:3].copy()
         code, at = self._steps(n0, n1, Ebound, inputs), n0
         while code == EVENTS_FULL:       # take the impact events, go on from where it stopped
             self._take_events()
@@ -283,7 +290,8 @@ class Run:
             # the last chunk's rows but has not got this one's: computed while it formats
             # them, they wait for the GIL it holds (measured: 2.5 s instead of 0.3 s over
             # 2,000,000 steps saved at every step)
-            self._next = self.scheme.inputs(n1, min(2 * n1 - n0, self.n_steps))
+            with np.errstate(over="ignore", invalid="ignore"):
+                self._next = self.scheme.inputs(n1, min(2 * n1 - n0, self.n_steps))
         self.wall += time.perf_counter() - t0
         k = self.stopped_at
         if code == FAILED:
@@ -296,18 +304,33 @@ class Run:
             raise SolverError(f"the {self.solver} contact solver failed at step {k} "
                               f"(t={k * self.dt:.6g} s){why}")
         if code == UNSTABLE:
-            self.status = "unstable"
-            self.message = (f"unstable at step {k} (t={k * self.dt:.6g} s): energy "
-                            f"{self.energy[k // self.save_every]:.3g} exceeds {Ebound:.3g}; "
-                            f"dt={self.dt:g} s, {self.label}")
-            if self.beta is not None:
-                limit = linear_limit(kappa_h(self.system), self.beta)
-                self.message += f", linear stability limit 2/√(κ_h(1−4β)) = {limit:.4g} s"
-            self.n = (k // self.save_every - 1) * self.save_every   # last good saved state
-            return
+            early = self.watch.negative(n0, k - 1, Ebound)   # a negative energy before it
+            if early is not None:
+                return self._unstable(*early)
+            return self._unstable(k, f"energy {self.energy[k // self.save_every]:.3g} "
+                                  f"exceeds {Ebound:.3g}", (k // self.save_every - 1)
+                                  * self.save_every)
+        bad = self.watch.bad(n0, n1, Ebound)
+        if bad is not None:
+            return self._unstable(*bad)
         self.n = n1
         if n1 == self.n_steps:
             self.status, self.message = "success", "the run reached T"
+
+    def _unstable(self, k: int, why: str, good: int) -> None:
+        """Stop as unstable at state ``k`` (``why``), keeping the saved states up to
+        ``good``, the last one that passed every test, and the running diagnostics
+        (penetration, impacts, contact steps) of the states before the chunk."""
+        self.st.stats[:], self.st.counters[:3] = self._before
+        self.status = "unstable"
+        self.message = f"unstable at step {k} (t={k * self.dt:.6g} s): {why}; " \
+            f"dt={self.dt:g} s, {self.label}"
+        if self.beta is not None:
+            limit = linear_limit(kappa_h(self.system), self.beta)
+            self.message += f", linear stability limit 2/√(κ_h(1−4β)) = {limit:.4g} s"
+            if self.dt > limit:     # ½E_β hides the growth: only what the watch vouched for
+                good = min(good, self.watch.vouched // self.save_every * self.save_every)
+        self.n = good
 
     # the saved series by saved-row number (see SavedRows), as the output pipeline reads them
     obs = property(lambda self: SavedRows(self, "obs"))

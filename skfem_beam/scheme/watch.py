@@ -1,0 +1,91 @@
+"""What the compiled loop's energy test (kernels.stop_code: |½E_β| ≤ the a-priori bound at
+every saved state) does not see, checked after each chunk, in Python, on the chunk's saved
+energies and its last state.
+
+- **A negative energy.**  ½E_β = ½δᵀ(M/Δt² + (β − ¼)K)δ + ½aᵀKa (δ = uⁿ − uⁿ⁻¹, a their
+  mean) is positive for every state exactly when Δt is below the linear stability limit
+  (β < ¼) or always (β ≥ ¼), so a saved ½E_β below round-off's −1e-9 × the bound means the
+  unstable modes have taken over: just above the limit the tip jumped from stop to stop at
+  every step while ½E_β went from 1.4 to −5,400, inside the loose a-priori bound.
+- **A growing kinetic energy under a constant ½E_β.**  Without contact the scheme conserves
+  ½E_β exactly, unstable or not (β = 0 beyond the limit: ½E_β stays 1.32 while the beam
+  reaches 1e4 m/s); the kinetic energy ½δᵀMδ/Δt² ≤ ½E_β/(1 − r²) while stable, r² =
+  Δt²κ_h(¼ − β) < 1 (r = 0 for β ≥ ¼), so past the bound / (1 − min(r², 0.99)) it is not.
+- **The last state of a chunk**, saved or not (``save_every`` may not divide the chunk, or
+  be larger than the run): finite, and the two tests above.
+
+Beyond the linear limit (β < ¼) a run whose loop test fires keeps no row after the last
+chunk end that passed: ½E_β hid the growth until then.
+
+A redistributed mass (massless rows: M singular) leaves ½E_β indefinite on those rows
+whatever Δt: there only finiteness and the loop's bound are checked."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+ROUND_OFF = 1e-9       # of the bound: a saved energy below −ROUND_OFF × bound is negative
+R2_CAP = 0.99          # r² used at or beyond the linear limit (no bound there)
+
+
+class Watch:
+    """The checks above for one run (``run``: scheme.Run); ``bad(n0, n1, Ebound)`` after
+    the chunk n0 → n1: None, or (the state where it failed, why, the last saved state
+    that passed them all)."""
+
+    def __init__(self, run):
+        self.run, self._kappa = run, None
+        self.vouched = run.n        # the last chunk's end that passed every test
+        from ..spaces.redistribution import massless_rows
+        self.definite = massless_rows(run.system.M).size == 0
+
+    def bad(self, n0: int, n1: int, Ebound: float):
+        floor = -ROUND_OFF * Ebound
+        negative = self.negative(n0, n1, Ebound)
+        if negative is not None:
+            return negative
+        why = self._last_state(Ebound, floor)
+        if why is None:
+            self.vouched = n1
+            return None
+        # the chunk's saved rows before n1 were not seen with this state's tests
+        return n1, why, (n0 // self.run.save_every) * self.run.save_every
+
+    def negative(self, n0: int, n1: int, Ebound: float):
+        """The first saved state of n0 < n ≤ n1 whose energy is negative, as ``bad``."""
+        run, every = self.run, self.run.save_every
+        if not self.definite:
+            return None
+        rows = np.arange(n0 // every + 1, n1 // every + 1)
+        energy = np.asarray(run.energy[rows], dtype=float) if rows.size else rows
+        below = np.flatnonzero(energy < -ROUND_OFF * Ebound)
+        if not below.size:
+            return None
+        k = int(rows[below[0]]) * every
+        return k, f"energy {energy[below[0]]:.3g} < 0 (½E_β is positive while stable)", \
+            k - every
+
+    def _last_state(self, Ebound: float, floor: float) -> str | None:
+        run = self.run
+        u, u_prev = run.u_cur, run.u_prev
+        if not (np.isfinite(u).all() and np.isfinite(u_prev).all()):
+            return "the state is not finite"
+        if run.beta is None or not self.definite:   # Moreau–Jean: ½vᵀMv + ½uᵀKu, the loop's
+            return None
+        s, dt = run.system, run.dt
+        d, a = u - u_prev, 0.5 * (u + u_prev)
+        kinetic = 0.5 * float(d @ (s.M @ d)) / dt ** 2
+        # the structure's ½E_β (a penalty run saves its springs' energy besides)
+        energy = kinetic + 0.5 * float((run.beta - 0.25) * (d @ (s.K @ d)) + a @ (s.K @ a))
+        if not (math.isfinite(energy) and floor <= energy <= Ebound):
+            return f"energy {energy:.3g} outside [0, {Ebound:.3g}]"
+        if kinetic > Ebound and kinetic > Ebound / (1 - min(self._r2(), R2_CAP)):
+            return f"kinetic energy {kinetic:.3g} above {Ebound:.3g}/(1 − r²)"
+        return None
+
+    def _r2(self) -> float:
+        if self._kappa is None:
+            from ..stability import kappa_h
+            self._kappa = kappa_h(self.run.system)
+        return self.run.dt ** 2 * self._kappa * max(0.25 - self.run.beta, 0.0)

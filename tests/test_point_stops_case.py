@@ -90,6 +90,21 @@ def test_overwrite_refuses_a_folder_no_run_wrote(tmp_path):
     assert sorted(q.name for q in tmp_path.rglob("*")) == ["data", "thesis.tex", "x.csv"]
 
 
+def test_overwrite_keeps_the_users_files_in_a_run_folder(tmp_path):
+    """A run's folder holding a user's notes and an export's default .mat: --overwrite
+    deleted both without a word; it now names them, exit 2, and removes nothing."""
+    out = tmp_path / "run"
+    assert run(["--T", "0.01", "--out", str(out)]).returncode == 0
+    (out / "notes.txt").write_text("mine")
+    (out / "run.mat").write_bytes(b"MATLAB")
+    before = sorted(q.name for q in out.iterdir())
+    p = run(["--T", "0.01", "--out", str(out), "--overwrite"])
+    assert p.returncode == 2 and p.stderr.strip() == (
+        f"error: --out {out} holds files besides the run's (notes.txt, run.mat): --overwrite "
+        "replaces only what a run writes; move them out or choose another folder")
+    assert sorted(q.name for q in out.iterdir()) == before
+
+
 def test_unstable_run_exit_code_and_valid_files(tmp_path):
     out = tmp_path / "run"
     p = run(["--beta", "0.1", "--dt", "1.92e-5", "--T", "0.1", "--out", str(out)])

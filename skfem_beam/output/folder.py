@@ -14,6 +14,7 @@ blocks the next one); a second run or resume into the same folder is refused.
 from __future__ import annotations
 
 import fcntl
+import fnmatch
 import json
 import os
 import shutil
@@ -33,6 +34,10 @@ from ..lock import LOCK, check_not_busy, lock_folder, release  # noqa: F401 (her
 SUMMARY = "summary.json"
 RESERVE = ".reserve"    # a little disk kept back, freed to write the final summary
 OURS = (LOCK, RESERVE)
+# what the project's commands write in a folder, which --overwrite may remove: anything
+# else there (a user's notes, an export's .mat or .npz) is refused by name, not deleted
+WRITTEN = ("*.csv", "*.png", "*.json", "*.xdmf", "*.h5", "*.pvd", "*.mp4", "*.gif",
+           "checkpoint.npz", ".*", "fields_vtu", "runs")
 OPENED: list[Path] = []         # the folders this process opened (for the interrupt line)
 
 
@@ -93,6 +98,13 @@ def _check_replaceable(out: Path, overwrite: bool) -> None:
         raise InputError(f"--out {out} holds files no run wrote ({shown}); --overwrite "
                          f"replaces only a run's folder (one with its {SUMMARY}): choose "
                          f"a new or empty folder")
+    foreign = sorted(p.name for p in out.iterdir()
+                     if not any(fnmatch.fnmatch(p.name, w) for w in WRITTEN))
+    if foreign:
+        shown = ", ".join(foreign[:3]) + (", …" if len(foreign) > 3 else "")
+        raise InputError(f"--out {out} holds files besides the run's ({shown}): --overwrite "
+                         "replaces only what a run writes; move them out or choose another "
+                         "folder")
 
 
 def _empty(out: Path, keep: tuple[str, ...]) -> None:

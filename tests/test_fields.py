@@ -3,6 +3,7 @@ import json
 import os
 import shutil
 import subprocess
+import sys
 import textwrap
 import xml.etree.ElementTree as ET
 
@@ -242,7 +243,8 @@ def test_bspline_and_bar_spaces(tmp_path):
 
 
 def test_streaming_writer(run, tmp_path, monkeypatch):
-    """Frames go out one by one; flush() makes the files readable mid-run; the .h5 is
+    """Frames go out one by one; flush() makes the files readable mid-run by another
+    process (the .h5 is not locked: ParaView aborted on a run in progress); the .h5 is
     written beside the .xdmf whatever the working directory."""
     elsewhere = tmp_path / "cwd"
     elsewhere.mkdir()
@@ -253,9 +255,11 @@ def test_streaming_writer(run, tmp_path, monkeypatch):
         for k in range(3):
             w.write(run.frames_t[k], run.frames_u[k], run.frames_v[k], run.frames_force[k])
         w.flush()
-        with meshio.xdmf.TimeSeriesReader(out / "live.xdmf") as rd:
-            rd.read_points_cells()
-            assert rd.num_steps == 3
+        read = ("import meshio, sys\nwith meshio.xdmf.TimeSeriesReader(sys.argv[1]) as rd:\n"
+                "    rd.read_points_cells(); print(rd.num_steps)")
+        p = subprocess.run([sys.executable, "-c", read, str(out / "live.xdmf")],
+                           capture_output=True, text=True)
+        assert p.returncode == 0 and p.stdout.strip() == "3", p.stderr
         assert len(ET.parse(out / "live.pvd").getroot().findall(".//DataSet")) == 3
         w.write(run.frames_t[3], run.frames_u[3], run.frames_v[3], run.frames_force[3])
         with pytest.raises(ValueError, match="shapes"):

@@ -44,6 +44,7 @@ import scipy.sparse as sp
 
 from ..errors import InputError
 from ..semidiscrete import SceneView
+from .folder import atomic_write
 
 FORMATS = ("xdmf", "vtu", "both", "none")
 
@@ -421,8 +422,8 @@ class FieldWriter:
         for t, rel in zip(self.times, self._vtu_files):
             ET.SubElement(coll, "DataSet", timestep=repr(t), group="", part="0", file=rel)
         ET.indent(root)
-        ET.ElementTree(root).write(self.folder / f"{self.name}.pvd", xml_declaration=True,
-                                   encoding="utf-8")
+        atomic_write(self.folder / f"{self.name}.pvd", lambda fh: ET.ElementTree(root).write(
+            fh, xml_declaration=True, encoding="utf-8"), binary=True)
 
     def flush(self) -> None:
         """Write the XML indexes now, so the files already read back as they are."""

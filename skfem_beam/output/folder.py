@@ -132,11 +132,13 @@ def _plain(value):
     return value
 
 
-def atomic_write(path: Path, write) -> None:
-    """``write(fh)`` into a hidden sibling of ``path``, then rename it into place."""
+def atomic_write(path: Path, write, binary: bool = False) -> None:
+    """``write(fh)`` into a hidden sibling of ``path``, then rename it into place (a reader,
+    or a run killed meanwhile, sees the old file or the new one, never half of one)."""
+    path = Path(path)
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     try:
-        with open(tmp, "w", newline="") as fh:
+        with (open(tmp, "wb") if binary else open(tmp, "w", newline="")) as fh:
             write(fh)
         os.replace(tmp, path)
     except BaseException:

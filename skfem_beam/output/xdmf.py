@@ -9,11 +9,13 @@ chart process draws on the other core (docs/design.md, "The whole command").
 from __future__ import annotations
 
 import os
+import xml.etree.ElementTree as ET
 
 import h5py
 import meshio
 import numpy as np
-from meshio._common import write_xml
+
+from .folder import atomic_write
 
 
 class XdmfSeries(meshio.xdmf.TimeSeriesWriter):
@@ -37,8 +39,13 @@ class XdmfSeries(meshio.xdmf.TimeSeriesWriter):
 
     def __enter__(self):
         self.h5_filename = str(self.filename.with_suffix(".h5"))
-        self.h5_file = h5py.File(self.h5_filename, "w")
+        # unlocked: ParaView opening a run in progress aborted on HDF5's lock
+        self.h5_file = h5py.File(self.h5_filename, "w", locking=False)
         return self
+
+    def __exit__(self, *_):
+        self.flush()
+        self.h5_file.close()
 
     def write_points_cells(self, points, cells):
         super().write_points_cells(points, cells)
@@ -75,6 +82,9 @@ class XdmfSeries(meshio.xdmf.TimeSeriesWriter):
             include.set("xpointer", self._pointer)
 
     def flush(self):
-        """Make the files readable as they are now (meshio writes the XML only at exit)."""
-        write_xml(self.filename, self.xdmf_file)
+        """Make the files readable as they are now (meshio writes the XML only at exit): the
+        data first, then the XML that points at it, replaced whole (a run killed while
+        meshio wrote it in place left it empty or cut, and ParaView aborted on it)."""
         self.h5_file.flush()
+        atomic_write(self.filename, lambda fh: ET.ElementTree(self.xdmf_file).write(fh),
+                     binary=True)

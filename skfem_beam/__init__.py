@@ -4,6 +4,8 @@ import sys as _sys
 if _sys.argv[:1] == ["-m"]:   # a command starting (runpy is importing it): Ctrl-C during
     from ._startup import command_starting   # the imports is one line and exit 130,
     command_starting()                        # until the command's own handlers take over
+from ._startup import numba_cache as _numba_cache
+_numba_cache()      # before the kernels' modules: numba needs a writable cache folder
 from .errors import InputError, SolverError
 from .modes import Modes, modes
 from .problem import (Beam, BeamProblem, Damping, InitialState, Load, Material, Obstacles,

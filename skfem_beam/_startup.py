@@ -12,6 +12,7 @@ import gc
 import os
 import signal
 import sys
+import tempfile
 import threading
 
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
@@ -99,3 +100,26 @@ def end(code: int) -> None:
     if pending:
         _ending(pending[0], None)
     os._exit(code)
+
+
+def numba_cache() -> None:
+    """A folder for numba's cache: beside the sources (numba's first choice) or the user's
+    cache folder; when neither can be written (a shared read-only install, no writable
+    HOME) a folder of this user's in the temporary directory, since numba then raised at
+    import ("no locator available") and every command, --help included, was a traceback.
+    A NUMBA_CACHE_DIR of the user's is kept."""
+    if os.environ.get("NUMBA_CACHE_DIR") or os.access(os.path.dirname(__file__), os.W_OK):
+        return
+    user = os.path.join(os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"),
+                        "numba")
+    try:
+        os.makedirs(user, exist_ok=True)
+        tempfile.TemporaryFile(dir=user).close()
+        return
+    except OSError:
+        pass
+    path = os.path.join(tempfile.gettempdir(), f"skfem_beam-numba-{os.getuid()}")
+    os.environ["NUMBA_CACHE_DIR"] = path
+    if "numba" in sys.modules:      # imported before us: its config read the environment
+        sys.modules["numba"].config.CACHE_DIR = path
+

@@ -204,11 +204,13 @@ def psd_from_csv(path, seed: int = 0, df: float | None = None) -> SumOfSines:
 def _two_columns(path: Path, names: str) -> tuple[list, list, int]:
     """The two numeric columns of a CSV file and its header lines (a non-numeric first
     line is a header, 0 or 1); one error line naming the file and the row otherwise."""
-    try:
-        with open(path, newline="") as fh:
+    try:    # -sig: a byte-order mark (Excel's "CSV UTF-8") made the first row a header
+        with open(path, newline="", encoding="utf-8-sig") as fh:
             rows = [r for r in csv.reader(fh) if r and any(c.strip() for c in r)]
     except OSError as e:
         raise InputError(f"cannot read the table {path}: {e.strerror}") from None
+    except UnicodeDecodeError:
+        raise InputError(f"{path}: not a UTF-8 text file (a CSV of numbers)") from None
     header = 0
     if rows:
         try:

@@ -74,9 +74,12 @@ def profile_values(value, x: np.ndarray) -> np.ndarray:
 def read_profile(path: str, flag: str) -> Table:
     """A profile from a CSV file of x,value rows (a header line and # comments allowed)."""
     try:
-        lines = open(path, encoding="utf-8").read().splitlines()
+        with open(path, encoding="utf-8-sig") as fh:       # a byte-order mark is no header
+            lines = fh.read().splitlines()
     except OSError as e:
         raise InputError(f"{flag} {path}: cannot read it ({e.strerror or e})") from None
+    except UnicodeDecodeError:
+        raise InputError(f"{flag} {path}: not a UTF-8 text file (a CSV of numbers)") from None
     pairs = []
     for i, line in enumerate(lines, 1):
         cells = [c.strip() for c in line.split("#")[0].split(",")]

@@ -39,7 +39,7 @@ def read(path, overrides=(), files: dict | None = None, text: str | None = None,
     path = scene_path(path)
     if text is None:
         try:
-            text = path.read_text(encoding="utf-8")
+            text = path.read_text(encoding="utf-8-sig")     # a byte-order mark is no TOML
         except OSError as e:
             raise InputError(f"cannot read the scene file {path}: {e.strerror}") from None
         except UnicodeDecodeError:
@@ -181,7 +181,7 @@ class Tables:
             return p
         p = Path(name) if Path(name).is_absolute() else self.base / name
         try:
-            self.read[name] = p.read_text(encoding="utf-8")
+            self.read[name] = p.read_text(encoding="utf-8-sig")
         except (OSError, UnicodeDecodeError):
             pass    # the reader names the file and why (Table.from_csv)
         return p

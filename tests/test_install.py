@@ -52,3 +52,22 @@ def test_a_missing_extra_is_named_in_one_line(monkeypatch):
     with pytest.raises(InputError, match=r'pip install "skfem_beam\[cluster\]"'):
         with dask_client(scheduler="tcp://127.0.0.1:1"):
             pass
+
+
+def test_numba_gets_a_cache_folder_where_nothing_else_is_writable(tmp_path, monkeypatch):
+    """A shared read-only install run by an account without a writable HOME: numba found
+    no cache locator and every command, --help included, was a traceback at import."""
+    import os
+    import tempfile
+    from skfem_beam import _startup
+    blocked = tmp_path / "file"
+    blocked.write_text("")
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(blocked))     # cannot hold a folder
+    monkeypatch.setattr(_startup.os, "access", lambda path, mode: False)
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    import numba
+    monkeypatch.setattr(numba.config, "CACHE_DIR", numba.config.CACHE_DIR)  # restored after
+    _startup.numba_cache()
+    assert os.environ["NUMBA_CACHE_DIR"] == str(tmp_path / f"skfem_beam-numba-{os.getuid()}")
+    assert numba.config.CACHE_DIR == os.environ["NUMBA_CACHE_DIR"]

@@ -90,7 +90,9 @@ SECTION_DOCS = {
         'or `u0 = {x = [...], u = [...]}` (cubic spline; bar: linear, or a number), `v0 = {x, '
         "v}`; two planes: these are the first plane's, `u0_w = {x, u}`, `v0_w = {x, v}` the "
         "second's (without them w starts at rest); beams read them in the fixed frame (ũ, "
-        'ũ_t) unless `fixed_frame = false`: no `[initial]` is at rest'
+        'ũ_t) unless `fixed_frame = false`: no `[initial]` is at rest on the supports (a '
+        'support displaced at t = 0 carries the beam in its static shape there); a `u0` '
+        'that misses a clamped or pinned end or a support is refused'
     ),
     'mesh': (
         '`J` (elements, default 19; a node must fall on every obstacle end, support and '

@@ -95,18 +95,32 @@ def _load_columns(problem: BeamProblem, space, profiles, times):
 
 
 def _initial(problem: BeamProblem, space, lift: Lifting | None):
-    """(u0, v0): interpolated u0, L²-projected v0; in the fixed frame, minus h φ(0), h φ'(0)."""
+    """(u0, v0): interpolated u0, L²-projected v0; in the fixed frame, minus h φ(0), h φ'(0).
+    With no u0 the beam starts at rest in its static shape on the support at φ(0) (ũ =
+    h_s φ(0), h_s the static lifting): flat in the fixed frame it missed a support that
+    starts away from 0, and the interpolant dropped the gap, a kink whose strain energy grew
+    as J³."""
     ini = problem.initial
     u0f, du0f, v0f = ini.u0, ini.du0, ini.v0
     if ini.fixed_frame and lift is not None:
         p0, dp0 = float(lift.motion.phi(0.0)), float(lift.motion.phi_d(0.0))
         zero = lambda x: np.zeros(np.shape(x))  # noqa: E731
-        ut, vt = u0f or zero, v0f or zero
-        dut = du0f or (five_point_slope(ut, 1e-3 * problem.beam.L) if u0f else zero)
-        dh = lift.h_d
-        u0f = lambda x: ut(x) - lift.h(x) * p0  # noqa: E731
-        du0f = lambda x: dut(x) - dh(x) * p0  # noqa: E731
+        vt = v0f or zero
+        if u0f is None and p0 != 0.0 and lift.kind == "paper":
+            c = static_lifting(space, lift.motion.at, problem.beam.k2)
+            hs, dhs = _evaluator(space, c, 0), _evaluator(space, c, 1)
+            u0f = lambda x: (hs(x) - lift.h(x)) * p0  # noqa: E731
+            du0f = lambda x: (dhs(x) - lift.h_d(x)) * p0  # noqa: E731
+        elif u0f is not None:
+            ut = u0f
+            dut = du0f or five_point_slope(ut, 1e-3 * problem.beam.L)
+            dh = lift.h_d
+            u0f = lambda x: ut(x) - lift.h(x) * p0  # noqa: E731
+            du0f = lambda x: dut(x) - dh(x) * p0  # noqa: E731
+            _meets_support(problem, u0f, p0)
         v0f = lambda x: vt(x) - lift.h(x) * dp0  # noqa: E731
+    elif u0f is not None:
+        _meets_support(problem, u0f, 0.0)
     u0 = space.interpolate(u0f, du0f) if u0f is not None else np.zeros(space.n)
     # initial velocity: L² projection (v0 need not be in V: the first paper's v0 = −2h has
     # v0(0) = −2 ≠ 0; (2.1) asks for convergence in H, which the L² projection gives best)
@@ -114,6 +128,24 @@ def _initial(problem: BeamProblem, space, lift: Lifting | None):
     if not (np.isfinite(u0).all() and np.isfinite(v0).all()):
         raise InputError("the initial state u0, v0 is not finite")
     return u0, v0
+
+
+def _meets_support(problem: BeamProblem, u, p0: float) -> None:
+    """Refuse an initial displacement that misses what holds the beam at t = 0 (``u``: the
+    relative u0, zero there; ``p0``: φ(0), the moving support's start): the interpolant
+    dropped the gap, a kink whose strain energy grew as J³.  (A slope it sets itself: a
+    table's spline cannot be told its end slope.)"""
+    L = problem.beam.L
+    held = [x for x, e in ((0.0, problem.ends[0]), (L, problem.ends[1]))
+            if e in ("clamped", "pinned")] + list(problem.supports)
+    scale = max(abs(p0), float(np.abs(np.asarray(u(np.linspace(0.0, L, 41)))).max()))
+    for x in held:
+        gap = float(np.asarray(u(np.array([x])), dtype=float).ravel()[0])
+        if not abs(gap) <= 1e-6 * scale:
+            raise InputError(
+                f"[initial] u0 misses what holds the beam at x={x:g} at t = 0 by {gap:.3g} m "
+                f"(the support is at {p0 if x == problem.support.at else 0.0:g} m there): "
+                "start the beam on it, or give no u0 (it starts at rest on its supports)")
 
 
 class _Plane(NamedTuple):

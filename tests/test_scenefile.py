@@ -877,3 +877,15 @@ def test_a_bad_time_grid_names_its_key_or_flag(tmp_path, capsys, argv, line):
     out.mkdir()
     assert_refused(run_main, [str(write(tmp_path, PIPE)), *argv, "--out", str(out / "r")],
                    line, capsys, out)
+
+
+@pytest.mark.parametrize("setting, written", [
+    # read as truthy before: "false" ran as true (6 impacts, not 9), 0 as a load
+    ('initial.fixed_frame="false"', "--set initial.fixed_frame=\"false\""),
+    ("loads.0.distributed=0", "--set loads.0.distributed=0"),
+    ('loads.0.per_mass="no"', "--set loads.0.per_mass=\"no\""),
+])
+def test_a_flag_is_true_or_false(tmp_path, capsys, setting, written):
+    scene = example("flat_obstacles.toml")
+    assert_refused(run_main, [str(scene), "--set", setting, "--out", str(tmp_path / "x")],
+                   f"{written}: must be true or false (no quotes)", capsys, tmp_path)

@@ -25,6 +25,13 @@ class Number:
 N = Number()
 
 
+class Flag:
+    """In a schema: true or false (TOML's booleans; "false" or 0 read as true, silently)."""
+
+
+B = Flag()
+
+
 class ListOf:
     """In a schema: an array whose every item is ``item`` (N, or a ListOf: an array of
     arrays), checked where the file is read, so that a unit string inside a list is one
@@ -130,14 +137,14 @@ BEAM_KEYS = {
     "supports": [{"x": N}],
     "motion": {"end": V, "at": N, "lifting": V, "direction": NUMBERS, **TIME},
     "obstacles": [{"x": N, "x_from": N, "x_to": N, "g1": G, "g2": G, "hole": HOLE,
-                   "carried": V, "stiffness": N, "damping": N, "friction": N}],
+                   "carried": B, "stiffness": N, "damping": N, "friction": N}],
     "wear": {"coefficient": N, "service_years": N, "land": N, "radius": N},
     "damping": {"zeta": N, "f1": N, "f2": N, "alpha": N, "alpha_K": N, "modal": N},
-    "loads": [{"x": N, "distributed": V, "per_mass": V, "gravity": N, "x_from": N, "x_to": N,
+    "loads": [{"x": N, "distributed": B, "per_mass": B, "gravity": N, "x_from": N, "x_to": N,
                "direction": NUMBERS, "rotating": {"amplitude": N, "omega": N,
                                                   "phase": N},
                **TIME}],
-    "initial": {"mode": N, "amplitude": N, "u0": U0, "v0": V0, "fixed_frame": V,
+    "initial": {"mode": N, "amplitude": N, "u0": U0, "v0": V0, "fixed_frame": B,
                 "u0_w": U0, "v0_w": V0},
     "mesh": {"J": N, "element": V, "nodes": NUMBERS, "mass": V, "massless": V},
     "time": TIME_KEYS, "contact": CONTACT, "output": OUTPUT,
@@ -221,6 +228,9 @@ def _check_value(value, sub, path: tuple, sets) -> None:
     if sub is N:
         if not _is_number(value):
             raise _bad_value(path, value, sets, f"a number, {SI}")
+    elif sub is B:
+        if not isinstance(value, bool):
+            raise _bad_value(path, value, sets, "true or false (no quotes)")
     elif isinstance(sub, Names):
         if not isinstance(value, dict):
             raise InputError(f"{key_path(path)} must be a table of names = values "

@@ -115,6 +115,11 @@ def parse(p: Parser, argv=None):
     args = stored_args(p.parse_args(argv), p, argv)
     if hasattr(args, "law"):
         check_law(args, p)
+        if args.law == methods.MOREAU_JEAN and not args.resume \
+                and "beta" in _given(p, argv):
+            # it was checked and not used: --beta 0 ran as stable, warned of its limit
+            raise InputError(f"--beta {args.beta:g} is the β-scheme's β; --law "
+                             f"{methods.MOREAU_JEAN} has none (its θ: --theta)")
         if args.beta is None:
             args.beta = methods.default_beta(method(args))
     return args

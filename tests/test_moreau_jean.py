@@ -99,3 +99,20 @@ def test_command_line_moreau_jean_and_restitution_run(tmp_path):
         s = json.loads((out / "summary.json").read_text())
         assert s["status"] == "success" and s["solver"] == {"moreau-jean": "moreau-jean",
                                                               "0.5": "restitution"}[args[1]]
+
+
+def test_a_beta_given_to_moreau_jean_is_refused(tmp_path, capsys):
+    """Moreau–Jean has θ, no β: a β given to it was checked and not used (β = 0 ran, as
+    stable as any, after a warning of the β-scheme's stability limit)."""
+    from conftest import assert_refused
+    from skfem_beam.cases import flat_obstacles
+    from skfem_beam.scenefile import example, run_main
+    assert_refused(flat_obstacles.main, ["--law", "moreau-jean", "--beta", "0", "--out",
+                                         str(tmp_path / "a")],
+                   "--beta 0 is the β-scheme's β; --law moreau-jean has none (its θ: --theta)",
+                   capsys, tmp_path)
+    assert_refused(run_main, [str(example("flat_obstacles.toml")), "--set",
+                              "contact.law=moreau-jean", "--set", "time.beta=0.25", "--out",
+                              str(tmp_path / "b")],
+                   "[time] beta = 0.25 is the β-scheme's β; [contact] law = moreau-jean has "
+                   "none (its θ: [contact] theta)", capsys, tmp_path)

@@ -415,6 +415,7 @@ def sweep(settings: dict, values: list[float], out, client=None, progress: bool 
     (RETRIES times), then marked failed in runs.csv while the others finish.
     ``task``: what runs one value (default :func:`run_value`).
     """
+    out = Path(out)         # a str too (bench.sweep_throughput's temporary folder)
     results, timing = run_values(settings, values, out, client, progress, warm, task)
     return assemble(out, settings, results, {"timing": timing})
 

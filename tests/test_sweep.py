@@ -51,7 +51,8 @@ def results_without_timing(out):
 def test_two_workers_match_serial_exactly(tmp_path):
     settings = make_settings("point_stops", "omega", **SHORT)
     values = parse_values("linspace(8, 30, 20)")
-    serial = sweep(settings, values, tmp_path / "serial", client=None, progress=False)
+    # a folder given as a str (bench.sweep_throughput's): TypeError 'str' / 'str' before
+    serial = sweep(settings, values, str(tmp_path / "serial"), client=None, progress=False)
     pytest.importorskip("distributed")
     with dask_client(workers=2) as client:
         assert len(client.nthreads()) == 2

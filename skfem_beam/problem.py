@@ -315,9 +315,14 @@ class Obstacles:
         if b <= a:
             raise InputError(f"span [a={a:g}, b={b:g}] needs a < b")
 
-        def within(g, outside):
-            return lambda x: np.where((x >= a) & (x <= b),
-                                      g(x) if callable(g) else float(g), outside)
+        def within(g, outside):         # g is evaluated where the span acts only
+            def bound(x):
+                x = np.asarray(x, dtype=float)
+                out = np.full(x.shape, outside)
+                inside = (x >= a) & (x <= b)
+                out[inside] = g(x[inside]) if callable(g) else float(g)
+                return out
+            return bound
         return cls(within(g1, -np.inf), within(g2, np.inf), (a, b), carried)
 
     @classmethod

@@ -889,3 +889,16 @@ def test_a_flag_is_true_or_false(tmp_path, capsys, setting, written):
     scene = example("flat_obstacles.toml")
     assert_refused(run_main, [str(scene), "--set", setting, "--out", str(tmp_path / "x")],
                    f"{written}: must be true or false (no quotes)", capsys, tmp_path)
+
+
+def test_a_beam_obstacle_table_must_cover_where_it_acts(tmp_path, capsys):
+    """{x, g} over the span [5, 10] given on [6, 8] only was extended flat beyond its
+    points (np.interp), silently; a plate's table is refused the same way."""
+    scene = example("flat_obstacles.toml")
+    assert_refused(run_main, [str(scene), "--set", "obstacles.0.g1={x=[6,8],g=[-0.01,-0.02]}",
+                              "--out", str(tmp_path / "x")],
+                   "obstacles.0.g1 = {x, g}: the obstacle acts at x=5, outside its table's x "
+                   "[6, 8]", capsys, tmp_path)
+    covered = tmp_path / "ok"
+    assert exit_code(run_main, [str(scene), "--set", "obstacles.0.g1={x=[5,10],g=[-0.01,-0.02]}",
+                                "--T", "0.2", "--format", "none", "--out", str(covered)]) == 0

@@ -30,7 +30,17 @@ def _g(value, where: str):
         if xs.ndim != 1 or xs.shape != gs.shape or xs.size < 2 or np.any(np.diff(xs) <= 0):
             raise InputError(f"{where} = {{x, g}}: x must increase, with one g per x (at "
                              "least two)")
-        return lambda x: np.interp(np.asarray(x, dtype=float), xs, gs)
+        tol = 1e-9 * max(1.0, float(np.abs(xs).max()))
+
+        def table(x):       # not extended flat beyond its points, as a plate's table
+            x = np.asarray(x, dtype=float)
+            off = x[(x < xs[0] - tol) | (x > xs[-1] + tol)]
+            if off.size:
+                raise InputError(f"{where} = {{x, g}}: the obstacle acts at x={off[0]:g}, "
+                                 f"outside its table's x [{xs[0]:g}, {xs[-1]:g}]: extend "
+                                 "the table, or give x_from, x_to")
+            return np.interp(x, xs, gs)
+        return table
     raise InputError(f"{where} must be a number, {{ poly = [c0, c1, ...], about = x0 }} or "
                      f"{{ x = [...], g = [...] }} (got keys {', '.join(value)})")
 

@@ -49,8 +49,8 @@ SECTION_DOCS = {
     'obstacles': (
         '`x` (point stops) or `x_from`, `x_to` (a span) or neither (the whole beam); `g1`, '
         '`g2`: numbers, `{ poly = [c0, c1, ...], about = x0 }` (Σ c_k (x − x0)^k) or `{ x = '
-        '[...], g = [...] }` (linear between points, covering where it acts); `carried = true` moves with the '
-        'support; `stiffness` (N/m) and `damping` (N·s/m, optional): elastic supports, the '
+        '[...], g = [...] }` (linear between points, covering where it acts); `carried = '
+        'true` moves with the support; `stiffness` (N/m) and `damping` (N·s/m, optional): elastic supports, the '
         "penalty law's springs with Kelvin–Voigt dashpots, each obstacle its own (one plane; "
         'two planes: the same on every obstacle), on every obstacle or none (rigid); '
         "summary.json `spring_supports` gives each one's largest deflection and force. "

@@ -902,3 +902,13 @@ def test_a_beam_obstacle_table_must_cover_where_it_acts(tmp_path, capsys):
     covered = tmp_path / "ok"
     assert exit_code(run_main, [str(scene), "--set", "obstacles.0.g1={x=[5,10],g=[-0.01,-0.02]}",
                                 "--T", "0.2", "--format", "none", "--out", str(covered)]) == 0
+
+
+def test_a_load_span_off_the_beam_is_refused(tmp_path, capsys):
+    """x_from, x_to = [11, 12] on the 10 m beam ran as no load at all (a point force off
+    the beam is refused, and a plate's load region off the plate)."""
+    assert_refused(run_main, [str(example("flat_obstacles.toml")), "--set",
+                              "loads=[{distributed=true,x_from=11.0,x_to=12.0,value=1000.0}]",
+                              "--out", str(tmp_path / "x")],
+                   "[loads.0] x_from, x_to = [11, 12] must lie on the beam [0, L=10]",
+                   capsys, tmp_path)

@@ -123,7 +123,7 @@ def beam_problem(data: dict, reader: Tables) -> BeamProblem:
     ends = data.get("ends", {})
     mesh = data.get("mesh", {})
     obstacles, holes = obstacles_and_holes(data)
-    load, load_w = loads_of(data, reader)
+    load, load_w = loads_of(data, reader, beam.L)
     problem = BeamProblem(
         beam, obstacles, support_of(data, beam.L, reader), load,
         J=mesh.get("J", 19), element=mesh.get("element", "hermite"), nodes=mesh.get("nodes"),

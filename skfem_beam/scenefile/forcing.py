@@ -78,7 +78,7 @@ def _direction(d: dict, data: dict, where: str) -> tuple[float, float]:
     return check_direction(f"[{where}] direction", d["direction"])
 
 
-def loads_of(data: dict, reader: Tables) -> tuple[Load, Load]:
+def loads_of(data: dict, reader: Tables, L: float = math.inf) -> tuple[Load, Load]:
     """The loads of the first and the second plane: a load along ``direction`` = [dy, dz]
     acts dy× in v and dz× in w; ``rotating`` = {amplitude, omega, phase} is
     amplitude·cos(ωt + phase) in v and amplitude·sin(ωt + phase) in w (two planes)."""
@@ -100,8 +100,9 @@ def loads_of(data: dict, reader: Tables) -> tuple[Load, Load]:
             phase = d["rotating"].get("phase", 0.0)
             rest = {k: v for k, v in d.items() if k != "rotating"}
             total_v = total_v + _load(rest, where, Sine(rot["amplitude"], rot["omega"],
-                                                        phase + math.pi / 2))
-            total_w = total_w + _load(rest, where, Sine(rot["amplitude"], rot["omega"], phase))
+                                                        phase + math.pi / 2), L)
+            total_w = total_w + _load(rest, where, Sine(rot["amplitude"], rot["omega"], phase),
+                                      L)
             continue
         if "gravity" in d:
             if len(d) > 1:
@@ -113,13 +114,14 @@ def loads_of(data: dict, reader: Tables) -> tuple[Load, Load]:
             if time is None:
                 raise InputError(f"[{where}] needs a time function: amplitude/omega, value, "
                                  "sines, table, random or (two planes) rotating")
-            part = _load(d, where, time)
+            part = _load(d, where, time, L)
         total_v, total_w = total_v + part.scaled(dy), total_w + part.scaled(dz)
     return total_v, total_w
 
 
-def _load(d: dict, where: str, time) -> Load:
-    """One [[loads]] item's load with the time function ``time``."""
+def _load(d: dict, where: str, time, L: float = math.inf) -> Load:
+    """One [[loads]] item's load with the time function ``time`` (``L``: the beam's
+    length, which a span must lie in)."""
     kinds = [k for k in ("x", "distributed", "per_mass") if d.get(k, False) is not False]
     span = [k for k in ("x_from", "x_to") if k in d]
     if span and kinds != ["distributed"]:
@@ -134,6 +136,9 @@ def _load(d: dict, where: str, time) -> Load:
         a, b = need(d, ("x_from", "x_to"), where).values()
         if not a < b:
             raise InputError(f"[{where}] x_from={a:g} must be below x_to={b:g}")
+        if a < -1e-12 * L or b > L * (1 + 1e-12):     # off the beam it loaded nothing
+            raise InputError(f"[{where}] x_from, x_to = [{a:g}, {b:g}] must lie on the beam "
+                             f"[0, L={L:g}]")
         return Load.distributed(_span(a, b), time)
     if kinds[0] == "distributed":
         return Load.distributed(1.0, time)

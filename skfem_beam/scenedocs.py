@@ -102,7 +102,8 @@ SECTION_DOCS = {
         '"beta"\\|"quasi-static"` (only with `mass = "redistributed"`, as `--massless`)'
     ),
     'time': (
-        '`dt`, `T` (required), `beta` (default 1/2; 1/4 for a bar or penalty), `load_window` '
+        '`dt`, `T` (required), `beta` (the β-scheme\'s: default 1/2; 1/4 for a bar or '
+        'penalty; `law = "moreau-jean"` has θ instead and does not use it), `load_window` '
         '(`"forward"`, the papers\': fⁿ averages f over [tₙ, tₙ + Δt]; `"centered"`: over [tₙ '
         '− Δt/2, tₙ + Δt/2], second order)'
     ),

@@ -912,3 +912,14 @@ def test_a_load_span_off_the_beam_is_refused(tmp_path, capsys):
                               "--out", str(tmp_path / "x")],
                    "[loads.0] x_from, x_to = [11, 12] must lie on the beam [0, L=10]",
                    capsys, tmp_path)
+
+
+@pytest.mark.parametrize("setting, word", [
+    ("contact.friction=0.3", "unknown key 'friction'; [contact] allows: law, stiffness"),
+    ("output.probes=[0.5]", "unknown key 'probes'; [output] allows: format"),
+])
+def test_the_bar_refuses_keys_it_ignored(tmp_path, capsys, setting, word):
+    """A bar's [contact] friction and [output] probes were read and ignored (the same
+    files with and without them)."""
+    assert_refused(run_main, [str(example("impacting_bar.toml")), "--set", setting, "--out",
+                              str(tmp_path / "x")], word, capsys, tmp_path)

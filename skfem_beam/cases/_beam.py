@@ -16,7 +16,7 @@ from ..output.probes import probe_columns, probe_units
 from ..output.checkpoint import read_summary
 from ..output.stream import Series, execute, prepare
 from ..output.supports import support_table, support_wear
-from ..methods import Penalty, summary_word
+from ..methods import MoreauJean, Penalty, summary_word
 from ..scheme.kernels import WORK_TERMS
 from ..spec import RunSpec
 from ..semidiscrete import PLANE_SUFFIXES, add_probes, beam_system
@@ -32,7 +32,9 @@ def run_beam_case(case: str, problem, spec: RunSpec, stops=(), extra=None) -> in
     prepare(spec.options)                         # fail before the run, not after it
     system = beam_system(problem)
     add_probes(system, list(spec.probes))
-    kh, limit = stability_warning(system, spec.stepping.dt, spec.beta)
+    # Moreau–Jean (θ ≥ ½) has no β and no limit: a scene file's [time] beta is not its
+    kh, limit = stability_warning(system, spec.stepping.dt,
+                                  0.5 if isinstance(spec.method, MoreauJean) else spec.beta)
     if spec.mass == "redistributed":
         system = redistributed(system)
     run = spec.method.build(system, spec.stepping)

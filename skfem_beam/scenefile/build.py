@@ -64,9 +64,6 @@ class Scene:
         contact = self.data.get("contact", {})
         params = CONTACT.method_params(contact)
         params["beta"] = self._beta_given()
-        if law == methods.MOREAU_JEAN and "beta" in self.data.get("time", {}):
-            raise InputError(f"[time] beta = {params['beta']:g} is the β-scheme's β; "
-                             f"[contact] law = {law} has none (its θ: [contact] theta)")
         return methods.make(law, solver, self.restitution or 0.0, self.stiffness, massless,
                             words=SCENE_WORDS, damping=self.damping, params=params)
 

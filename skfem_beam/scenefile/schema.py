@@ -158,7 +158,10 @@ BAR_KEYS = {
     "initial": {"u0": NumberOr(U0, "{ x = [...], u = [...] }"),
                 "v0": NumberOr(V0, "{ x = [...], v = [...] }")},
     "mesh": {"J": N, "mass": V, "massless": V},
-    "time": TIME_KEYS, "contact": CONTACT, "output": OUTPUT,
+    # no friction (no cross-section to slide in) and no probes (it writes u(0), u(L)):
+    # they were read and ignored
+    "time": TIME_KEYS, "contact": ContactKeys(law=V, stiffness=N, restitution=N, theta=N),
+    "output": {k: v for k, v in OUTPUT.items() if k != "probes"},
 }
 PLATE_KEYS = {
     "kind": V, "geometry": {"a": N, "b": N, "mesh": V}, "section": {"thickness": N},

@@ -264,16 +264,8 @@ class Run:
         with np.errstate(over="ignore", invalid="ignore"):     # a load's inf: refused below
             inputs = (self._next if self._next[0] == (n0, n1)
                       else self.scheme.inputs(n0, n1))[1]
-            G = inputs.G
-            self.load_bound += float((np.abs(G) @ self.load_norm).sum()) * self.dt \
-                if G.shape[1] else 0.0
-        # the bound grows with n: its chunk-end value is the loosest for the chunk
-        root = math.sqrt(abs(self.E1)) + self.load_bound
-        Ebound = self.stepping.growth_limit * root * root + 1e-300     # inf, not OverflowError
-        if not math.isfinite(Ebound):
-            raise InputError(f"the load is too large for floating point: its work by step {n1} "
-                             f"is {self.load_bound:g}" if math.isfinite(self.load_bound) else
-                             "the load is too large for floating point: its work overflows")
+        G = inputs.G
+        Ebound = self._energy_bound(G, n1)
         # the running diagnostics before the chunk: an unstable chunk's are not the run's
         self._before = self.st.stats.copy(), self.st.counters[:3].copy()
         code, at = self._steps(n0, n1, Ebound, inputs), n0
@@ -316,6 +308,21 @@ class Run:
         self.n = n1
         if n1 == self.n_steps:
             self.status, self.message = "success", "the run reached T"
+
+    def _energy_bound(self, G, n1: int) -> float:
+        """The a-priori energy bound at state ``n1`` (docs/design.md), the chunk's loads
+        ``G`` added to the load's work so far; a load too large for floats refused."""
+        with np.errstate(over="ignore", invalid="ignore"):
+            self.load_bound += float((np.abs(G) @ self.load_norm).sum()) * self.dt \
+                if G.shape[1] else 0.0
+        # the bound grows with n: its chunk-end value is the loosest for the chunk
+        root = math.sqrt(abs(self.E1)) + self.load_bound
+        Ebound = self.stepping.growth_limit * root * root + 1e-300     # inf, not OverflowError
+        if not math.isfinite(Ebound):
+            raise InputError(f"the load is too large for floating point: its work by step {n1} "
+                             f"is {self.load_bound:g}" if math.isfinite(self.load_bound) else
+                             "the load is too large for floating point: its work overflows")
+        return Ebound
 
     def _unstable(self, k: int, why: str, good: int) -> None:
         """Stop as unstable at state ``k`` (``why``), keeping the saved states up to

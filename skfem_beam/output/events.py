@@ -160,6 +160,9 @@ def hole_springs(table: dict, supports, stiffness: float, damping: float) -> lis
 EPISODES = ("of the run's time: each episode from its first state in contact to its first "
             "state off, one still open at the end to its last state (so one step less than "
             "the run's contact_fraction, which counts every step that ends in contact)")
+# impacts.csv's velocity, as summary.json's units say it
+VELOCITY = ("m/s: (yⁿ − yⁿ⁻¹)/Δt at the state before the first in contact (a free flight's "
+            "approach; after a one-step separation, that separation's, away from the obstacle)")
 # peak_force's unit under exact contact
 RIGID_PEAK = ("; rigid (exact) contact: the largest one-step force, which grows as dt "
               "shrinks: quote the impulse")
@@ -216,7 +219,7 @@ def _write_impacts(folder, run, units, scale, sign, obstacles, last, wear) -> tu
     if not run.springs:     # exact contact: the force of one step, impulse/Δt
         f += RIGID_PEAK + ", or give the supports a stiffness"
     stats["units"] = {"t_start": "s", "t_end": "s", "x": "m", "bound": "1 = g1 (lower), "
-                      "2 = g2 (upper)", "velocity": "m/s", "peak_force": f, "impulse": i,
+                      "2 = g2 (upper)", "velocity": VELOCITY, "peak_force": f, "impulse": i,
                       "max_violation": "m", "open": "1 = not over at the last state",
                       "contact_fraction": EPISODES}
     if planes == 2:

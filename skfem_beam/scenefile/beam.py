@@ -131,4 +131,10 @@ def beam_problem(data: dict, reader: Tables) -> BeamProblem:
         supports=tuple(s.get("x", math.nan) for s in data.get("supports", [])),
         damping=_damping(data), planes=plane_count(data), holes=holes,
         second=Plane(load=load_w))
+    if problem.element == "bspline" and beam.steps:
+        from ..cli import warn
+        warn(f"element = \"bspline\" on a beam whose section steps at x = "
+             f"{', '.join(f'{x:g}' for x in beam.steps)}: cubic B-splines are C² and cannot "
+             "follow the jump of u'' there, so they converge at first order (frequencies "
+             "off by 1–4 % at J = 20); element = \"hermite\" converges at h⁴")
     return _initial(data, problem)

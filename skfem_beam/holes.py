@@ -89,7 +89,10 @@ class Hole:
     @classmethod
     def polygon(cls, vertices) -> "Hole":
         """A convex polygon through ``vertices`` [[y, z], ...], counter-clockwise (m)."""
-        p = np.asarray(vertices, dtype=float) if _is_table(vertices) else None
+        try:    # a ragged list (a vertex of three numbers) is no array
+            p = np.asarray(vertices, dtype=float) if _is_table(vertices) else None
+        except ValueError:
+            p = None
         if p is None or p.ndim != 2 or p.shape[1] != 2 or p.shape[0] < 3 \
                 or not np.isfinite(p).all():
             raise InputError("hole polygon must be [[y1, z1], [y2, z2], ...] (at least three "

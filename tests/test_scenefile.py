@@ -923,3 +923,23 @@ def test_the_bar_refuses_keys_it_ignored(tmp_path, capsys, setting, word):
     files with and without them)."""
     assert_refused(run_main, [str(example("impacting_bar.toml")), "--set", setting, "--out",
                               str(tmp_path / "x")], word, capsys, tmp_path)
+
+
+@pytest.mark.parametrize("scene, setting, word", [
+    # tracebacks before: TypeError (unhashable, a missing argument), ValueError (ragged)
+    ("tube_round_holes.toml", "motion.end=[1]", "--set motion.end=[1]: must be a word in quotes"),
+    ("tube_round_holes.toml", "mesh.element=1", "--set mesh.element=1: must be a word in quotes"),
+    ("tube_round_holes.toml", "loads.0.random={rms=10.0}",
+     "[loads.0.random] needs rms, f_low, f_high (missing f_low, f_high)"),
+    ("tube_round_holes.toml",
+     "obstacles.0.hole={polygon=[[0.001,0.0,1.0],[0.0,0.001],[-0.001,0.0]]}",
+     "hole polygon must be [[y1, z1], [y2, z2], ...]"),
+    # a zero load, silently
+    ("flat_obstacles.toml", "loads=[{per_mass=true,omega=10.0}]",
+     "[loads.0] amplitude and omega go together"),
+    ("flat_obstacles.toml", "loads=[{per_mass=true,amplitude=1.0}]",
+     "[loads.0] amplitude and omega go together"),
+])
+def test_malformed_values_are_one_line(tmp_path, capsys, scene, setting, word):
+    assert_refused(run_main, [str(example(scene)), "--set", setting, "--out",
+                              str(tmp_path / "x")], word, capsys, tmp_path)

@@ -25,7 +25,10 @@ def _time_function(d: dict, where: str, reader: Tables):
         return None
     form = forms[0]
     if form in ("amplitude", "omega"):
-        return Sine(d.get("amplitude", 0.0), d.get("omega", 0.0), d.get("phase", 0.0))
+        if "amplitude" not in d or "omega" not in d:    # either alone was a zero, silently
+            raise InputError(f"[{where}] amplitude and omega go together (amplitude · "
+                             "sin(omega t + phase)); a constant is value = ...")
+        return Sine(d["amplitude"], d["omega"], d.get("phase", 0.0))
     if form == "value":
         return Constant(d["value"])
     if form == "sines":
@@ -42,7 +45,12 @@ def _time_function(d: dict, where: str, reader: Tables):
         if "table" not in psd:
             raise InputError(f"[{where}] psd = {{ table = \"file.csv\", seed, df }} needs table")
         return psd_from_csv(reader.path(psd["table"]), psd.get("seed", 0), psd.get("df"))
-    return band_limited(**d["random"])
+    random = d["random"]
+    if not isinstance(random, dict):
+        raise InputError(f"[{where}] random = {{ rms, f_low, f_high, seed, count }} (got "
+                         f"{random!r})")
+    return band_limited(**need(random, ("rms", "f_low", "f_high"), f"{where}.random"), **{
+        k: random[k] for k in ("seed", "count") if k in random})
 
 
 def support_of(data: dict, L: float, reader: Tables) -> Support:

@@ -25,6 +25,14 @@ class Number:
 N = Number()
 
 
+class Word:
+    """In a schema: a word (a TOML string; the object checks which): a list or a number
+    there ended in a TypeError from inside ("unhashable type: 'list'")."""
+
+
+W = Word()
+
+
 class Flag:
     """In a schema: true or false (TOML's booleans; "false" or 0 read as true, silently)."""
 
@@ -78,14 +86,14 @@ class NumberOr(dict):
 
 NUMBERS = ListOf(N)
 TIME = {"amplitude": N, "omega": N, "phase": N, "value": N, "sines": ListOf(NUMBERS),
-        "table": V, "random": {"rms": N, "f_low": N, "f_high": N, "seed": N, "count": N},
-        "psd": Either({"table": V, "seed": N, "df": N})}
+        "table": W, "random": {"rms": N, "f_low": N, "f_high": N, "seed": N, "count": N},
+        "psd": Either({"table": W, "seed": N, "df": N})}
 SECTION = {"I": N, "A": N, "I_y": N, "I_z": N, "tube": {"outer_diameter": N, "wall": N},
            "rod": {"diameter": N}, "rect": {"b": N, "h": N}}
 MATERIAL = {"E": N, "rho": N}
 U0, V0 = {"x": NUMBERS, "u": NUMBERS}, {"x": NUMBERS, "v": NUMBERS}
-TIME_KEYS = {"dt": N, "T": N, "beta": N, "load_window": V}
-OUTPUT = {"format": V, "save_every": N, "frames": N, "flush_every": N, "checkpoint_every": N,
+TIME_KEYS = {"dt": N, "T": N, "beta": N, "load_window": W}
+OUTPUT = {"format": W, "save_every": N, "frames": N, "flush_every": N, "checkpoint_every": N,
           "probes": NUMBERS}
 OUTPUT_DEFAULTS = {"format": "both", "save_every": 1, "frames": 200, "flush_every": 20000,
                    "checkpoint_every": None}      # [output] when the file leaves them out
@@ -115,7 +123,7 @@ class ContactKeys(dict):
         return iter(self._all())
 
 
-CONTACT = ContactKeys(law=V, stiffness=N, restitution=N, friction=N, theta=N)
+CONTACT = ContactKeys(law=W, stiffness=N, restitution=N, friction=N, theta=N)
 G = NumberOr({"poly": NUMBERS, "about": N, "x": NUMBERS, "g": NUMBERS},   # the rest: obstacles._g
              "{ poly = [...] } or { x = [...], g = [...] }")
 # a plate's obstacle: a number, Σ c_ij (x − x0)^i (y − y0)^j or a table on an x, y grid
@@ -128,14 +136,14 @@ HOLE = {"radius": N, "sides": N, "angle": N, "centre": NUMBERS,     # the rest: 
         "polygon": ListOf(NUMBERS), "faces": ListOf(NUMBERS), "lands": N, "land_width": N}
 
 BEAM_KEYS = {
-    "kind": V, "planes": N, "material": MATERIAL, "section": SECTION,
+    "kind": W, "planes": N, "material": MATERIAL, "section": SECTION,
     "mass_normalised": {"k2": N, "rho_S": N},
     "mass": {"added": N},
     "geometry": {"L": N},
     "segments": [{"length": N, "material": MATERIAL, "section": SECTION}],
-    "ends": {"left": V, "right": V},
+    "ends": {"left": W, "right": W},
     "supports": [{"x": N}],
-    "motion": {"end": V, "at": N, "lifting": V, "direction": NUMBERS, **TIME},
+    "motion": {"end": W, "at": N, "lifting": W, "direction": NUMBERS, **TIME},
     "obstacles": [{"x": N, "x_from": N, "x_to": N, "g1": G, "g2": G, "hole": HOLE,
                    "carried": B, "stiffness": N, "damping": N, "friction": N}],
     "wear": {"coefficient": N, "service_years": N, "land": N, "radius": N},
@@ -146,34 +154,34 @@ BEAM_KEYS = {
                **TIME}],
     "initial": {"mode": N, "amplitude": N, "u0": U0, "v0": V0, "fixed_frame": B,
                 "u0_w": U0, "v0_w": V0},
-    "mesh": {"J": N, "element": V, "nodes": NUMBERS, "mass": V, "massless": V},
+    "mesh": {"J": N, "element": W, "nodes": NUMBERS, "mass": W, "massless": W},
     "time": TIME_KEYS, "contact": CONTACT, "output": OUTPUT,
 }
 BAR_KEYS = {
-    "kind": V, "material": MATERIAL, "section": SECTION, "geometry": {"L": N},
-    "ends": {"left": V, "right": V},
+    "kind": W, "material": MATERIAL, "section": SECTION, "geometry": {"L": N},
+    "ends": {"left": W, "right": W},
     "obstacles": [{"x": NumberOrWord("left", "right"), "stiffness": N}],
     "damping": {"viscosity": N},
     "loads": [{"value": N}],
     "initial": {"u0": NumberOr(U0, "{ x = [...], u = [...] }"),
                 "v0": NumberOr(V0, "{ x = [...], v = [...] }")},
-    "mesh": {"J": N, "mass": V, "massless": V},
+    "mesh": {"J": N, "mass": W, "massless": W},
     # no friction (no cross-section to slide in) and no probes (it writes u(0), u(L)):
     # they were read and ignored
-    "time": TIME_KEYS, "contact": ContactKeys(law=V, stiffness=N, restitution=N, theta=N),
+    "time": TIME_KEYS, "contact": ContactKeys(law=W, stiffness=N, restitution=N, theta=N),
     "output": {k: v for k, v in OUTPUT.items() if k != "probes"},
 }
 PLATE_KEYS = {
-    "kind": V, "geometry": {"a": N, "b": N, "mesh": V}, "section": {"thickness": N},
+    "kind": W, "geometry": {"a": N, "b": N, "mesh": W}, "section": {"thickness": N},
     "material": {"E": N, "rho": N, "nu": N},
     "edges": Names("left", "right", "bottom", "top"),
-    "mesh": {"nx": N, "ny": N, "element": V},
+    "mesh": {"nx": N, "ny": N, "element": W},
     "obstacles": [{"g1": G_PLATE, "g2": G_PLATE, "region": NUMBERS,
                    "points": ListOf(NUMBERS)}],
     "loads": [{"pressure": N, "region": NUMBERS, **TIME}],
     "initial": {"static_pressure": N, "velocity": N},
     "time": {"dt": N, "T": N, "beta": N},
-    "contact": ContactKeys(law=V, solver=V, stiffness=N, restitution=N, theta=N),
+    "contact": ContactKeys(law=W, solver=W, stiffness=N, restitution=N, theta=N),
     "output": {**OUTPUT, "probes": ListOf(NUMBERS)},
 }
 KINDS = {"beam": BEAM_KEYS, "bar": BAR_KEYS, "plate": PLATE_KEYS}
@@ -231,6 +239,9 @@ def _check_value(value, sub, path: tuple, sets) -> None:
     if sub is N:
         if not _is_number(value):
             raise _bad_value(path, value, sets, f"a number, {SI}")
+    elif sub is W:
+        if not isinstance(value, str):
+            raise _bad_value(path, value, sets, "a word in quotes")
     elif sub is B:
         if not isinstance(value, bool):
             raise _bad_value(path, value, sets, "true or false (no quotes)")

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
+import shlex
 import signal
 import sys
 import threading
@@ -273,12 +274,12 @@ def _same_command(out: Path, summary: dict, prog: str) -> None:
     if (prog.endswith(" run") if scene else theirs == case):
         return
     if scene:
-        how = f"python -m skfem_beam run --resume {out}"
+        how = f"python -m skfem_beam run --resume {shlex.quote(str(out))}"
     elif theirs == "sweep":
         how = f"python -m skfem_beam.sweep, the same values and --out {out}"
     elif isinstance(theirs, str) and theirs.isidentifier() \
             and importlib.util.find_spec(f"skfem_beam.cases.{theirs}") is not None:
-        how = f"python -m skfem_beam.cases.{theirs} --resume {out}"
+        how = f"python -m skfem_beam.cases.{theirs} --resume {shlex.quote(str(out))}"
     else:
         how = "the command that wrote it"
     raise InputError(f"--resume {out}: a run of {theirs!r}, not of {prog}: resume it with "

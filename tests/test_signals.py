@@ -82,3 +82,14 @@ def test_a_signal_while_the_command_exits_is_one_line_and_its_code(tmp_path):
         assert err == ([] if line is None else
                        [f"interrupted by {line} while exiting: the command had finished"])
         assert mark.exists() or how == "during"
+
+
+def test_the_resume_line_quotes_its_folder(tmp_path):
+    """Pasted back, `--resume sp ace/r ü` was two arguments: the folder is quoted."""
+    import shlex
+    from types import SimpleNamespace
+    from skfem_beam.output.stream import _resume_command
+    folder = SimpleNamespace(path=tmp_path / "sp ace" / "r ü",
+                             summary={"config": {"command": "python -m skfem_beam run"}})
+    line = _resume_command(folder)
+    assert shlex.split(line)[-2:] == ["--resume", str(tmp_path / "sp ace" / "r ü")], line

@@ -20,6 +20,7 @@ from __future__ import annotations
 import errno
 import os
 import resource
+import shlex
 import signal
 import sys
 import threading
@@ -167,6 +168,11 @@ class Signals:
         for sig, old in self._old.items():
             signal.signal(sig, old)
         return False
+
+
+def _resume_command(folder) -> str:
+    """The command that resumes ``folder``, its path quoted for a shell (spaces, ü)."""
+    return f"{_command(folder.summary)} --resume {shlex.quote(str(folder.path))}"
 
 
 def _command(summary: dict) -> str:
@@ -426,9 +432,9 @@ class _Stream:
         folder.close(**{**entries, "status": "interrupted", "steps": run.n,
                         "message": f"interrupted by {name} at step {run.n} "
                                    f"(t={run.n * run.dt:.6g} s)"})
-        resume = (f"continue with: {_command(folder.summary)} --resume {folder.path}"
-                  if self.kept is not None else "no checkpoint: run it again from step 0 "
-                  f"with: {_command(folder.summary)} --resume {folder.path}")
+        again = _resume_command(folder)
+        resume = f"continue with: {again}" if self.kept is not None else \
+            f"no checkpoint: run it again from step 0 with: {again}"
         print(f"interrupted by {name}: {self.what_is_kept()}{why}; {resume}", file=sys.stderr)
         return e.code
 
@@ -436,10 +442,10 @@ class _Stream:
         """A write refused (full disk, ...): status "failed", what is kept, exit 3."""
         run, folder = self.run, self.folder
         folder.fail(e, steps=run.n, kept=self.what_is_kept(), **self.write_events(run.n))
-        resume = (f"{_once_fixed(e)}, continue with: {_command(folder.summary)} --resume "
-                  f"{folder.path}" if self.kept is not None else
+        again = _resume_command(folder)
+        resume = (f"{_once_fixed(e)}, continue with: {again}" if self.kept is not None else
                   f"{_once_fixed(e)}, with no checkpoint (--checkpoint-every) run it again "
-                  f"from step 0 with: {_command(folder.summary)} --resume {folder.path}")
+                  f"from step 0 with: {again}")
         print(f"error: could not write the results: {e}; {self.what_is_kept()}; {resume}",
               file=sys.stderr)
         return EXIT_SOLVER

@@ -49,8 +49,20 @@ def release(out=None) -> None:
 
 
 def check_not_busy(out: Path) -> None:
-    """Refuse a folder another process is writing (probe its lock, hold nothing)."""
+    """Refuse a folder another process is writing (probe its lock, hold nothing).  The
+    probe opens the lock read-only: a reader without write permission (a colleague's
+    finished run, exported) was refused "Permission denied" on opening it to write."""
     if Path(out).resolve() in _HELD or not (Path(out) / LOCK).exists():
         return
-    lock_folder(out)
-    release(out)
+    try:
+        fd = os.open(Path(out) / LOCK, os.O_RDONLY)
+    except OSError:
+        return          # cannot be read: nobody's lock this process can see
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError as e:
+        if e.errno in (errno.EWOULDBLOCK, errno.EAGAIN):
+            raise _busy(out) from None
+        raise
+    finally:
+        os.close(fd)

@@ -526,3 +526,19 @@ def test_a_full_disk_with_hdf5_fields_exits_3_in_one_line_every_time(disk_3m):
         assert p.returncode == 3 and len(err) == 1 and "No space left" in err[0], (i, p.stderr)
         assert summary(out)["status"] == "failed"
         shutil.rmtree(out)
+
+
+def test_a_finished_run_of_someone_else_can_be_checked_for_a_writer(tmp_path, monkeypatch):
+    """export reads a folder: its busy probe opened .lock to write, and a user without
+    write permission got "could not write the results: Permission denied", exit 3."""
+    import os
+    from skfem_beam.lock import LOCK, check_not_busy
+    (tmp_path / LOCK).write_text("")
+    real = os.open
+
+    def read_only(path, flags, *args):
+        if flags & (os.O_WRONLY | os.O_RDWR):
+            raise PermissionError(13, "Permission denied", str(path))
+        return real(path, flags, *args)
+    monkeypatch.setattr(os, "open", read_only)
+    check_not_busy(tmp_path)

@@ -943,3 +943,17 @@ def test_the_bar_refuses_keys_it_ignored(tmp_path, capsys, setting, word):
 def test_malformed_values_are_one_line(tmp_path, capsys, scene, setting, word):
     assert_refused(run_main, [str(example(scene)), "--set", setting, "--out",
                               str(tmp_path / "x")], word, capsys, tmp_path)
+
+
+def test_modes_over_a_run_folder_replaces_it_whole(tmp_path, capsys):
+    """modes --out DIR --overwrite on a run's folder wrote modes.csv and its summary
+    beside the run's series, fields and checkpoint (a resume then refused, read_run mixed
+    them); it now empties the folder as a run does, and locks it while it writes."""
+    out = tmp_path / "run"
+    assert exit_code(point_stops.main, ["--T", "0.01", "--format", "none", "--out",
+                                        str(out)]) == 0
+    assert exit_code(modes_main, [str(example("point_stops.toml")), "--out", str(out),
+                                  "--overwrite"]) == 0
+    assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == \
+        ["modes.csv", "summary.json"]
+    assert json.loads((out / "summary.json").read_text())["modes"] == 6

@@ -209,13 +209,14 @@ def modes_main(argv) -> int:
     for i, (f, w, p, _) in enumerate(rows, 1):
         print(f"{i:4d}{p:>6s} {f:14.6g} {w:14.6g}" if two else f"{i:4d} {f:14.6g} {w:14.6g}")
     if out is not None:
-        _write_modes(out, rows, planes[0][1].x, two)
+        with _modes_folder(out, args.overwrite) as folder:
+            _write_modes(folder.path, rows, planes[0][1].x, two)
+            _modes_written(folder, len(rows))
     return 0
 
 
 def _write_modes(out: Path, rows: list, x, two: bool) -> None:
     """DIR/modes.csv: each mode's number, plane (two planes), f, ω and shape at ``x``."""
-    out.mkdir(parents=True, exist_ok=True)
     with open(out / "modes.csv", "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(["mode"] + (["plane"] if two else []) + ["f_Hz", "omega_rad_s"]
@@ -223,16 +224,20 @@ def _write_modes(out: Path, rows: list, x, two: bool) -> None:
         for i, (f, om, p, shape) in enumerate(rows, 1):
             w.writerow([i] + ([p] if two else []) + [f"{f:.17g}", f"{om:.17g}"]
                        + [f"{u:.17g}" for u in shape])
-    _modes_written(out, len(rows))
 
 
-def _modes_written(out: Path, n: int) -> None:
+def _modes_folder(out: Path, overwrite: bool):
+    """The folder of ``modes --out``, made, locked and (``overwrite``) emptied as a run's
+    is: over a run's folder it left the run's files beside its own."""
+    from ..output.folder import Folder
+    return Folder.open(out, {"command": "python -m skfem_beam modes"}, overwrite=overwrite)
+
+
+def _modes_written(folder, n: int) -> None:
     """The folder's summary.json (so that --overwrite knows a folder this command wrote)
     and the line naming modes.csv."""
-    from ..output.folder import stamp, write_summary
-    write_summary(out, {"command": "python -m skfem_beam modes", "status": "success",
-                        "modes": n, **stamp()})
-    print(f"written: {out / 'modes.csv'}", file=sys.stderr)
+    folder.close(modes=n)
+    print(f"written: {folder / 'modes.csv'}", file=sys.stderr)
 
 
 def _plate_modes(scene, args) -> int:
@@ -249,14 +254,14 @@ def _plate_modes(scene, args) -> int:
     for i, w in enumerate(omega, 1):
         print(f"{i:4d} {w / (2 * np.pi):14.6g} {w:14.6g}")
     if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
         x, y = space.vertices
-        with open(out / "modes.csv", "w", newline="") as fh:
-            w = csv.writer(fh)
-            w.writerow(["mode", "f_Hz", "omega_rad_s"]
-                       + [f"w({xi:.12g};{yi:.12g})" for xi, yi in zip(x, y)])
-            for i, om in enumerate(omega):
-                w.writerow([i + 1, f"{om / (2 * np.pi):.17g}", f"{om:.17g}"]
-                           + [f"{v:.17g}" for v in shapes[space.w_dofs, i]])
-        _modes_written(out, len(omega))
+        with _modes_folder(out, args.overwrite) as folder:
+            with open(folder / "modes.csv", "w", newline="") as fh:
+                w = csv.writer(fh)
+                w.writerow(["mode", "f_Hz", "omega_rad_s"]
+                           + [f"w({xi:.12g};{yi:.12g})" for xi, yi in zip(x, y)])
+                for i, om in enumerate(omega):
+                    w.writerow([i + 1, f"{om / (2 * np.pi):.17g}", f"{om:.17g}"]
+                               + [f"{v:.17g}" for v in shapes[space.w_dofs, i]])
+            _modes_written(folder, len(omega))
     return 0

@@ -542,3 +542,13 @@ def test_a_finished_run_of_someone_else_can_be_checked_for_a_writer(tmp_path, mo
         return real(path, flags, *args)
     monkeypatch.setattr(os, "open", read_only)
     check_not_busy(tmp_path)
+
+
+def test_a_long_legal_folder_name_is_taken(tmp_path):
+    """The writability probe was named after the folder: a legal name of 250 bytes passed
+    the file system's 255 with the probe's prefix and was refused 'File name too long'."""
+    from skfem_beam.output.folder import check_output_dir
+    out = tmp_path / ("ü" * 125)        # 250 bytes in UTF-8
+    assert check_output_dir(out) == out
+    out.mkdir()
+    assert check_output_dir(out) == out     # probed inside itself when it exists

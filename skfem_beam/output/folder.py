@@ -64,15 +64,18 @@ def check_output_dir(out: str | os.PathLike, overwrite: bool = False) -> Path:
         check_not_busy(out)
     if out.is_dir() and _holds_files(out):
         _check_replaceable(out, overwrite)
-    # missing parents are made when the run starts (after every check); probe the
-    # nearest folder that exists: permission bits say little (root, read-only mounts, /proc)
-    parent = out.resolve().parent
+    # missing parents are made when the run starts (after every check); probe the folder
+    # itself when it exists (a writable one in a read-only parent is fine, a read-only one
+    # failed later with exit 3), else the nearest parent that exists: permission bits say
+    # little (root, read-only mounts, /proc)
+    parent = out.resolve() if out.is_dir() else out.resolve().parent
     while not parent.exists():
         parent = parent.parent
     if not parent.is_dir():
         raise InputError(f"--out {out}: {parent} is not a folder")
     try:
-        os.rmdir(tempfile.mkdtemp(prefix=f".{out.name}.", dir=parent))
+        os.rmdir(tempfile.mkdtemp(prefix=".probe.", dir=parent))   # not out's name: a long
+        # name of 250 bytes, legal, passed 255 with the probe's prefix and was refused
     except OSError as e:
         raise InputError(f"--out {out}: folder {parent} is not writable ({e.strerror})") from None
     return out

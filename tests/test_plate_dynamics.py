@@ -148,6 +148,10 @@ def test_a_regional_pressure_and_point_stops():
 
 @pytest.mark.parametrize("kwargs, message", [
     ({"obstacles": [PlateObstacle(g1=1e-3, region=(0, 0, 0, 1))]}, "held at w = 0"),
+    # only at held vertices: it ran with solver "none" and no contact (a beam's is refused)
+    ({"obstacles": [PlateObstacle(g1=-1e-3, region=(0, 0, 0, 1))]},
+     "obstacle 0 acts only at vertices its plate's supports hold at w = 0"),
+    ({"obstacles": [PlateObstacle(g1=-1e-3, points=((0.0, 0.5),))]}, "it would never act"),
     ({"obstacles": [PlateObstacle(points=((0.3, 0.3),), g1=0.0)]}, "not a vertex"),
     ({"obstacles": [PlateObstacle(g1=1e-3, g2=0.0)]}, "need g1 < g2"),
     ({"obstacles": [PlateObstacle(g1=1e-6, region=(0.5, 1, 0, 1))],

@@ -136,3 +136,15 @@ def test_penalty_defaults_to_the_papers_beta(tmp_path):
         assert code == 0 and s["beta"] == beta and s["method"] == method
     pen = json.loads((tmp_path / "penalty" / "summary.json").read_text())
     assert pen["impacts"] > 0 and pen["max_penetration"] > 1e-6     # a spring penetrates
+
+
+def test_a_save_interval_that_does_not_divide_the_steps_says_so(tmp_path):
+    """--save-every 7 on 2000 steps: the last row and energy_final are state 1995's; that
+    was nowhere said."""
+    out = tmp_path / "run"
+    p = run(["--T", "0.1", "--save-every", "7", "--format", "none", "--out", str(out)])
+    assert p.returncode == 0
+    assert "note: --save-every 7 does not divide the 2000 steps: the last saved row is " \
+        "state 1995 (t=0.09975 s), not the last state" in p.stderr, p.stderr
+    data = np.genfromtxt(out / "timeseries.csv", delimiter=",", names=True)
+    assert data["t"][-1] == pytest.approx(0.09975)

@@ -241,6 +241,12 @@ def _note_last_step(run) -> None:
     if s is not None and abs(s.steps * s.dt - s.T) > 1e-9 * s.T:
         print(f"note: T={s.T:g} s is not a whole number of steps dt={s.dt:g} s: the run "
               f"ends at t={s.steps * s.dt:.9g} s ({s.steps} steps)", file=sys.stderr)
+    every, steps = getattr(run, "save_every", 1), getattr(run, "n_steps", 0)
+    if steps % every:       # the rows, and energy_final, stop short of the end
+        last = steps // every * every
+        print(f"note: --save-every {every} does not divide the {steps} steps: the last "
+              f"saved row is state {last} (t={last * run.dt:.9g} s), not the last state",
+              file=sys.stderr)
 
 
 PHASES = ("last-chunk", "final-checkpoint", "charts", "impacts", "summary")

@@ -237,14 +237,19 @@ def _contact_rows(space, obstacles, position):
     of the obstacles at each vertex whose w is free and bounded."""
     nv = space.vertices.shape[1]
     lo, hi = np.full(nv, -np.inf), np.full(nv, np.inf)
-    for obstacle in obstacles:
+    held = position[space.w_dofs] < 0       # w fixed to 0 by a support
+    for k, obstacle in enumerate(obstacles):
         g1, g2 = obstacle.bounds(space)
+        acts = np.isfinite(g1) | np.isfinite(g2)
+        # as a beam's: it ran with no contact (one that conflicts with w = 0: below)
+        if acts.any() and held[acts].all() and not np.any((g1 > 0) | (g2 < 0)):
+            raise InputError(f"obstacle {k} acts only at vertices its plate's supports "
+                             "hold at w = 0: it would never act")
         lo, hi = np.maximum(lo, g1), np.minimum(hi, g2)
     if np.isnan(lo).any() or np.isnan(hi).any() or np.any(lo >= hi):
         i = int(np.argmax(np.isnan(lo) | np.isnan(hi) | (lo >= hi)))
         raise InputError(f"obstacles at vertex ({space.vertices[0, i]:g}, "
                          f"{space.vertices[1, i]:g}) need g1 < g2 (g1={lo[i]:g}, g2={hi[i]:g})")
-    held = position[space.w_dofs] < 0       # w fixed to 0 by a support
     if np.any(held & ((lo > 0) | (hi < 0))):
         i = int(np.argmax(held & ((lo > 0) | (hi < 0))))
         raise InputError(f"vertex ({space.vertices[0, i]:g}, {space.vertices[1, i]:g}) is "

@@ -60,7 +60,9 @@ def listing() -> str:
     groups = [
         ("Scenes (python -m MODULE --help for the flags)", modules("skfem_beam.cases")),
         ("Sweeps", ["skfem_beam.sweep"]),
-        ("Studies (docs/ charts and tables)", modules("skfem_beam.bench")),
+        ("Studies (docs/ charts and tables)", modules("skfem_beam.bench")
+         + ["skfem_beam.plate.bench", "skfem_beam.plate.convergence"]),
+        ("Tools", ["skfem_beam.meshes"]),
     ]
     rows = [(f"python -m {m}", _first_line(m)) for _, ms in groups for m in ms]
     rows += [(f"python -m skfem_beam {name} {c.usage}", c.help) for name, c in COMMANDS.items()]

@@ -42,7 +42,10 @@ def navier_table(a: float = 1.0, b: float = 0.6, meshes=(5, 10, 20)) -> None:
         previous = errors
 
 
-def main() -> None:
+def main(argv=None) -> None:
+    import argparse     # no flags: --help says what it prints, a stray flag is refused
+    argparse.ArgumentParser(prog="python -m skfem_beam.plate.convergence",
+                            description=__doc__.split("\n\n")[0]).parse_args(argv)
     print("centre deflection, simply supported unit square, p = sin(πx) sin(πy)")
     for element, meshes in STATIC_MESHES.items():
         errors = [centre_deflection_error(element, n) for n in meshes]

@@ -197,6 +197,10 @@ def test_failed_solver_keeps_the_impacts_so_far(tmp_path, monkeypatch, capsys):
     assert s["status"] == "failed" and s["steps"] * 1e-4 < t_fail and 0.4 < t_fail < 0.8
     t = read_run(out, fields="none").series["t"]
     assert t[-1] == pytest.approx(t_fail - 1e-4) and s["steps"] == round(t[-1] / 1e-4)
+    # the run's entries up to there, as an interrupted run's (they were missing)
+    series = read_run(out, fields="none").series
+    assert s["energy_final"] == series["energy"][-1] and s["solver"] == "gives-up"
+    assert s["impacts"] > 10 and 0 < s["contact_fraction"] < 1 and s["wall_time_s"] > 0
     imp = read_run(out).impacts
     assert imp["t_start"].size > 10 and imp["t_end"].max() == pytest.approx(t_fail - 1e-4) \
         or imp["open"].sum() == 0

@@ -274,8 +274,11 @@ def _stream(s: _Stream, finish) -> int:
     except Interrupted as e:
         return s.interrupted(e)
     except SolverError as e:
-        # the loop stopped inside a chunk: its events reach the state before the failed step
-        folder.fail(e, steps=run.n, **s.write_events(run.stopped_at - 1))
+        # the loop stopped inside a chunk: its events reach the state before the failed step;
+        # the summary has the run's entries up to there, as an interrupted run's
+        kept = {k: v for k, v in outcome(run.result(), s.rows.data()).items()
+                if k not in ("status", "message")}
+        folder.fail(e, **{**kept, "steps": run.n, **s.write_events(run.stopped_at - 1)})
         raise
     except OSError as e:
         return s.failed_write(e)

@@ -8,6 +8,8 @@ import subprocess
 import sys
 import time
 
+import numpy as np
+
 # `python -m skfem_beam.cases.point_stops` as Python runs it (runpy, argv[0] "-m" while
 # the package imports), once the interpreter has said it is up: the instants count from
 # there, not from a process start whose length depends on the machine and its load (a
@@ -93,3 +95,18 @@ def test_the_resume_line_quotes_its_folder(tmp_path):
                              summary={"config": {"command": "python -m skfem_beam run"}})
     line = _resume_command(folder)
     assert shlex.split(line)[-2:] == ["--resume", str(tmp_path / "sp ace" / "r ü")], line
+
+
+def test_the_kept_rows_line_reads_the_last_rows_time(tmp_path):
+    """A bar run's rows are decimated by its writer, not by its run (save_every 1): the
+    interrupt line said 'to t=0.84 s' for rows that reached 8.4 s."""
+    from types import SimpleNamespace
+    from skfem_beam.output.series import SeriesFile
+    from skfem_beam.output.stream import _Stream
+    rows = SeriesFile(tmp_path / "ts.csv", ["t", "u"])
+    rows.append({"t": np.arange(0, 42001) * 2e-4, "u": np.zeros(42001)})
+    rows.sync()
+    s = SimpleNamespace(run=SimpleNamespace(save_every=1, dt=2e-5), rows=rows, kept=None,
+                        fields=None, folder=SimpleNamespace(path=tmp_path))
+    assert "kept 42001 whole rows of timeseries.csv (to t=8.4 s)" in _Stream.what_is_kept(s)
+    rows.close()

@@ -86,6 +86,7 @@ class SeriesFile:
     row held, for a command whose analysis needs them all (else KEEP_ROWS rows, then the
     envelope).
     """
+    last_t = None       # the time of the last row appended by this process
 
     def __init__(self, path: Path, names: list[str], keep: dict | None = None,
                  whole: bool = False):
@@ -146,6 +147,8 @@ class SeriesFile:
     def append(self, columns: dict) -> None:
         """Rows to write (copied: the run's buffers move on); written in the background."""
         cols = {k: np.array(columns[k], dtype=float) for k in self.names}
+        if "t" in cols and cols["t"].size:
+            self.last_t = float(cols["t"][-1])      # the last row's time, as written
         self._chunks.append(cols)
         self._held += len(cols[self.names[0]])
         if self.limit is not None and self._held > self.limit:

@@ -420,7 +420,10 @@ class _Stream:
 
     def what_is_kept(self) -> str:
         run, rows, kept = self.run, self.rows, self.kept
-        t = (rows.rows - 1) * run.save_every * run.dt if rows is not None and rows.rows else 0.0
+        # the last row's own time: a bar's rows are decimated by its writer, not its run
+        t = getattr(rows, "last_t", None) if rows is not None and rows.rows else 0.0
+        if t is None:
+            t = (rows.rows - 1) * run.save_every * run.dt
         ck_line = (f"the checkpoint at step {kept} (t={kept * run.dt:.6g} s)"
                    if kept is not None else "no checkpoint")
         frames = f", {self.fields.written} field frames" if self.fields is not None else ""

@@ -8,7 +8,6 @@ and use one as ``BeamProblem(..., nodes=load_mesh("meshes/pipe10_J40.msh", 10.0)
 """
 from __future__ import annotations
 
-import argparse
 import io
 from contextlib import redirect_stderr, redirect_stdout
 from pathlib import Path
@@ -16,8 +15,9 @@ from pathlib import Path
 import meshio
 import numpy as np
 
-from .errors import InputError
 from .checks import check_positive
+from .errors import InputError
+from .parser import Parser
 
 # name -> (L, J): uniform meshes of the papers (J even on [0, 10]: x = 5 is a node)
 PAPER_MESHES = {
@@ -109,16 +109,20 @@ def write_mesh(path, nodes) -> Path:
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(prog="python -m skfem_beam.meshes",
+    p = Parser(prog="python -m skfem_beam.meshes",
                                 description="Write the papers' uniform line meshes (.msh).")
     p.add_argument("--out", default="meshes", help="folder (default: meshes)")
     args = p.parse_args(argv)
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as e:        # a file of that name, a read-only parent
+        raise InputError(f"--out {out}: cannot make the folder ({e.strerror})") from None
     for name, (L, J) in PAPER_MESHES.items():
         print(write_mesh(out / f"{name}.msh", np.linspace(0.0, L, J + 1)))
     return 0
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    from .cli import main_guard
+    main_guard(main)

@@ -21,3 +21,33 @@ class Defaults(argparse.ArgumentDefaultsHelpFormatter):
         if action.default is None or "default" in (action.help or ""):
             return action.help
         return super()._get_help_string(action)
+
+
+def count(text: str) -> int:
+    """An argparse type: a whole number ≥ 1 (a repeat, a cycle count, a mesh size)."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number ≥ 1")
+    return value
+
+
+def counts(text: str) -> list[int]:
+    """An argparse type: comma-separated whole numbers ≥ 1 (``25,50,100``)."""
+    return [count(s) for s in text.split(",")]
+
+
+def positives(text: str) -> list[float]:
+    """An argparse type: comma-separated numbers > 0 (``0.4,0.04``)."""
+    out = []
+    for s in text.split(","):
+        try:
+            value = float(s)
+        except ValueError:
+            value = 0.0
+        if not value > 0 or value == float("inf"):
+            raise argparse.ArgumentTypeError(f"{s!r} is not a finite number > 0")
+        out.append(value)
+    return out

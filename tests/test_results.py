@@ -321,3 +321,19 @@ def test_a_plate_export_places_its_fields(tmp_path):
         assert np.array_equal(z["fields_x"], saved.fields.points[:, 0])
         assert np.array_equal(z["fields_y"], saved.fields.points[:, 1])
         assert z["fields_w"].shape == (saved.fields.t.size, z["fields_y"].size)
+
+
+@pytest.mark.parametrize("module, argv, word", [
+    # tracebacks before (ValueError from int()/float()/min()), or a run of -1 cycles
+    ("skfem_beam.bench.bar_convergence", ["--N", "abc"], "--N: 'abc' is not a whole number"),
+    ("skfem_beam.bench.rod_study", ["--courant", "x"], "--courant: 'x' is not a finite"),
+    ("skfem_beam.bench.qp_solvers", ["--repeat", "0"], "--repeat: '0' is not a whole number"),
+    ("skfem_beam.bench.soak", ["--cycles", "-1"], "--cycles: '-1' is not a whole number"),
+    ("skfem_beam.meshes", ["--out", "FILE"], "cannot make the folder (File exists)"),
+])
+def test_study_commands_refuse_bad_flags_in_one_line(tmp_path, module, argv, word):
+    (tmp_path / "FILE").write_text("")
+    argv = [str(tmp_path / "FILE") if a == "FILE" else a for a in argv]
+    p = subprocess.run([sys.executable, "-m", module, *argv], capture_output=True, text=True,
+                       timeout=120)
+    assert p.returncode == 2 and p.stderr.count("\n") == 1 and word in p.stderr, p.stderr

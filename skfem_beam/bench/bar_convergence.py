@@ -10,11 +10,11 @@ Raupp & Feijoo: a = ρ = L = 1, b = 0, f = 0, v0 = −1.
 """
 from __future__ import annotations
 
-import argparse
 import math
 
 from .. import scenes
 from ..bar import energy_report, errors, run_bar
+from ..parser import Parser, counts
 from ..reference import BarExact
 
 KEYS = ("l2_u0", "l2_uL", "l2_force")
@@ -58,9 +58,10 @@ def table(rows: list[dict], title: str = "") -> str:
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(prog="skfem_beam.bench.bar_convergence",
+    p = Parser(prog="skfem_beam.bench.bar_convergence",
                                 description=__doc__.splitlines()[0])
-    p.add_argument("--N", default="25,50,100,200,400", help="meshes, comma separated")
+    p.add_argument("--N", type=counts, default="25,50,100,200,400",
+                   help="meshes, comma separated")
     p.add_argument("--courant", type=float, default=0.1, help="c·Δt/h")
     p.add_argument("--T", type=float, default=3.0)
     p.add_argument("--beta", type=float, default=0.25)
@@ -68,7 +69,7 @@ def main(argv=None) -> int:
     p.add_argument("--obstacle", default="rigid,elastic")
     p.add_argument("--k", type=float, default=100.0)
     a = p.parse_args(argv)
-    Ns = [int(s) for s in a.N.split(",")]
+    Ns = a.N
     for obstacle in a.obstacle.split(","):
         rows = study(obstacle, Ns, a.courant, a.T, a.beta, mass=a.mass, k=a.k)
         extra = f", k={a.k:g}" if obstacle == "elastic" else ""

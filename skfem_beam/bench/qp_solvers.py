@@ -14,13 +14,13 @@ difference of any step's coefficients from the active-set run (relative).
 """
 from __future__ import annotations
 
-import argparse
 import time
 
 import numpy as np
 from numba import njit
 
 from ..contact.active_set import box_qp
+from ..parser import Parser, count
 
 SOLVERS = ("active-set", "daqp", "osqp")
 
@@ -80,13 +80,13 @@ def replay(system, r, solver: str, dt: float, repeat: int) -> float:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="skfem_beam.bench.qp_solvers",
+    ap = Parser(prog="skfem_beam.bench.qp_solvers",
                                  description=__doc__.splitlines()[0])
     ap.add_argument("--J", default="40,80,160")
     ap.add_argument("--T", type=float, default=1.0)
     ap.add_argument("--dt", type=float, default=1e-3)
     ap.add_argument("--element", default="hermite", choices=("hermite", "bspline"))
-    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--repeat", type=count, default=3)
     args = ap.parse_args(argv)
     print(f"convex obstacles, {args.element}, dt={args.dt:g}, T={args.T:g}, beta=1/2; "
           f"best of {args.repeat}")

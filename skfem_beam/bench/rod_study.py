@@ -29,7 +29,6 @@ Courant number, GetFEM's figures beside them, written to ``rod_study.json`` in -
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import json
 import math
@@ -40,6 +39,7 @@ import numpy as np
 from .. import scenes
 from ..bar import bar_system, l2_time, run_bar
 from ..methods import MOREAU_JEAN
+from ..parser import Parser, counts, positives
 from ..reference import exact_of
 from .work_precision import COURANTS, run_method, rung
 
@@ -329,30 +329,32 @@ def accuracy(N: int, out: Path) -> dict:
 
 
 def main(argv=None) -> None:
-    p = argparse.ArgumentParser(prog="skfem_beam.bench.rod_study", description=__doc__)
+    p = Parser(prog="skfem_beam.bench.rod_study", description=__doc__)
     p.add_argument("--classes", action="store_true",
                    help="every class and option at one N (the first of --N; default 80)")
     p.add_argument("--accuracy", action="store_true",
                    help="the named settings at Δt/h = 0.4, 0.04 (N default 80): rod_study.json")
     p.add_argument("--out", default="docs",
                    help="folder for rod_study.csv (--classes) or rod_study.json (--accuracy)")
-    p.add_argument("--N", default=None, help="default 20,40,80,160 (80 with --classes)")
-    p.add_argument("--courant", default="0.4,0.04")
+    p.add_argument("--N", type=counts, default=None,
+                   help="default 20,40,80,160 (80 with --classes)")
+    p.add_argument("--courant", type=positives, default="0.4,0.04")
     p.add_argument("--T", type=float, default=12.0)
     p.add_argument("--mass", default="consistent,lumped,average")
-    p.add_argument("--beta", default="0.25,0.5")
+    p.add_argument("--beta", type=lambda s: [float(b) for b in s.split(",")],
+                   default="0.25,0.5")
     args = p.parse_args(argv)
     if args.accuracy:
-        accuracy(int(args.N.split(",")[0]) if args.N else 80, Path(args.out))
+        accuracy(args.N[0] if args.N else 80, Path(args.out))
         return
     if args.classes:
-        classes(int(args.N.split(",")[0]) if args.N else 80, Path(args.out))
+        classes(args.N[0] if args.N else 80, Path(args.out))
         return
-    Ns = [int(n) for n in (args.N or "20,40,80,160").split(",")]
+    Ns = args.N or [20, 40, 80, 160]
     rows = []
     for mass in args.mass.split(","):
-        for beta in (float(b) for b in args.beta.split(",")):
-            for courant in (float(c) for c in args.courant.split(",")):
+        for beta in args.beta:
+            for courant in args.courant:
                 rows += study(Ns, courant, args.T, beta, mass)
     print(table(rows))
 

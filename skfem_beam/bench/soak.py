@@ -19,7 +19,6 @@ or difference.
 """
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import random
@@ -31,6 +30,8 @@ import tempfile
 import time
 from collections import Counter
 from pathlib import Path
+
+from ..parser import Parser, count
 
 RUN = ["-m", "skfem_beam.cases.point_stops", "--dt", "2e-6", "--T", "0.4", "--save-every",
        "10", "--format", "xdmf", "--frames", "20", "--flush-every", "20000",
@@ -184,8 +185,8 @@ def cycle(ref: Path, work: Path, rng: random.Random, tally: Counter,
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="skfem_beam.bench.soak", description=__doc__)
-    ap.add_argument("--cycles", type=int, default=20)
+    ap = Parser(prog="skfem_beam.bench.soak", description=__doc__)
+    ap.add_argument("--cycles", type=count, default=20)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", default=None, help="write the table as DIR/soak.json too")
     ap.add_argument("--only", choices=KINDS, default=None, help="one kind of stop only")

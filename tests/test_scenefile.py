@@ -957,3 +957,11 @@ def test_modes_over_a_run_folder_replaces_it_whole(tmp_path, capsys):
     assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == \
         ["modes.csv", "summary.json"]
     assert json.loads((out / "summary.json").read_text())["modes"] == 6
+
+
+def test_an_initial_amplitude_needs_its_mode(tmp_path, capsys):
+    """[initial] amplitude without mode was read and ignored: the beam started at rest."""
+    assert_refused(run_main, [str(example("flat_obstacles.toml")), "--set",
+                              "initial.amplitude=0.001", "--out", str(tmp_path / "x")],
+                   "[initial] amplitude scales a mode shape: it needs mode = k", capsys,
+                   tmp_path)

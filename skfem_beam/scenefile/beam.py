@@ -76,6 +76,8 @@ def _spline(d: dict, name: str, value: str):
 def _initial(data: dict, problem: BeamProblem) -> BeamProblem:
     ini = data.get("initial", {})
     fixed = ini.get("fixed_frame", True)
+    if "amplitude" in ini and "mode" not in ini:     # it was read and ignored
+        raise InputError("[initial] amplitude scales a mode shape: it needs mode = k")
     if "mode" in ini:
         if "u0" in ini:
             raise InputError("[initial] give mode or u0, not both")

@@ -965,3 +965,14 @@ def test_an_initial_amplitude_needs_its_mode(tmp_path, capsys):
                               "initial.amplitude=0.001", "--out", str(tmp_path / "x")],
                    "[initial] amplitude scales a mode shape: it needs mode = k", capsys,
                    tmp_path)
+
+
+@pytest.mark.parametrize("setting, word", [
+    # named a flag the user never gave (--format, --flush-every), and no file
+    ('output.format="vtk"', "flat_obstacles.toml: [output] format 'vtk' is not one of"),
+    ("output.flush_every=0", "flat_obstacles.toml: [output] flush_every=0 must be"),
+])
+def test_an_output_value_of_the_file_is_named_as_the_file_has_it(tmp_path, capsys, setting,
+                                                                word):
+    assert_refused(run_main, [str(example("flat_obstacles.toml")), "--set", setting, "--out",
+                              str(tmp_path / "x")], word, capsys, tmp_path)

@@ -105,14 +105,24 @@ def _same_mesh(scene, summary: dict, resume) -> None:
 def _grid(scene, flags: dict, resume) -> tuple[OutputOptions, object]:
     """The output options and the time grid: the flags (completed in place from the
     scene's [output] and [time] T where not given) over the scene's."""
+    from_file = set()
     for key, value in scene.output.items():
         if key != "probes" and flags[key] is None:
             flags[key] = value
+            from_file.add(key)
     flags["T"] = scene.stepping.T if flags["T"] is None else flags["T"]
     flags["out"] = flags["out"] or f"out/{Path(flags['scene']).stem}"
-    options = OutputOptions(flags["out"], flags["overwrite"], resume, flags["format"],
-                            flags["frames"], flags["save_every"], flags["flush_every"],
-                            flags["checkpoint_every"])
+    try:
+        options = OutputOptions(flags["out"], flags["overwrite"], resume, flags["format"],
+                                flags["frames"], flags["save_every"], flags["flush_every"],
+                                flags["checkpoint_every"])
+    except InputError as e:       # the file's [output] value, named as the file has it
+        flag = next((k for k in from_file if str(e).startswith(f"--{k.replace('_', '-')}")),
+                    None)
+        if flag is None:
+            raise
+        raise InputError(f"{Path(flags['scene']).name}: [output] {flag}"
+                         f"{str(e)[len(flag) + 2:]}") from None
     try:
         return options, replace(scene.stepping, T=flags["T"], save_every=options.save_every,
                                 frames=options.frames)

@@ -189,7 +189,7 @@ def check_start(y0, rows: ConstraintRows, motion, shift) -> None:
     if bad.any():
         i = int(np.argmax(bad))
         raise InputError(f"u0 violates the obstacles at x={x[i]:g}: "
-                         f"u0={y0[i]:g} not in [{lo[i]:g}, {hi[i]:g}]")
+                         f"u0={y0[i]:.10g} not in [{lo[i]:.10g}, {hi[i]:.10g}]")
 
 
 def friction(rows: ConstraintRows) -> np.ndarray | None:

@@ -353,7 +353,7 @@ def add_probes(system: SemiDiscrete, xs) -> list[dict]:
     probes = system.meta.setdefault("probes", [])
     for x in np.atleast_1d(np.asarray(xs, dtype=float)).tolist():
         if not 0.0 <= x <= L:
-            raise InputError(f"probe x={x:g} is outside the beam [0, L={L:g}]")
+            raise InputError(f"probe x={x:.10g} is outside the beam [0, L={L:.10g}]")
         name = f"probe_{x:g}"
         if any(p["name"] == name for p in probes):
             raise InputError(f"probe x={x:g} is given twice")

@@ -127,9 +127,10 @@ def resolve(law: str | ContactLaw = "auto", stiffness: float | None = None,
     e = Restitution(restitution).e
     if e > 0:
         if law not in ("auto", "restitution") or stiffness is not None:
+            other = f"stiffness={stiffness:g} (springs)" if stiffness is not None \
+                else f"solver={law!r}"
             raise InputError(f"restitution={e:g} is a law of its own (exact contact with a "
-                             f"coefficient of restitution): it cannot be combined with "
-                             f"{'stiffness=' if stiffness is not None else f'solver={law!r}'}")
+                             f"coefficient of restitution): it cannot be combined with {other}")
         return Restitution(e)
     if stiffness is not None:
         if law not in ("auto", "penalty"):

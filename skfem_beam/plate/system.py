@@ -329,7 +329,7 @@ def plate_system(space: PlateSpace, obstacles=(), loads=(), initial: PlateInitia
         i = int(np.argmax((y0 < lo - tol) | (y0 > hi + tol)))
         x, y = space.vertices[:, vertices[i]]
         raise InputError(f"the initial deflection violates the obstacles at ({x:g}, {y:g}): "
-                         f"w0={y0[i]:g} not in [{lo[i]:g}, {hi[i]:g}]")
+                         f"w0={y0[i]:.10g} not in [{lo[i]:.10g}, {hi[i]:.10g}]")
     return SemiDiscrete(
         M=M, K=K, C=C, lo=lo, hi=hi, x_contact=space.vertices[0, vertices].copy(),
         loads=np.column_stack(b) if b else np.zeros((dofs.size, 0)),

@@ -299,7 +299,7 @@ class Run:
             early = self.watch.negative(n0, k - 1, Ebound)   # a negative energy before it
             if early is not None:
                 return self._unstable(*early)
-            return self._unstable(k, f"energy {self.energy[k // self.save_every]:.3g} "
+            return self._unstable(k, f"|energy| {abs(self.energy[k // self.save_every]):.3g} "
                                   f"exceeds {Ebound:.3g}", (k // self.save_every - 1)
                                   * self.save_every)
         bad = self.watch.bad(n0, n1, Ebound)
@@ -334,7 +334,8 @@ class Run:
             f"dt={self.dt:g} s, {self.label}"
         if self.beta is not None:
             limit = linear_limit(kappa_h(self.system), self.beta)
-            self.message += f", linear stability limit 2/√(κ_h(1−4β)) = {limit:.4g} s"
+            if math.isfinite(limit):        # β ≥ 1/4 has none
+                self.message += f", linear stability limit 2/√(κ_h(1−4β)) = {limit:.4g} s"
             if self.dt > limit:     # ½E_β hides the growth: only what the watch vouched for
                 good = min(good, self.watch.vouched // self.save_every * self.save_every)
         self.n = good

@@ -93,7 +93,9 @@ def output_flags(p: Parser, prog: str) -> Parser:
     """The flags of what a run writes and where (parser()'s tail)."""
     p.add_argument("--save-every", type=int, default=1,
                    help="keep every n-th step in timeseries.csv")
-    p.add_argument("--frames", type=int, default=200, help="field snapshots kept")
+    p.add_argument("--frames", type=int, default=200,
+                   help="field snapshots kept, about: every ⌊steps/frames⌋-th state from t = 0 "
+                        "(up to twice as many; the last state only when that divides the steps)")
     p.add_argument("--format", default="both",
                    help="field time series for ParaView: xdmf | vtu | both | none")
     p.add_argument("--out", default=f"out/{prog.rsplit('.', 1)[-1]}", help="output folder")

@@ -107,19 +107,28 @@ def numba_cache() -> None:
     cache folder; when neither can be written (a shared read-only install, no writable
     HOME) a folder of this user's in the temporary directory, since numba then raised at
     import ("no locator available") and every command, --help included, was a traceback.
-    A NUMBA_CACHE_DIR of the user's is kept."""
-    if os.environ.get("NUMBA_CACHE_DIR") or os.access(os.path.dirname(__file__), os.W_OK):
+    A NUMBA_CACHE_DIR of the user's is kept where it can be written; else one warning line
+    and the temporary folder."""
+    given = os.environ.get("NUMBA_CACHE_DIR")
+    if given:
+        if _writable(given):
+            return
+        os.write(2, f"warning: NUMBA_CACHE_DIR={given} cannot be written\n".encode())
+    elif os.access(os.path.dirname(__file__), os.W_OK) or _writable(
+            os.path.join(os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"),
+                         "numba")):
         return
-    user = os.path.join(os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"),
-                        "numba")
-    try:
-        os.makedirs(user, exist_ok=True)
-        tempfile.TemporaryFile(dir=user).close()
-        return
-    except OSError:
-        pass
     path = os.path.join(tempfile.gettempdir(), f"skfem_beam-numba-{os.getuid()}")
     os.environ["NUMBA_CACHE_DIR"] = path
     if "numba" in sys.modules:      # imported before us: its config read the environment
         sys.modules["numba"].config.CACHE_DIR = path
 
+
+def _writable(folder: str) -> bool:
+    """Whether ``folder`` exists or can be made, and takes a file (as numba checks it)."""
+    try:
+        os.makedirs(folder, exist_ok=True)
+        tempfile.TemporaryFile(dir=folder).close()
+        return True
+    except OSError:
+        return False

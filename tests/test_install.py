@@ -71,3 +71,9 @@ def test_numba_gets_a_cache_folder_where_nothing_else_is_writable(tmp_path, monk
     _startup.numba_cache()
     assert os.environ["NUMBA_CACHE_DIR"] == str(tmp_path / f"skfem_beam-numba-{os.getuid()}")
     assert numba.config.CACHE_DIR == os.environ["NUMBA_CACHE_DIR"]
+    # a NUMBA_CACHE_DIR of the user's that cannot be written (a file here): one warning
+    # line, and the same folder of the temporary directory
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(blocked / "sub"))
+    _startup.numba_cache()
+    assert os.environ["NUMBA_CACHE_DIR"] == str(tmp_path / f"skfem_beam-numba-{os.getuid()}")
+

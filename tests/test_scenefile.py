@@ -939,6 +939,8 @@ def test_the_bar_refuses_keys_it_ignored(tmp_path, capsys, setting, word):
      "[loads.0] amplitude and omega go together"),
     ("flat_obstacles.toml", "loads=[{per_mass=true,amplitude=1.0}]",
      "[loads.0] amplitude and omega go together"),
+    ("point_stops.toml", "motion={end=\"left\",omega=10.0}",
+     "[motion] amplitude and omega go together"),
 ])
 def test_malformed_values_are_one_line(tmp_path, capsys, scene, setting, word):
     assert_refused(run_main, [str(example(scene)), "--set", setting, "--out",

@@ -70,7 +70,10 @@ def support_of(data: dict, L: float, reader: Tables) -> Support:
     time = {k: v for k, v in m.items() if k != "direction"}
     if set(time) & {"amplitude", "omega"} and not set(time) & {"phase", "value", "sines",
                                                                 "table", "random", "psd"}:
-        return Support(m.get("amplitude", 0.0), m.get("omega", 0.0), at=at, lifting=lifting,
+        if not {"amplitude", "omega"} <= set(time):     # either alone: a support at rest
+            raise InputError("[motion] amplitude and omega go together (amplitude · "
+                             "sin(omega t + phase)); a constant is value = ...")
+        return Support(m["amplitude"], m["omega"], at=at, lifting=lifting,
                        direction=direction)
     return Support(motion=_time_function(time, "motion", reader), at=at, lifting=lifting,
                    direction=direction)

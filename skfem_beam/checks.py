@@ -73,11 +73,17 @@ def check_restitution(e, name: str = "restitution=") -> float:
     return e
 
 
-def check_count(name: str, value, least: int = 1) -> int:
-    """A whole number ≥ ``least`` (bools refused)."""
+def check_count(name: str, value, least: int = 1, most: int | None = None) -> int:
+    """A whole number ≥ ``least`` (bools refused), ≤ ``most`` when given."""
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < least:
         raise InputError(f"{name}={value!r} must be a whole number ≥ {least}")
+    if most is not None and value > most:
+        raise InputError(f"{name}={value!r} must be at most {most:,}: more than a machine's "
+                         "memory holds")
     return int(value)
+
+
+MAX_ELEMENTS = 10_000_000     # along one direction: beyond it numpy raised from inside
 
 
 def check_choice(name: str, value, allowed) -> str:

@@ -12,8 +12,9 @@ from typing import Callable
 
 import numpy as np
 
-from .checks import (check_beta, check_bound, check_choice, check_count,  # noqa: F401
-                     check_finite, check_nonnegative, check_positive, check_ratio)
+from .checks import (MAX_ELEMENTS, check_beta, check_bound, check_choice,  # noqa: F401
+                     check_count, check_finite, check_nonnegative, check_positive,
+                     check_ratio)
 from .errors import InputError
 from .timefunctions import Constant, derivative
 from .spaces.ends import DEFAULT_ENDS, END_CONDITIONS, check_ends, fixed_dofs, support_nodes
@@ -574,7 +575,7 @@ class BeamProblem:
         self._check_planes()
         object.__setattr__(self, "supports", self._check_supports())
         if self.nodes is None:
-            check_count("J", self.J)
+            check_count("J", self.J, most=MAX_ELEMENTS)
             object.__setattr__(self, "nodes", np.linspace(0.0, self.beam.L, int(self.J) + 1))
         else:
             x = np.asarray(self.nodes, dtype=float)

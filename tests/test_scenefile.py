@@ -978,3 +978,22 @@ def test_an_output_value_of_the_file_is_named_as_the_file_has_it(tmp_path, capsy
                                                                 word):
     assert_refused(run_main, [str(example("flat_obstacles.toml")), "--set", setting, "--out",
                               str(tmp_path / "x")], word, capsys, tmp_path)
+
+
+@pytest.mark.parametrize("scene, setting, word", [
+    # numpy's "Maximum allowed size exceeded", skfem's "Newton iteration didn't converge"
+    ("flat_obstacles.toml", "mesh.J=99999999999999999999999", "must be at most 10,000,000"),
+    ("plate_rattling.toml", "mesh.nx=100000", "plate nx=100000 must be at most 2,000"),
+])
+def test_a_mesh_beyond_memory_is_one_line(tmp_path, capsys, scene, setting, word):
+    assert_refused(run_main, [str(example(scene)), "--set", setting, "--out",
+                              str(tmp_path / "x")], word, capsys, tmp_path)
+
+
+def test_a_kind_that_is_no_word_is_one_line(tmp_path, capsys):
+    path = tmp_path / "src" / "k.toml"
+    path.parent.mkdir()
+    path.write_text('kind = ["beam"]\n')
+    (tmp_path / "out").mkdir()
+    assert_refused(run_main, [str(path), "--out", str(tmp_path / "out" / "x")],
+                   "kind=['beam'] must be one of: beam, bar, plate", capsys, tmp_path / "out")

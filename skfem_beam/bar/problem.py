@@ -17,7 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
-from ..checks import check_choice, check_count, check_finite, check_nonnegative, check_positive
+from ..checks import (MAX_ELEMENTS, check_choice, check_count, check_finite,
+                      check_nonnegative, check_positive)
 from ..spaces.lagrange import MASSES
 
 OBSTACLES = ("rigid", "elastic")
@@ -146,7 +147,7 @@ class Bar:
             object.__setattr__(self, name, check_positive(name, getattr(self, name)))
         object.__setattr__(self, "b", check_nonnegative("b", self.b))
         object.__setattr__(self, "f", check_finite("f", self.f))
-        object.__setattr__(self, "N", check_count("N", self.N))
+        object.__setattr__(self, "N", check_count("N", self.N, most=MAX_ELEMENTS))
         check_choice("obstacle", self.obstacle, OBSTACLES)
         check_choice("mass", self.mass, MASSES)
         check_choice("far_end", self.far_end, FAR_ENDS)

@@ -5,6 +5,8 @@ from dataclasses import dataclass, field
 from ..checks import check_count, check_finite, check_positive
 from ..errors import InputError
 
+MAX_PLATE_SIDE = 2000     # elements a side: 16M unknowns (BFS), past a machine's memory
+
 EDGES = ("left", "right", "bottom", "top")
 SUPPORTS = ("clamped", "simply_supported", "free", "sliding")
 ELEMENTS = ("bfs", "morley", "argyris")
@@ -90,8 +92,8 @@ class Plate(_Plate):
         if self.element not in ELEMENTS:
             raise InputError(f"plate element {self.element!r} is not one of: "
                              f"{', '.join(ELEMENTS)}")
-        self.nx = check_count("plate nx", self.nx)
-        self.ny = check_count("plate ny", self.ny)
+        self.nx = check_count("plate nx", self.nx, most=MAX_PLATE_SIDE)
+        self.ny = check_count("plate ny", self.ny, most=MAX_PLATE_SIDE)
 
     @property
     def boundary_names(self) -> tuple[str, ...]:

@@ -49,7 +49,7 @@ def read(path, overrides=(), files: dict | None = None, text: str | None = None,
     except tomllib.TOMLDecodeError as e:
         raise InputError(f"{path}: not valid TOML: {e}") from None
     kind = data.get("kind", "beam")
-    if kind not in KINDS:
+    if not isinstance(kind, str) or kind not in KINDS:     # a list: unhashable, a traceback
         raise InputError(f"{path}: kind={kind!r} must be one of: {', '.join(KINDS)}")
     sets = dict(apply_set(data, assignment) for assignment in overrides)
     if data.get("kind", "beam") != kind:

@@ -24,7 +24,7 @@ from skfem_beam.methods import PositionLevel
 from conftest import exit_code
 from skfem_beam.cases import impacting_bar, point_stops
 from skfem_beam.contact import ContactLaw
-from skfem_beam.errors import SolverError
+from skfem_beam.errors import InputError, SolverError
 from skfem_beam.output import series
 from skfem_beam.output.folder import Folder
 from skfem_beam.results import read_run
@@ -556,3 +556,7 @@ def test_a_long_legal_folder_name_is_taken(tmp_path):
     assert check_output_dir(out) == out
     out.mkdir()
     assert check_output_dir(out) == out     # probed inside itself when it exists
+    # one over the file system's limit: refused (exit 2), where the checks raised
+    # ENAMETOOLONG (exit 3, "could not write the results")
+    with pytest.raises(InputError, match="a name of 300 bytes, more than a file name may"):
+        check_output_dir(tmp_path / ("a" * 300))

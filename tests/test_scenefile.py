@@ -997,3 +997,10 @@ def test_a_kind_that_is_no_word_is_one_line(tmp_path, capsys):
     (tmp_path / "out").mkdir()
     assert_refused(run_main, [str(path), "--out", str(tmp_path / "out" / "x")],
                    "kind=['beam'] must be one of: beam, bar, plate", capsys, tmp_path / "out")
+
+
+def test_the_bar_refuses_a_probe_flag(tmp_path, capsys):
+    """`run impacting_bar.toml --probe 0.5` took the probe and wrote no column for it."""
+    assert_refused(run_main, [str(example("impacting_bar.toml")), "--probe", "0.5", "--out",
+                              str(tmp_path / "x")],
+                   "--probe X is a beam's: the bar writes u(0) and u(L) only", capsys, tmp_path)

@@ -18,6 +18,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from ..parser import Parser, count
+
 # (label, scene, parameters, target seconds for the time loop or None)
 CONFIGS = [
     ("point stops J=19 dt=5e-5 T=2", "point_stops", dict(dt=5e-5, T=2.0), 0.1),
@@ -181,9 +183,9 @@ def planes_table(rows: list[dict]) -> None:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="skfem_beam.bench.speed", description=__doc__.splitlines()[0])
+    ap = Parser(prog="skfem_beam.bench.speed", description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="one repeat, fast solvers only")
-    ap.add_argument("--repeat", type=int, default=5,
+    ap.add_argument("--repeat", type=count, default=5,
                     help="time loops per configuration; the best counts (this VM's speed "
                          "drifts by ±30%% over seconds)")
     ap.add_argument("--out", default="speed.json")

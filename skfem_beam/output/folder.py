@@ -38,6 +38,7 @@ OURS = (LOCK, RESERVE)
 # else there (a user's notes, an export's .mat or .npz) is refused by name, not deleted
 WRITTEN = ("*.csv", "*.png", "*.json", "*.xdmf", "*.h5", "*.pvd", "*.mp4", "*.gif",
            "checkpoint.npz", ".*", "fields_vtu", "runs")
+NAME_MAX = 255          # bytes of one file name (Linux, macOS, Windows' NTFS in characters)
 OPENED: list[Path] = []         # the folders this process opened (for the interrupt line)
 
 
@@ -58,6 +59,10 @@ def _make_locked(out: Path) -> None:
 def check_output_dir(out: str | os.PathLike, overwrite: bool = False) -> Path:
     """Refuse an ``--out`` that cannot be written, or holds another run (unless overwrite)."""
     out = Path(out)
+    longest = max((len(p.encode()) for p in out.parts), default=0)
+    if longest > NAME_MAX:      # the checks below raised ENAMETOOLONG: exit 3, not 2
+        raise InputError(f"--out {out}: a name of {longest} bytes, more than a file name "
+                         f"may have ({NAME_MAX})")
     if out.exists() and not out.is_dir():
         raise InputError(f"--out {out} exists and is not a folder")
     if out.is_dir():

@@ -138,6 +138,8 @@ def _spec(scene: Scene, flags: dict, resume) -> RunSpec:
     """The scene and the command line's flags (which override its [output] and [time] T)
     as one RunSpec; summary.json's config records both, in the flags' names."""
     given = flags.pop("probe", None) or []
+    if given and scene.kind == "bar":       # it was taken and ignored
+        raise InputError("--probe X is a beam's: the bar writes u(0) and u(L) only")
     options, stepping = _grid(scene, flags, resume)
     (law, solver), restitution = methods.split_law(scene.law), scene.restitution
     mass = scene.data.get("mesh", {}).get("mass", "consistent") if scene.kind == "beam" \

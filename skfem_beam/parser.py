@@ -51,3 +51,15 @@ def positives(text: str) -> list[float]:
             raise argparse.ArgumentTypeError(f"{s!r} is not a finite number > 0")
         out.append(value)
     return out
+
+
+def made_folder(text: str):
+    """An argparse type: a study's --out folder, made now, so that a bad one is refused
+    before the study computes (it failed at the end, exit 3, the work lost)."""
+    from pathlib import Path
+    path = Path(text)
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise argparse.ArgumentTypeError(f"{text!r}: cannot make the folder ({e.strerror})")
+    return path

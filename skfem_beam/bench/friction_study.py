@@ -32,7 +32,6 @@ the order p of |s(Δt) − s(Δt/2)| ∝ Δt^p fitted on the ladder.
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import math
 from dataclasses import replace
@@ -43,6 +42,7 @@ import numpy as np
 from ..errors import SolverError
 from ..methods import MOREAU_JEAN
 from ..output.supports import support_rows, union_length
+from ..parser import Parser, made_folder
 from ..scenefile import example, load
 from ..scenefile.build import wear
 from ..semidiscrete import beam_system
@@ -290,14 +290,15 @@ def chart(rows: list[dict], dt_scene: float, path: Path) -> None:
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(prog="python -m skfem_beam.bench.friction_study",
-                                description=__doc__.split("\n\n")[0])
+    p = Parser(prog="python -m skfem_beam.bench.friction_study",
+               description=__doc__.split("\n\n")[0])
     p.add_argument("--dts", default=None, help="comma-separated Δt (s); default: the "
                    "scene's Δt × 4, 2, 1, 1/2, 1/4, 1/8")
     p.add_argument("--T", type=float, default=4.7, help="end time (s)")
     p.add_argument("--t0", type=float, default=0.5, help="start of the window (s)")
     p.add_argument("--blocks", type=int, default=6, help="blocks for the standard error")
-    p.add_argument("--out", default="docs", help="folder for the CSV and the chart")
+    p.add_argument("--out", type=made_folder, default="docs",
+                   help="folder for the CSV and the chart")
     args = p.parse_args(argv)
     dt_scene = load(example(SCENE)).stepping.dt
     dts = [float(d) for d in args.dts.split(",")] if args.dts else \

@@ -39,7 +39,7 @@ import numpy as np
 from .. import scenes
 from ..bar import bar_system, l2_time, run_bar
 from ..methods import MOREAU_JEAN
-from ..parser import Parser, counts, positives
+from ..parser import Parser, counts, made_folder, positives
 from ..reference import exact_of
 from .work_precision import COURANTS, run_method, rung
 
@@ -334,7 +334,7 @@ def main(argv=None) -> None:
                    help="every class and option at one N (the first of --N; default 80)")
     p.add_argument("--accuracy", action="store_true",
                    help="the named settings at Δt/h = 0.4, 0.04 (N default 80): rod_study.json")
-    p.add_argument("--out", default="docs",
+    p.add_argument("--out", type=made_folder, default="docs",
                    help="folder for rod_study.csv (--classes) or rod_study.json (--accuracy)")
     p.add_argument("--N", type=counts, default=None,
                    help="default 20,40,80,160 (80 with --classes)")

@@ -63,3 +63,9 @@ def made_folder(text: str):
     except OSError as e:
         raise argparse.ArgumentTypeError(f"{text!r}: cannot make the folder ({e.strerror})")
     return path
+
+
+def about(doc: str) -> str:
+    """A command's --help description: its module docstring's first paragraph, joined
+    (its first line alone stopped mid-sentence)."""
+    return " ".join((doc or "").strip().split("\n\n")[0].split())

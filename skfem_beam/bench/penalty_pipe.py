@@ -12,12 +12,12 @@ penalty_stiffness.png (penetration falls as 1/ε grows while the explicit stable
 """
 from __future__ import annotations
 
-import argparse
 import json
 from pathlib import Path
 
 import numpy as np
 
+from ..parser import Parser, about
 from ..scheme import solve
 from ..scheme.methods import Penalty
 from ..semidiscrete import beam_system
@@ -26,7 +26,7 @@ from ..stability import kappa_h
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="skfem_beam.bench.penalty_pipe")
+    ap = Parser(prog="skfem_beam.bench.penalty_pipe", description=about(__doc__))
     ap.add_argument("--out", default="docs")
     ap.add_argument("--quick", action="store_true", help="T = 0.3 s and Δt ≥ 1e-6 only")
     args = ap.parse_args(argv)

@@ -11,7 +11,6 @@ paper's P3 Table 3.
 """
 from __future__ import annotations
 
-import argparse
 import csv
 from dataclasses import replace
 from pathlib import Path
@@ -21,6 +20,7 @@ import numpy as np
 from .. import scenes
 from ..scheme import solve
 from ..output.charts import penetration_chart
+from ..parser import Parser, about
 from ..problem import Obstacles
 from ..semidiscrete import beam_system
 
@@ -38,7 +38,7 @@ def run(scene, J, element):
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="skfem_beam.bench.penetration_tables")
+    ap = Parser(prog="skfem_beam.bench.penetration_tables", description=about(__doc__))
     ap.add_argument("--out", default="docs")
     args = ap.parse_args(argv)
     out = Path(args.out)

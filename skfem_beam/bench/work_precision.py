@@ -45,7 +45,6 @@ work_precision_beam.png (rod and bar keep their own files).
 """
 from __future__ import annotations
 
-import argparse
 import csv
 from dataclasses import replace
 from pathlib import Path
@@ -57,6 +56,7 @@ from ..bar import bar_system, l2_time
 from ..reference import exact_of
 from .. import methods
 from ..methods import MOREAU_JEAN
+from ..parser import Parser, about
 from ..errors import InputError
 from ..scheme import solve
 from ..semidiscrete import add_probes, beam_system
@@ -367,8 +367,7 @@ def write(out: Path, name: str, rows: list[dict], draw) -> None:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="skfem_beam.bench.work_precision",
-                                 description=__doc__.splitlines()[0])
+    ap = Parser(prog="skfem_beam.bench.work_precision", description=about(__doc__))
     ap.add_argument("--scene", default="all",
                     choices=["all", *BENCHMARKS, "beams", *BEAM_SCENES])
     ap.add_argument("--out", default="docs")

@@ -51,11 +51,11 @@ def main(argv=None) -> int:
                    beta=0.25, element=False, mass=MASSES[2:3] + MASSES[:2] + MASSES[3:])
     p.add_argument("--obstacle", default="rigid", help="rigid | elastic")
     p.add_argument("--k", type=float, default=100.0, help="elastic obstacle: R = k·U⁻ (Pa/m)")
-    p.add_argument("--a", "--E", dest="a", type=float, default=1.0,
+    p.add_argument("--a", "--E", dest="a", type=float, default=1.0, metavar="E",
                    help="Young's modulus E (Pa)")
     p.add_argument("--b", type=float, default=0.0, help="Kelvin–Voigt viscosity (Pa·s)")
     p.add_argument("--rho", type=float, default=1.0, help="density (kg/m³)")
-    p.add_argument("--A", type=float, default=None,
+    p.add_argument("--A", type=float, default=None, metavar="AREA",
                    help="cross-section (m²): forces in N, energies in J, --k in N/m "
                         "(default: per unit cross-section)")
     p.add_argument("--L", type=float, default=1.0, help="length (m)")

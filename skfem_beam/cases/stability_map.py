@@ -24,6 +24,7 @@ from ..scheme import solve
 from ..methods import FLAGS, Penalty, law_of, make
 from ..output.charts import figure
 from ..output.folder import Folder, check_output_dir
+from ..parser import about
 from ..checks import check_beta, check_positive
 from ..semidiscrete import beam_system
 from ..stability import PAPER_KAPPA_BOUNDS, kappa_h, linear_limit, prop31_limit, stability_table
@@ -104,18 +105,22 @@ def chart(path, rows, kappa, kappa_paper, title):
 
 
 def main(argv=None) -> int:
-    p = cli.Parser(prog="skfem_beam.cases.stability_map", description=__doc__.splitlines()[0])
-    p.add_argument("--betas", default="0,0.1,0.2,0.25,0.35,0.5")
-    p.add_argument("--ratios", default="0.5,0.9,1.2,2,10,100")
+    p = cli.Parser(prog="skfem_beam.cases.stability_map", description=about(__doc__))
+    p.add_argument("--betas", default="0,0.1,0.2,0.25,0.35,0.5",
+                   help="comma-separated Newmark β in [0, 1/2]")
+    p.add_argument("--ratios", default="0.5,0.9,1.2,2,10,100",
+                   help="comma-separated Δt as multiples of the linear limit (β < 1/4) or of "
+                        "the paper's Prop. 3.1 step (β ≥ 1/4)")
     p.add_argument("--methods", default="contact,penalty",
                    help="comma-separated: contact (= position), penalty, moreau-jean")
-    p.add_argument("--T", type=float, default=0.5)
-    p.add_argument("--J", type=int, default=19)
+    p.add_argument("--T", type=float, default=0.5, help="final time of each run (s)")
+    p.add_argument("--J", type=int, default=19, help="elements of the pipe")
     p.add_argument("--stiffness", type=float, default=1e8, help="penalty stiffness (N/m)")
     p.add_argument("--max-seconds", type=float, default=900.0,
                    help="refuse a grid whose estimated run time exceeds this")
-    p.add_argument("--out", default="out/stability_map")
-    p.add_argument("--overwrite", action="store_true")
+    p.add_argument("--out", default="out/stability_map", help="output folder")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace the --out folder of an earlier map")
     args = p.parse_args(argv)
     betas = [check_beta(b) for b in floats("betas", args.betas)]
     ratios = [check_positive("ratio", r) for r in floats("ratios", args.ratios)]

@@ -19,7 +19,6 @@ nothing tuned (docs/plate.md, "Which engine at which size").
 """
 from __future__ import annotations
 
-import argparse
 import resource
 import time
 
@@ -30,6 +29,7 @@ from ..contact.registry import Auto
 from ..contact.sparse_qp import COUNTS, SparseCholesky, _one_thread, cholesky_kind
 from ..linalg import Banded, band_solve
 from ..methods import PositionLevel
+from ..parser import Parser, about
 from ..scheme import solve
 from ..scheme.operators import step_operators
 from .model import Plate
@@ -134,7 +134,7 @@ def law_rows(pressed, laws, solve_ms: float, lapack_ms: float, steps: int = STEP
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = Parser(prog="python -m skfem_beam.plate.bench", description=about(__doc__))
     parser.add_argument("--meshes", type=int, nargs="+", default=[20, 40, 80])
     parser.add_argument("--steps", type=int, nargs="+", default=[STEPS],
                         help="steps of each run, one number per mesh (the last repeats)")

@@ -124,5 +124,9 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    from .cli import main_guard
-    main_guard(main)
+    import sys
+    try:    # not cli.main_guard: cli imports this module
+        raise SystemExit(main())
+    except InputError as e:
+        print(f"error: {e}", file=sys.stderr)
+        raise SystemExit(2) from None

@@ -302,6 +302,9 @@ class Obstacles:
     def stops(cls, x, g1, g2, carried: bool = False) -> "Obstacles":
         """Point stops g1[i] ≤ u(x[i]) ≤ g2[i] (numbers apply to every x; ±inf: one-sided)."""
         xs = np.atleast_1d(np.asarray(x, dtype=float))
+        for name, g in (("g1", g1), ("g2", g2)):    # complex: a TypeError, or cast silently
+            for v in np.atleast_1d(np.asarray(g, dtype=object)).ravel():
+                check_bound(name, v, "x")
         lo = np.broadcast_to(np.asarray(g1, dtype=float), xs.shape)
         hi = np.broadcast_to(np.asarray(g2, dtype=float), xs.shape)
         parts = [cls.point_stops(check_finite(f"x[{i}]", xi), lo[i], hi[i], carried)
@@ -315,6 +318,8 @@ class Obstacles:
         a, b = check_finite("a", a), check_finite("b", b)
         if b <= a:
             raise InputError(f"span [a={a:g}, b={b:g}] needs a < b")
+        check_bound("g1", g1, "x")
+        check_bound("g2", g2, "x")
 
         def within(g, outside):         # g is evaluated where the span acts only
             def bound(x):

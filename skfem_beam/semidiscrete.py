@@ -141,11 +141,13 @@ def _meets_support(problem: BeamProblem, u, p0: float) -> None:
     scale = max(abs(p0), float(np.abs(np.asarray(u(np.linspace(0.0, L, 41)))).max()))
     for x in held:
         gap = float(np.asarray(u(np.array([x])), dtype=float).ravel()[0])
-        if not abs(gap) <= 1e-6 * scale:
+        # 1e-12 L: a sine's φ(0) at phase π is 2.4e-17, round-off, not a start
+        if not abs(gap) <= 1e-6 * scale + 1e-12 * L:
             raise InputError(
-                f"[initial] u0 misses what holds the beam at x={x:g} at t = 0 by {gap:.3g} m "
-                f"(the support is at {p0 if x == problem.support.at else 0.0:g} m there): "
-                "start the beam on it, or give no u0 (it starts at rest on its supports)")
+                f"[initial] the start misses what holds the beam at x={x:g} at t = 0 by "
+                f"{gap:.3g} m (the support is at {p0 if x == problem.support.at else 0.0:g} m "
+                "there): start the beam on it (u0, mode), or give no initial displacement "
+                "(it then starts at rest on its supports)")
 
 
 class _Plane(NamedTuple):

@@ -156,6 +156,8 @@ def test_stepped_beam_needs_a_node_at_the_step():
     (lambda: Obstacles(g1=float("nan")), ["g1=nan must be a number"]),
     (lambda: Obstacles.stops([0.5, 1.0], [-0.1, np.nan], 0.1), ["g1=nan must be a number"]),
     (lambda: Obstacles(g2=np.complex128(0.1)), ["g2=(0.1+0j) must be a number"]),
+    (lambda: Obstacles.stops([1.5], np.complex128(-0.1 + 1j), 0.1), ["g1=(-0.1+1j) must be"]),
+    (lambda: Obstacles.span(0.0, 1.0, -0.1 + 1j, 0.1), ["g1=(-0.1+1j) must be a number"]),
     (lambda: InitialState(v0=np.zeros(5)), ["InitialState v0=", "must be a function of x"]),
     (lambda: skfem_beam.modes(beam_system(BeamProblem(Beam(1.5, k2=282.84), J=4)), 2),
      ["modes needs the BeamProblem (not SemiDiscrete"]),

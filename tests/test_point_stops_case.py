@@ -97,11 +97,14 @@ def test_overwrite_keeps_the_users_files_in_a_run_folder(tmp_path):
     assert run(["--T", "0.01", "--out", str(out)]).returncode == 0
     (out / "notes.txt").write_text("mine")
     (out / "run.mat").write_bytes(b"MATLAB")
+    (out / ".git").mkdir()                          # names a run could have written too
+    (out / "my_measurements.csv").write_text("1,2")
     before = sorted(q.name for q in out.iterdir())
     p = run(["--T", "0.01", "--out", str(out), "--overwrite"])
     assert p.returncode == 2 and p.stderr.strip() == (
-        f"error: --out {out} holds files besides the run's (notes.txt, run.mat): --overwrite "
-        "replaces only what a run writes; move them out or choose another folder")
+        f"error: --out {out} holds files besides the run's (.git, my_measurements.csv, "
+        "notes.txt, …): --overwrite replaces only what a run writes; move them out or choose "
+        "another folder")
     assert sorted(q.name for q in out.iterdir()) == before
 
 
@@ -144,7 +147,22 @@ def test_a_save_interval_that_does_not_divide_the_steps_says_so(tmp_path):
     out = tmp_path / "run"
     p = run(["--T", "0.1", "--save-every", "7", "--format", "none", "--out", str(out)])
     assert p.returncode == 0
-    assert "note: --save-every 7 does not divide the 2000 steps: the last saved row is " \
-        "state 1995 (t=0.09975 s), not the last state" in p.stderr, p.stderr
+    assert "note: a row saved every 7 states does not divide the 2000 steps: the last " \
+        "saved row is state 1995 (t=0.09975 s), not the last state" in p.stderr, p.stderr
     data = np.genfromtxt(out / "timeseries.csv", delimiter=",", names=True)
     assert data["t"][-1] == pytest.approx(0.09975)
+
+
+def test_an_unstable_runs_summary_agrees_with_its_impacts(tmp_path):
+    """Penalty springs at β = 0.2 go unstable at t ≈ 1.03 s: summary.json's impacts and
+    penetration disagreed with the impacts.csv it wrote (158 against 185): the rows kept
+    ran past the states whose diagnostics were kept."""
+    out = tmp_path / "run"
+    p = run(["--method", "penalty", "--beta", "0.2", "--dt", "1e-5", "--T", "1.2",
+             "--format", "none", "--out", str(out)])
+    assert p.returncode == 4, p.stderr
+    s = json.loads((out / "summary.json").read_text())
+    rows = np.genfromtxt(out / "impacts.csv", delimiter=",", names=True, ndmin=1)
+    assert s["status"] == "unstable" and s["impacts"] == rows.size > 100
+    assert s["max_penetration"] == rows["max_violation"].max()
+    assert rows["t_start"].max() <= s["steps"] * 1e-5 + 1e-12

@@ -328,6 +328,7 @@ def test_a_plate_export_places_its_fields(tmp_path):
     ("skfem_beam.bench.bar_convergence", ["--N", "abc"], "--N: 'abc' is not a whole number"),
     ("skfem_beam.bench.rod_study", ["--courant", "x"], "--courant: 'x' is not a finite"),
     ("skfem_beam.bench.qp_solvers", ["--repeat", "0"], "--repeat: '0' is not a whole number"),
+    ("skfem_beam.bench.qp_solvers", ["--J", "40,-5"], "--J: '-5' is not a whole number"),
     ("skfem_beam.bench.soak", ["--cycles", "-1"], "--cycles: '-1' is not a whole number"),
     ("skfem_beam.meshes", ["--out", "FILE"], "cannot make the folder (File exists)"),
     # these two checked --out only once their study was done: exit 3, the work lost

@@ -73,7 +73,7 @@ def test_instability_the_energy_bound_missed_is_detected(pipe_system, beta, rati
 def test_a_runaway_the_energy_hides_keeps_no_row_of_it(pipe_system):
     """β = 0 beyond the limit, no contact: ½E_β is conserved exactly while the unstable
     mode grows, so the loop's test fired only at ~1e4 m/s and kept rows with the tip at
-    8,000 m; only the states the kinetic-energy test vouched for are kept."""
+    8,000 m; only the rows before the chunk it was found in are kept."""
     free = beam_system(scenes.point_stops(gap=1e6))
     dt = 2 * linear_limit(kappa_h(free), 0.0)
     r = solve(free, dt, 0.5, 0.0, frames=2)

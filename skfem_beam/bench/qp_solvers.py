@@ -20,7 +20,7 @@ import numpy as np
 from numba import njit
 
 from ..contact.active_set import box_qp
-from ..parser import Parser, count
+from ..parser import Parser, count, counts
 
 SOLVERS = ("active-set", "daqp", "osqp")
 
@@ -82,7 +82,7 @@ def replay(system, r, solver: str, dt: float, repeat: int) -> float:
 def main(argv=None) -> int:
     ap = Parser(prog="skfem_beam.bench.qp_solvers",
                                  description=__doc__.splitlines()[0])
-    ap.add_argument("--J", default="40,80,160")
+    ap.add_argument("--J", type=counts, default="40,80,160")
     ap.add_argument("--T", type=float, default=1.0)
     ap.add_argument("--dt", type=float, default=1e-3)
     ap.add_argument("--element", default="hermite", choices=("hermite", "bspline"))
@@ -92,7 +92,7 @@ def main(argv=None) -> int:
           f"best of {args.repeat}")
     print(f"{'J':>4s} {'solver':11s} {'µs/step':>9s} {'solver µs':>10s} {'its/step':>9s} "
           f"{'impacts':>8s} {'max viol m':>11s} {'max Δu rel':>11s}")
-    for J in (int(j) for j in args.J.split(",")):
+    for J in args.J:
         floor = best_run(scene(J, args.element, obstacles=False), "auto", args.dt, args.T,
                          args.repeat)
         print(f"{J:4d} {'(no obst.)':11s} {1e6 * floor.wall_time_s / floor.steps:9.1f}")

@@ -34,10 +34,18 @@ from ..lock import LOCK, check_not_busy, lock_folder, release  # noqa: F401 (her
 SUMMARY = "summary.json"
 RESERVE = ".reserve"    # a little disk kept back, freed to write the final summary
 OURS = (LOCK, RESERVE)
-# what the project's commands write in a folder, which --overwrite may remove: anything
-# else there (a user's notes, an export's .mat or .npz) is refused by name, not deleted
-WRITTEN = ("*.csv", "*.png", "*.json", "*.xdmf", "*.h5", "*.pvd", "*.mp4", "*.gif",
-           "checkpoint.npz", ".*", "fields_vtu", "runs")
+# what the project's commands write in a folder, by name, which --overwrite may remove:
+# anything else there (a user's notes, a .git, their own CSV, an export's .mat) is named and
+# the run refused, not deleted
+WRITTEN = (
+    "summary.json", "timeseries.csv", "impacts.csv", "checkpoint.npz", "modes.csv",
+    "fields.xdmf", "fields.h5", "fields.pvd", "fields_vtu",
+    "poincare.csv", "runs.csv", "sweep.json", "runs", "bifurcation.png",      # a sweep's
+    "stability_map.csv", "stability_map.png",
+    "beam_shapes.png", "contact_force.png", "deflection.png", "displacement.png",  # charts
+    "energy.csv", "energy.png", "energy_decay.png", "probes.png", "tip_displacement.png",
+    "orbit_*.png", "wear_*.png",
+    ".lock", ".reserve", ".*.tmp")      # a run's own hidden files (atomic writes' temporaries)
 NAME_MAX = 255          # bytes of one file name (Linux, macOS, Windows' NTFS in characters)
 OPENED: list[Path] = []         # the folders this process opened (for the interrupt line)
 

@@ -244,9 +244,9 @@ def _note_last_step(run) -> None:
     every, steps = getattr(run, "save_every", 1), getattr(run, "n_steps", 0)
     if steps % every:       # the rows, and energy_final, stop short of the end
         last = steps // every * every
-        print(f"note: --save-every {every} does not divide the {steps} steps: the last "
-              f"saved row is state {last} (t={last * run.dt:.9g} s), not the last state",
-              file=sys.stderr)
+        print(f"note: a row saved every {every} states does not divide the {steps} steps: "
+              f"the last saved row is state {last} (t={last * run.dt:.9g} s), not the last "
+              "state", file=sys.stderr)
 
 
 PHASES = ("last-chunk", "final-checkpoint", "charts", "impacts", "summary")

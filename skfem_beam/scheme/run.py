@@ -267,7 +267,7 @@ class Run:
         G = inputs.G
         Ebound = self._energy_bound(G, n1)
         # the running diagnostics before the chunk: an unstable chunk's are not the run's
-        self._before = self.st.stats.copy(), self.st.counters[:3].copy()
+        self._before = self.st.stats.copy(), self.st.counters[:3].copy(), n0
         code, at = self._steps(n0, n1, Ebound, inputs), n0
         while code == EVENTS_FULL:       # take the impact events, go on from where it stopped
             self._take_events()
@@ -296,7 +296,7 @@ class Run:
             raise SolverError(f"the {self.solver} contact solver failed at step {k} "
                               f"(t={k * self.dt:.6g} s){why}")
         if code == UNSTABLE:
-            early = self.watch.negative(n0, k - 1, Ebound)   # a negative energy before it
+            early = self.watch.negative(n0, k, Ebound)   # a negative energy, there or before
             if early is not None:
                 return self._unstable(*early)
             return self._unstable(k, f"|energy| {abs(self.energy[k // self.save_every]):.3g} "
@@ -326,9 +326,12 @@ class Run:
 
     def _unstable(self, k: int, why: str, good: int) -> None:
         """Stop as unstable at state ``k`` (``why``), keeping the saved states up to
-        ``good``, the last one that passed every test, and the running diagnostics
-        (penetration, impacts, contact steps) of the states before the chunk."""
-        self.st.stats[:], self.st.counters[:3] = self._before
+        ``good`` (the last one that passed every test) but not after the chunk's start,
+        whose running diagnostics (penetration, impacts, contact steps) are kept."""
+        self.st.stats[:], self.st.counters[:3], n0 = self._before
+        # the states after the chunk's start have no diagnostics of their own: keeping their
+        # rows made summary.json's impacts and penetration disagree with impacts.csv
+        good = min(good, n0 // self.save_every * self.save_every)
         self.status = "unstable"
         self.message = f"unstable at step {k} (t={k * self.dt:.6g} s): {why}; " \
             f"dt={self.dt:g} s, {self.label}"
@@ -336,8 +339,6 @@ class Run:
             limit = linear_limit(kappa_h(self.system), self.beta)
             if math.isfinite(limit):        # β ≥ 1/4 has none
                 self.message += f", linear stability limit 2/√(κ_h(1−4β)) = {limit:.4g} s"
-            if self.dt > limit:     # ½E_β hides the growth: only what the watch vouched for
-                good = min(good, self.watch.vouched // self.save_every * self.save_every)
         self.n = good
 
     # the saved series by saved-row number (see SavedRows), as the output pipeline reads them

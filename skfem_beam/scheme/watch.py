@@ -14,8 +14,9 @@ energies and its last state.
 - **The last state of a chunk**, saved or not (``save_every`` may not divide the chunk, or
   be larger than the run): finite, and the two tests above.
 
-Beyond the linear limit (β < ¼) a run whose loop test fires keeps no row after the last
-chunk end that passed: ½E_β hid the growth until then.
+An unstable run keeps no row after the start of the chunk it was found in (scheme.Run):
+½E_β can hide the growth until the chunk's end, and only there are the running
+diagnostics (penetration, impacts) known.
 
 A redistributed mass (massless rows: M singular) leaves ½E_β indefinite on those rows
 whatever Δt: there only finiteness and the loop's bound are checked."""
@@ -36,7 +37,6 @@ class Watch:
 
     def __init__(self, run):
         self.run, self._kappa = run, None
-        self.vouched = run.n        # the last chunk's end that passed every test
         from ..spaces.redistribution import massless_rows
         self.definite = massless_rows(run.system.M).size == 0
 
@@ -46,11 +46,9 @@ class Watch:
         if negative is not None:
             return negative
         why = self._last_state(Ebound, floor)
-        if why is None:
-            self.vouched = n1
-            return None
         # the chunk's saved rows before n1 were not seen with this state's tests
-        return n1, why, (n0 // self.run.save_every) * self.run.save_every
+        return None if why is None else (n1, why, n0 // self.run.save_every
+                                         * self.run.save_every)
 
     def negative(self, n0: int, n1: int, Ebound: float):
         """The first saved state of n0 < n ≤ n1 whose energy is negative, as ``bad``."""

@@ -33,9 +33,9 @@ def solve(system, dt: float, T: float, beta: float | None = None, method=None, *
     ``load_window`` ("forward"), ``growth_limit`` (10): see :class:`Stepping`.
 
     The run stops with status "unstable" when the discrete energy exceeds
-    ``growth_limit`` × the a-priori bound (√E¹ + Σ‖Gⁿ‖_{N⁻¹}Δt)² (operators.load_norms)
-    or a value turns non-finite; what was computed up to the last good saved state is
-    returned.
+    ``growth_limit`` × the a-priori bound (√E¹ + Σ‖Gⁿ‖_{N⁻¹}Δt)² (operators.load_norms),
+    turns negative, or a state is non-finite or runs away (scheme.watch); what was
+    computed up to the start of the 20,000-step chunk where that was found is returned.
     """
     if not isinstance(system, SemiDiscrete):
         raise InputError(f"solve needs a semi-discrete system (beam_system(problem), "

@@ -265,6 +265,11 @@ class Table(_FromEval):
         path = Path(path)
         t, phi, header = _two_columns(path, "t, phi")
         t_arr = np.asarray(t)
+        for name, col in (("the first column", t_arr), ("the second column", np.asarray(phi))):
+            nan = np.flatnonzero(~np.isfinite(col))
+            if nan.size:    # named by its row in the file (a header is row 1)
+                raise InputError(f"{path}: {name} is not a finite number in row "
+                                 f"{int(nan[0]) + 1 + header}")
         bad = np.flatnonzero(np.diff(t_arr) <= 0) if t_arr.size > 1 else []
         if len(bad):   # named by its row in the file (a header is row 1)
             j = int(bad[0]) + 1

@@ -68,6 +68,10 @@ def test_table_from_csv_and_its_refusals(tmp_path):
         Table.from_csv(tmp_path / "missing.csv")
     # Excel's "CSV UTF-8" starts with a byte-order mark: its first row was taken for a
     # header and silently left out; another encoding was a UnicodeDecodeError traceback
+    # a NaN on the file's line 3 was "phi ... in row 2" (its row among the numbers)
+    f.write_text("t,phi\n0,0\n0.1,nan\n0.2,4\n0.3,9\n")
+    with pytest.raises(InputError, match=r"the second column is not a finite number in row 3"):
+        Table.from_csv(f)
     f.write_bytes("\ufeff0,0\n0.1,1\n0.2,4\n0.3,9\n".encode("utf-8"))
     assert Table.from_csv(f).t == (0.0, 0.1, 0.2, 0.3)
     f.write_bytes("t,déplacement µm\n0,0\n".encode("latin-1"))

@@ -1004,3 +1004,24 @@ def test_the_bar_refuses_a_probe_flag(tmp_path, capsys):
     assert_refused(run_main, [str(example("impacting_bar.toml")), "--probe", "0.5", "--out",
                               str(tmp_path / "x")],
                    "--probe X is a beam's: the bar writes u(0) and u(L) only", capsys, tmp_path)
+
+
+@pytest.mark.parametrize("scene, settings", [
+    # skfem's "Transforming over 1000 elements to C_CONTIGUOUS." (a transposed array of ours)
+    ("flat_obstacles.toml", ["mesh.J=1200", "time.T=0.002"]),
+    # matplotlib's "No artists with labels found to put in legend."
+    ("plate_rattling.toml", ["output.probes=[]", "time.T=0.002"]),
+])
+def test_no_library_chatter_on_stderr(tmp_path, scene, settings):
+    """As a user runs it (a process of its own: pytest captures logging and warnings)."""
+    import os
+    import subprocess
+    import sys
+    argv = [sys.executable, "-m", "skfem_beam", "run", str(example(scene)), "--format",
+            "none", "--out", str(tmp_path / "x")]
+    for s in settings:
+        argv += ["--set", s]
+    p = subprocess.run(argv, capture_output=True, text=True,
+                       env={**os.environ, "SKFEM_BEAM_CHARTS": "1"})
+    assert p.returncode == 0, p.stderr
+    assert "C_CONTIGUOUS" not in p.stderr and "Warning" not in p.stderr, p.stderr

@@ -38,7 +38,7 @@ def _frame(ax, xlabel, ylabel, title="", legend=True, fontsize=None):
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.set_title(title, fontsize=fontsize)
-    if legend:
+    if legend and ax.get_legend_handles_labels()[0]:   # none: matplotlib warns on stderr
         ax.legend(loc="best", fontsize=8)
     ax.grid(alpha=0.3)
 

@@ -79,7 +79,7 @@ class HermiteSpace:
         p = np.zeros(2 * J)
         p[1::2] = self.h
         # a fresh element per mesh (docs/design.md §6: the element caches mesh data)
-        self._broken = MeshLine(p, np.arange(2 * J).reshape(J, 2).T)
+        self._broken = MeshLine(p, np.ascontiguousarray(np.arange(2 * J).reshape(J, 2).T))
         self._basis = Basis(self._broken, ElementLineHermite(), intorder=8)
         # P: global dofs (2 per node: value, slope; node 0 first) -> broken dofs; then keep
         # the dofs that the end conditions and supports leave free

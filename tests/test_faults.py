@@ -560,3 +560,14 @@ def test_a_long_legal_folder_name_is_taken(tmp_path):
     # ENAMETOOLONG (exit 3, "could not write the results")
     with pytest.raises(InputError, match="a name of 300 bytes, more than a file name may"):
         check_output_dir(tmp_path / ("a" * 300))
+
+
+def test_a_penalty_failure_says_why(tmp_path, capsys):
+    """Springs of 1e20 N/m cycle on and off: the line said only "the penalty contact solver
+    failed at step 191", with no reason and no hint."""
+    out = tmp_path / "run"
+    assert exit_code(point_stops.main, ["--law", "penalty", "--stiffness", "1e20", "--T",
+                                        "0.5", "--format", "none", "--out", str(out)]) == 3
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert "the penalty contact solver failed at step" in err and \
+        "its set of compressed springs did not settle" in err, err

@@ -17,7 +17,8 @@ A law is an object with
 
   (y_cur, y_prev: the constrained values of uⁿ and uⁿ⁻¹; ``state``: int8 warm start
   kept across steps; writes ``mu`` and ``active``, the values in contact; returns
-  the iterations, < 0 on failure), or ``None`` for a law solved in Python, which then
+  the iterations, < 0 on failure, which the law's ``failure`` text, if it has one, explains
+  in the run's error line), or ``None`` for a law solved in Python, which then
   has ``solver(step)`` returning an object with ``solve(x_free, y_free, lo, hi) ->
   (μ, its)`` (lo, hi: the step's bounds, which move with a support) and, so that its
   runs checkpoint and resume bit for bit, ``checkpoint() -> dict`` of arrays and

@@ -525,6 +525,11 @@ class BetaScheme:
                                     + _GAUSS_W[2] * v[2] + _GAUSS_W[3] * v[3]) / 2.0
         return f
 
+    def failure(self) -> str:
+        """Why a step failed, where its law says (its ``failure``), for the run's line."""
+        why = getattr(self.law, "failure", "")
+        return f": {why}" if isinstance(why, str) and why else ""
+
     def steps(self, out, n0, n1, Ebound, inputs=None):
         """The compiled loop over steps n0..n1−1 (see kernels.run_steps)."""
         if inputs is None:

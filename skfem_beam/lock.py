@@ -21,6 +21,18 @@ def _busy(out: Path) -> InputError:
                       "wait for it to end or choose another folder")
 
 
+def _flock(fd: int, out: Path) -> None:
+    """Take ``fd``'s exclusive flock without waiting; refuse ``out`` as busy (closing
+    ``fd``) when another process holds it."""
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError as e:
+        os.close(fd)
+        if e.errno in (errno.EWOULDBLOCK, errno.EAGAIN):
+            raise _busy(out) from None
+        raise
+
+
 def lock_folder(out: Path) -> None:
     """Take the exclusive lock of folder ``out`` (which exists) for this process, or refuse
     (InputError naming the folder) when another process holds it.  Held until
@@ -29,13 +41,7 @@ def lock_folder(out: Path) -> None:
     if key in _HELD:
         return
     fd = os.open(key / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError as e:
-        os.close(fd)
-        if e.errno in (errno.EWOULDBLOCK, errno.EAGAIN):
-            raise _busy(out) from None
-        raise
+    _flock(fd, out)
     _HELD[key] = fd
 
 
@@ -58,11 +64,5 @@ def check_not_busy(out: Path) -> None:
         fd = os.open(Path(out) / LOCK, os.O_RDONLY)
     except OSError:
         return          # cannot be read: nobody's lock this process can see
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError as e:
-        if e.errno in (errno.EWOULDBLOCK, errno.EAGAIN):
-            raise _busy(out) from None
-        raise
-    finally:
-        os.close(fd)
+    _flock(fd, out)
+    os.close(fd)

@@ -133,27 +133,24 @@ def spring_supports(table: dict, obstacles, stiffness, damping) -> list[dict]:
     x, bound = np.asarray(table["x"], dtype=float), np.asarray(table["bound"], dtype=int)
     owner = obstacles.owners(x)[np.arange(x.size), bound - 1] if x.size else \
         np.zeros(0, int)
-    out = []
-    for i, part in enumerate(parts):
-        rows = np.flatnonzero(owner == i)
-        out.append({"obstacle": i, "where": _describe(part), "stiffness": float(k[i]),
-                    "damping": float(c[i]), "impacts": int(rows.size),
-                    "max_deflection": float(table["max_violation"][rows].max(initial=0.0)),
-                    "max_force": float(table["peak_force"][rows].max(initial=0.0))})
-    return out
+    return [_spring(table, np.flatnonzero(owner == i), i, _describe(part), k[i], c[i])
+            for i, part in enumerate(parts)]
 
 
 def hole_springs(table: dict, supports, stiffness: float, damping: float) -> list[dict]:
     """:func:`spring_supports` of a two-plane run: one stiffness and damping on every
     support, one entry per support (a hole or faces at x, ``supports`` in order)."""
-    out = []
-    for i, x in enumerate(supports):
-        rows = np.flatnonzero(np.asarray(table["x"], dtype=float) == x)
-        out.append({"obstacle": i, "where": f"support at x={x:g}", "stiffness": float(stiffness),
-                    "damping": float(damping), "impacts": int(rows.size),
-                    "max_deflection": float(table["max_violation"][rows].max(initial=0.0)),
-                    "max_force": float(table["peak_force"][rows].max(initial=0.0))})
-    return out
+    x = np.asarray(table["x"], dtype=float)
+    return [_spring(table, np.flatnonzero(x == xi), i, f"support at x={xi:g}", stiffness,
+                    damping) for i, xi in enumerate(supports)]
+
+
+def _spring(table: dict, rows, i: int, where: str, stiffness, damping) -> dict:
+    """One entry of ``spring_supports``: the impacts ``rows`` of ``table`` its spring took."""
+    return {"obstacle": i, "where": where, "stiffness": float(stiffness),
+            "damping": float(damping), "impacts": int(rows.size),
+            "max_deflection": float(table["max_violation"][rows].max(initial=0.0)),
+            "max_force": float(table["peak_force"][rows].max(initial=0.0))}
 
 
 # impact_statistics' contact_fraction, as summary.json's units say it

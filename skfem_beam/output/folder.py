@@ -45,7 +45,7 @@ WRITTEN = (
     "beam_shapes.png", "contact_force.png", "deflection.png", "displacement.png",  # charts
     "energy.csv", "energy.png", "energy_decay.png", "probes.png", "tip_displacement.png",
     "orbit_*.png", "wear_*.png",
-    ".lock", ".reserve", ".*.tmp")      # a run's own hidden files (atomic writes' temporaries)
+    *OURS, ".*.tmp")        # a run's own hidden files (atomic writes' temporaries)
 NAME_MAX = 255          # bytes of one file name (Linux, macOS, Windows' NTFS in characters)
 OPENED: list[Path] = []         # the folders this process opened (for the interrupt line)
 

@@ -68,11 +68,9 @@ def support_of(data: dict, L: float, reader: Tables) -> Support:
     lifting = m.get("lifting", "auto")
     direction = _direction(m, data, "motion")
     time = {k: v for k, v in m.items() if k != "direction"}
-    if set(time) & {"amplitude", "omega"} and not set(time) & {"phase", "value", "sines",
-                                                                "table", "random", "psd"}:
-        if not {"amplitude", "omega"} <= set(time):     # either alone: a support at rest
-            raise InputError("[motion] amplitude and omega go together (amplitude · "
-                             "sin(omega t + phase)); a constant is value = ...")
+    # either alone: _time_function refuses it (it was a support at rest)
+    if {"amplitude", "omega"} <= set(time) and not set(time) & {"phase", "value", "sines",
+                                                                 "table", "random", "psd"}:
         return Support(m["amplitude"], m["omega"], at=at, lifting=lifting,
                        direction=direction)
     return Support(motion=_time_function(time, "motion", reader), at=at, lifting=lifting,

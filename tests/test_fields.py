@@ -271,6 +271,21 @@ def test_streaming_writer(run, tmp_path, monkeypatch):
         assert rd.read_data(3)[0] == run.frames_t[3]
 
 
+def test_closing_after_a_flush_does_not_write_the_indexes_again(run, tmp_path):
+    """A run's last update flushes, then the run closes its writer: the .xdmf and .pvd
+    (each replaced whole when written) are written once, and list every frame."""
+    with FieldWriter(tmp_path, run.system, fmt="both", samples_per_element=4) as w:
+        for k in range(3):
+            w.write(run.frames_t[k], run.frames_u[k], run.frames_v[k], run.frames_force[k])
+        w.flush()
+        inodes = {s: os.stat(tmp_path / f"fields.{s}").st_ino for s in ("xdmf", "pvd")}
+    assert {s: os.stat(tmp_path / f"fields.{s}").st_ino for s in ("xdmf", "pvd")} == inodes
+    assert len(ET.parse(tmp_path / "fields.pvd").getroot().findall(".//DataSet")) == 3
+    with meshio.xdmf.TimeSeriesReader(tmp_path / "fields.xdmf") as rd:
+        rd.read_points_cells()
+        assert rd.num_steps == 3 and rd.read_data(2)[0] == run.frames_t[2]
+
+
 def test_bad_field_options(run, tmp_path):
     with pytest.raises(InputError, match="format='vtk' is not one of: xdmf, vtu, both, none"):
         FieldWriter(tmp_path, run.system, fmt="vtk")

@@ -223,8 +223,9 @@ def beam_charts(case, problem, rho_S, stops, extra, observed_x=None, wear=None):
                  shapes(run.result(), elastic=run.springs),
                  title=f"{case}: displacement ũ(x, t) at saved times ({about})")
         else:
-            orbit_charts(folder, data, case, problem, about)
-            if wear is not None:
+            if wear is None:
+                orbit_charts(folder, data, case, problem, about)
+            else:       # each wear chart draws the orbit beside the wear
                 wear_charts(folder, data, run, case, problem, about, rho_S, wear)
         if extra is not None:
             extra(folder, data, run)
@@ -248,7 +249,8 @@ def force_chart(folder, data, case, about, rho_S, suffixes) -> None:
 
 
 def orbit_charts(folder, data, case, problem, about) -> None:
-    """orbit_<x>.png per hole node: w against v there, the hole's wall drawn."""
+    """orbit_<x>.png per hole node: w against v there, the hole's wall drawn (a run with
+    [wear] draws it in its wear_<x>.png instead: one picture per support)."""
     for h, x in hole_nodes(problem):
         key = f"hole_{x:g}_displacement"
         draw(orbit_chart, folder / f"orbit_{x:g}.png", data[f"{key}_v"],

@@ -368,6 +368,7 @@ class FieldWriter:
         self.times: list[float] = []
         self._vtu_files: list[str] = []
         self._xdmf = None
+        self._indexed = None    # how many frames the written indexes list (None: no index yet)
         self.closed = False
         if fmt in ("xdmf", "both"):
             from .xdmf import XdmfSeries    # meshio and h5py: loaded with a run's first frame
@@ -431,12 +432,17 @@ class FieldWriter:
             self._flush()
 
     def _flush(self) -> None:
-        if self.closed:
-            return
+        if not self.closed:
+            self._index()
+
+    def _index(self) -> None:
+        if self._indexed == len(self.times):
+            return      # they list every frame already (a run's last update, then close)
         if self._xdmf is not None:
             self._xdmf.flush()
         if self.fmt in ("vtu", "both"):
             self._write_pvd()
+        self._indexed = len(self.times)
 
     def close(self) -> None:
         if self.closed:
@@ -447,10 +453,7 @@ class FieldWriter:
 
     def _close(self) -> None:
         try:
-            if self._xdmf is not None:
-                self._xdmf.__exit__(None, None, None)   # writes the XML, closes the .h5
-            if self.fmt in ("vtu", "both"):
-                self._write_pvd()
+            self._index()
         finally:
             self._close_h5()
 

@@ -59,6 +59,22 @@ def test_an_x_space_engine_runs_the_active_sets_plate(plate, law, chol, monkeypa
     assert np.abs(closure(r)).max() <= 1e-9 * np.abs(r.energy).max()
 
 
+def test_the_beams_osqp_law_runs_the_benchmarks_plate_as_the_active_set():
+    """The OSQP law of the beam (W and D built) on the benchmark's 20 × 20 plate pressed onto
+    the obstacle under it: it called the step QP "dual infeasible" at step 16 when it scaled
+    the unknowns by A's mean diagonal (the twists' curvature fell below OSQP's eps_dinf);
+    scaled each by its own diagonal, it gives the active set's run to round-off."""
+    from skfem_beam.plate.bench import DT as dt, systems
+    system = systems(20)[1]
+    runs = [solve(system, dt, 30 * dt, method=PositionLevel(law), progress=False)
+            for law in ("osqp", "active-set")]
+    assert all(r.success for r in runs) and runs[0].solver == "osqp"
+    assert runs[0].contact_fraction > 0.5
+    scale = np.abs(runs[1].frames_u).max()
+    assert np.abs(runs[0].frames_u - runs[1].frames_u).max() <= 1e-10 * scale
+    assert runs[0].max_nodal_violation <= 1e-12 * scale
+
+
 def test_auto_takes_pdas_sparse_where_w_would_pass_its_budget(plate, monkeypatch):
     """auto: the compiled active set while W = A⁻¹Cᵀ fits in registry.W_BUDGET bytes,
     pdas-sparse past it (chosen before W is built), the same run to the bit as naming it."""

@@ -6,9 +6,12 @@ solution.  The compiled loop calls it only when the free step leaves its bounds 
 is exact otherwise).  What makes OSQP's answer exact (docs/design.md §4 and "Known traps"):
 
 - Scaling.  OSQP's tolerances are absolute.  Unknowns are measured in units of
-  s = the largest finite |bound| (x = s·x̂) and the objective is divided by s²·ā
-  (ā = mean diagonal of A), so the bounds, P and q are O(1) and EPS means "EPS of the
-  obstacle scale".  OSQP's own Ruiz scaling comes on top.
+  s = the largest finite |bound| and of their own diagonal of A (Jacobi: x = s·J x̂,
+  J = diag(A)^{-1/2}) and the objective is divided by s², so the bounds, P̂ = JAJ (unit
+  diagonal) and q̂ are O(1) and EPS means "EPS of the obstacle scale".  OSQP's own Ruiz
+  scaling comes on top.  Scaled by A's mean diagonal instead, a plate's twist unknowns
+  (diagonals 1e-7 of the mean) had curvature below OSQP's eps_dinf and it called the step
+  QP "dual infeasible" at the first contacts (40 × 40 BFS, contact.sparse_qp).
 - ADMM finds the active set, the exact finish solves on it.  ADMM runs to EPS = 1e-6
   (``status_val`` must be SOLVED); the set is read from its iterate by the rule of OSQP's
   own polishing (`guess_active`), and μ is computed exactly on it (D_WW μ_W = b_W −
@@ -51,10 +54,11 @@ class OSQPSolver:
         self.hi = np.array(hi, dtype=float)
         self.D = np.ascontiguousarray(D, dtype=float)
         self.s = bound_scale(self.lo, self.hi)
-        abar = float(A.diagonal().mean())
-        qmat = (A / (-self.s * abar)).tocsr()      # q̂ = −A x_free /(s ā)
+        J = sp.diags(1.0 / np.sqrt(A.diagonal()))
+        qmat = (J @ A / -self.s).tocsr()           # q̂ = −J A x_free / s
         self.qcsr = (qmat.indptr, qmat.indices, qmat.data)
-        self.ccsr = (self.C.indptr, self.C.indices, self.C.data)
+        CJ = (self.C @ J).tocsr()                  # C x = s·(C J) x̂
+        self.ccsr = (CJ.indptr, CJ.indices, CJ.data)
         self.q, self.z = np.zeros(A.shape[0]), np.zeros(self.lo.size)
         self.state = np.zeros(self.lo.size, dtype=np.int8)
         self.duals = np.zeros(self.lo.size)
@@ -62,8 +66,8 @@ class OSQPSolver:
         import osqp   # here, not at import: a run that does not use it does not load it
         self._solved = osqp.SolverStatus.OSQP_SOLVED
         self.prob = osqp.OSQP()
-        self.prob.setup(sp.triu(A / abar, format="csc"), np.zeros(A.shape[0]),
-                        self.C.tocsc(), self.lo / self.s, self.hi / self.s, verbose=False,
+        self.prob.setup(sp.triu(J @ A @ J, format="csc"), np.zeros(A.shape[0]),
+                        CJ.tocsc(), self.lo / self.s, self.hi / self.s, verbose=False,
                         eps_abs=EPS, eps_rel=EPS, polishing=False, warm_starting=True,
                         check_termination=CHECK_EVERY, max_iter=100000)
         # the compiled workspace: osqp.OSQP.solve() wraps the same call in a namespace of
@@ -112,7 +116,7 @@ def moved(lo, hi, lo_was, hi_was) -> bool:
 
 @njit(cache=True)
 def duals_and_finish(ccsr, x, y, z, lo, hi, s, duals, D, yf, state, mu):
-    """z ← C x̂ (``ccsr``: C's CSR arrays), OSQP's set by `guess_active`, μ exactly on it
+    """z ← C J x̂ (``ccsr``: C J's CSR arrays), OSQP's set by `guess_active`, μ exactly on it
     (`finish_on_duals`): its KKT residual (`active_set.repair` says what follows)."""
     csr_product(ccsr[0], ccsr[1], ccsr[2], x, z)
     guess_active(z, y, lo, hi, s, duals)

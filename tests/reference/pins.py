@@ -170,6 +170,10 @@ def all_runs(folder: Path, runs: dict = RUNS, workers: int = 2) -> dict:
 
 
 def main(argv) -> int:
+    if argv not in ([], ["--check"], ["--values"]):     # --help must not record (it did)
+        print(f"usage: python tests/reference/pins.py [--check | --values] (got "
+              f"{' '.join(argv)}); see the module docstring", file=sys.stderr)
+        return 2
     with tempfile.TemporaryDirectory() as tmp:
         outs = all_runs(Path(tmp))
         if "--values" in argv:

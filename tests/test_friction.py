@@ -454,7 +454,7 @@ def test_moreau_jean_reports_its_penetration_beyond_the_circle(tmp_path):
 
 
 @pytest.mark.parametrize("mu, word", [("-0.3", "[contact] friction=-0.3 must be ≥ 0"),
-                                      ("nan", "[contact] friction=nan must be a finite")])
+                                      ("nan", "contact.friction = nan: must be a number")])
 def test_a_bad_scene_friction_is_refused_where_every_hole_sets_its_own(tmp_path, capsys,
                                                                       mu, word):
     """[contact] friction is checked where a hole takes it; with every hole's own μ it was

@@ -244,10 +244,9 @@ def test_plate_obstacles_as_polynomials_and_tables(tmp_path):
      "g needs one row per y (2) of one value per x (3)"),
     ("{ x = [0.0, 0.4, 0.2], y = [0.0, 1.2], g = [[1, 2, 3], [1, 2, 3]] }", "must increase"),
     ("{ poly = [[1e-4]], about = [0.5] }", "about a point [x0, y0]"),
-    ("{ poly = [[nan]], about = [0.2, 0.6] }", "obstacles.0.g2 = {poly, about}: poly is rows "
-     "of finite numbers"),
+    ("{ poly = [[nan]], about = [0.2, 0.6] }", "g2.poly[0][0] = nan: must be a number"),
     ("{ x = [0.0, 0.4], y = [0.0, 1.2], g = [[nan, 1e-3], [1e-3, 1e-3]] }",
-     "x, y and g must be finite"),
+     "g2.g[0][0] = nan: must be a number"),
     ("{ x = [0.0, 0.4], g = [1e-4, 2e-4] }", "obstacles.0.g2.g[0] = 0.0001"),
     ('"1e-4 + x"', "must be a number or a table ({ poly"),
 ])

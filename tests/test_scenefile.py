@@ -611,11 +611,13 @@ T = 0.01
 """}
 
 
+@pytest.mark.parametrize("bad", ["0.5m", float("nan")])
 @pytest.mark.parametrize("name", SHIPPED + sorted(ARRAYS))
-def test_a_unit_string_for_any_number_of_a_scene_file_is_one_line(tmp_path, capsys, name):
+def test_a_unit_string_for_any_number_of_a_scene_file_is_one_line(tmp_path, capsys, name,
+                                                                   bad):
     """Every number of the shipped scene files (and of ARRAYS), in arrays too, written
-    "0.5m": exit code 2, one stderr line naming the file, the key path and the value,
-    nothing written."""
+    "0.5m" or nan: exit code 2, one stderr line naming the file, the key path and the
+    value, nothing written."""
     import copy
     import tomllib
     from skfem_beam.scenefile import KINDS
@@ -634,10 +636,10 @@ def test_a_unit_string_for_any_number_of_a_scene_file_is_one_line(tmp_path, caps
         node = changed
         for part in where[:-1]:
             node = node[part]
-        node[where[-1]] = "0.5m"
+        node[where[-1]] = bad
         src = write(tmp_path, toml_text(changed), name)
         assert_refused(run_main, [str(src), "--out", str(out / "run")],
-                       f"error: {name}: {key} = '0.5m': must be ", capsys, out)
+                       f"error: {name}: {key} = {bad!r}: must be ", capsys, out)
 
 
 @pytest.mark.parametrize("sets, warning", [
@@ -1025,3 +1027,51 @@ def test_no_library_chatter_on_stderr(tmp_path, scene, settings):
                        env={**os.environ, "SKFEM_BEAM_CHARTS": "1"})
     assert p.returncode == 0, p.stderr
     assert "C_CONTIGUOUS" not in p.stderr and "Warning" not in p.stderr, p.stderr
+
+
+SEGMENT_E0 = """kind = "beam"
+[[segments]]
+length = 0.75
+material = { E = 2.0e11, rho = 8000.0 }
+section = { rod = { diameter = 0.01 } }
+[[segments]]
+length = 0.75
+material = { E = 0.0, rho = 8000.0 }
+section = { rod = { diameter = 0.01 } }
+[[obstacles]]
+x = 1.5
+g1 = -0.01
+g2 = 0.01
+[time]
+dt = 1e-4
+T = 0.01
+"""
+
+
+@pytest.mark.parametrize("scene, args, line", [
+    ("point_stops", ["--set", "output.probes=[0.5, 5.0]"],
+     "error: point_stops.toml: [output] probes[1] = 5.0: outside the beam [0, L = 1.501] m"),
+    ("point_stops", ["--probe", "7"], "error: --probe 7: outside the beam [0, L = 1.501] m"),
+    ("point_stops", ["--set", "obstacles.0.g1=0.05"],
+     "error: point_stops.toml: u0 violates the obstacles at x=1.501"),
+    ("tube_round_holes", ["--set", "obstacles.0.x=0.0"],
+     "error: tube_round_holes.toml: hole 0 at x=0: the beam is held there"),
+    ("heat_exchanger_tube", ["--set", "material.E=0"],
+     "error: heat_exchanger_tube.toml: [material] E=0 must be > 0"),
+    ("heat_exchanger_tube", ["--set", "section.tube.wall=0.1"],
+     "error: heat_exchanger_tube.toml: [section.tube] wall=0.1 must be less than"),
+    ("segments", [], "error: segments.toml: [segments.1.material] E=0 must be > 0"),
+    ("point_stops", ["--set", "time.beta=-0.5"],
+     "error: point_stops.toml: [time] beta=-0.5 must lie in [0, 1/2]"),
+    ("plate_on_stops", ["--set", "time.beta=-0.5"],
+     "error: plate_on_stops.toml: [time] beta=-0.5 must lie in [0, 1/2]"),
+])
+def test_a_refusal_found_after_the_file_is_read_names_the_file_and_key(tmp_path, capsys,
+                                                                        scene, args, line):
+    """Errors the system's own checks find (a probe, the start against the obstacles, a
+    hole at a held node, a segment's E, β) name the file, and the key where it is one."""
+    src = write(tmp_path, SEGMENT_E0, "segments.toml") if scene == "segments" \
+        else example(scene)
+    out = tmp_path / "out"
+    out.mkdir()
+    assert_refused(run_main, [str(src), "--out", str(out / "run"), *args], line, capsys, out)

@@ -138,6 +138,7 @@ def test_a_load_too_large_for_floats_is_one_line_and_no_folder(tmp_path, capfd, 
     assert exit_code(run_main, [str(path), "--out", str(out), "--set", setting,
                                 "--format", "none"]) == 2
     err = capfd.readouterr().err.strip().splitlines()
-    assert err[-1].startswith("error: the load is too large for floating point"), err
+    assert err[-1].startswith(f"error: {path.name}: the load is too large for floating "
+                              "point"), err
     assert not any("Warning" in line for line in err), err
     assert not out.exists()

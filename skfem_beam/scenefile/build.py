@@ -15,7 +15,7 @@ from ..errors import InputError
 from ..scheme import Stepping
 from .bar import bar_problem
 from .beam import beam_problem
-from .parts import need, outer_radius, plane_count, stepping_of
+from .parts import named_section, need, outer_radius, plane_count, stepping_of
 from .read import Parsed, Tables, read
 from .schema import CONTACT, OUTPUT_DEFAULTS
 
@@ -177,7 +177,10 @@ def _scene(kind, problem, data, text, files) -> Scene:
                            massless=rows or "beta")
     scene = Scene(kind, problem, stepping, law, k, contact.get("restitution", 0.0), out, text,
                   files, data, c)
-    scene.beta      # the method's own checks (law, stiffness, restitution, β)
+    try:
+        scene.beta      # the method's own checks (law, stiffness, restitution, β)
+    except InputError as e:
+        raise named_section(e) from None
     return scene
 
 

@@ -48,6 +48,16 @@ def run_main(argv) -> int:
     p = _run_parser()
     args = stored_args(p.parse_args(argv), p, argv)
     scene = _scene_of(args.scene, args.set, args.resume)
+    try:
+        return _run_scene(scene, args)
+    except InputError as e:     # found once the scene is built: say which file it is about
+        file = f"{Path(args.scene or 'scene.toml').name}: "
+        if str(e).startswith((file, "--")):
+            raise
+        raise InputError(file + str(e)) from None
+
+
+def _run_scene(scene: Scene, args) -> int:
     name = f"scene {Path(args.scene).stem}" if args.scene else "scene"
     if scene.kind == "plate":
         from ..cases._plate import run_plate_case
@@ -146,6 +156,7 @@ def _spec(scene: Scene, flags: dict, resume) -> RunSpec:
         else scene.problem.mass
     probes = [float(x) for x in np.atleast_1d(scene.output.get("probes", []))] + \
         [x for x in given if x not in scene.output.get("probes", [])]
+    _probes_on_beam(scene, flags, given)
     config = {"command": "python -m skfem_beam run", "scene_text": scene.text,
               "scene_files": scene.files, **flags, "dt": stepping.dt, "beta": scene.beta,
               "method": methods.summary_word(law),
@@ -157,6 +168,19 @@ def _spec(scene: Scene, flags: dict, resume) -> RunSpec:
     except InputError as e:
         raise InputError(f"{Path(flags['scene'] or 'scene.toml').name}: {e}") from None
     return RunSpec(stepping, scene.method, options, config, mass, tuple(probes), worn)
+
+
+def _probes_on_beam(scene: Scene, flags: dict, given) -> None:
+    """A probe off the beam, named as the user gave it: ``[output] probes[i]`` of the
+    file or ``--probe X`` (the system's own check names neither)."""
+    if scene.kind != "beam":
+        return
+    L = scene.problem.beam.L
+    named = [(f"{Path(flags['scene'] or 'scene.toml').name}: [output] probes[{i}] = {x!r}", x)
+             for i, x in enumerate(scene.output.get("probes", []))]
+    for text, x in named + [(f"--probe {x:g}", x) for x in given]:
+        if not 0.0 <= x <= L:
+            raise InputError(f"{text}: outside the beam [0, L = {L:.10g}] m")
 
 
 def _plate_spec(scene, flags: dict, resume) -> RunSpec:

@@ -21,7 +21,7 @@ PLAUSIBLE = {"E": (1e6, 1.2e12, "Pa"), "rho": (10.0, 23000.0, "kg/m³")}
 def material_of(d: dict, where: str, plausible: bool = True) -> Material:
     """[material] E, rho; a beam's outside PLAUSIBLE warns (a bar's may be the papers'
     dimensionless a = ρ = 1)."""
-    material = Material(**need(d, ("E", "rho"), where))
+    material = in_section(where, Material, **need(d, ("E", "rho"), where))
     if plausible:
         warn_implausible(d, where)
     return material
@@ -37,6 +37,15 @@ def warn_implausible(d: dict, where: str) -> None:
                  f"({low:g}–{high:g} {unit}): is it in {unit}?")
 
 
+def in_section(where: str, make, **values):
+    """``make(**values)``, its error line naming the section (``[segments.1.material]
+    E=0 must be > 0``: the line named only ``E``, whichever segment it was)."""
+    try:
+        return make(**values)
+    except InputError as e:
+        raise InputError(f"[{where}] {e}") from None
+
+
 def section_of(d: dict, where: str) -> Section:
     """A [section]: I and A, I_y, I_z and A (two planes: v along y bends with I_z, w
     along z with I_y), tube, rod or rect."""
@@ -49,14 +58,13 @@ def section_of(d: dict, where: str) -> Section:
         if "I" in d:
             raise InputError(f"[{where}] give I (one plane) or I_y and I_z, not both")
         axes = need(d, ("I_y", "I_z", "A"), where)
-        return Section(axes["I_z"], axes["A"], axes["I_y"])
-    if "tube" in d:
-        return Section.tube(**need(d["tube"], ("outer_diameter", "wall"), f"{where}.tube"))
-    if "rod" in d:
-        return Section.rod(**need(d["rod"], ("diameter",), f"{where}.rod"))
-    if "rect" in d:
-        return Section.rect(**need(d["rect"], ("b", "h"), f"{where}.rect"))
-    return Section(**need(d, ("I", "A"), where))
+        return in_section(where, Section, I=axes["I_z"], A=axes["A"], I_w=axes["I_y"])
+    for form, keys in (("tube", ("outer_diameter", "wall")), ("rod", ("diameter",)),
+                       ("rect", ("b", "h"))):
+        if form in d:
+            return in_section(f"{where}.{form}", getattr(Section, form),
+                              **need(d[form], keys, f"{where}.{form}"))
+    return in_section(where, Section, **need(d, ("I", "A"), where))
 
 
 def plane_count(data: dict) -> int:
@@ -73,8 +81,14 @@ def outer_radius(section: dict) -> float | None:
     return None if diameter is None else 0.5 * diameter
 
 
-SECTIONS = {"dt": "[time] ", "T": "[time] ", "load_window": "[time] ",
+SECTIONS = {"dt": "[time] ", "T": "[time] ", "load_window": "[time] ", "beta": "[time] ",
             "save_every": "[output] ", "frames": "[output] "}
+
+
+def named_section(e: InputError) -> InputError:
+    """An error line ``key=value ...`` of a key of SECTIONS, with its section named."""
+    message = str(e)
+    return InputError(SECTIONS.get(message.split("=")[0], "") + message)
 
 
 def stepping_of(t: dict, out: dict, **more):
@@ -83,5 +97,4 @@ def stepping_of(t: dict, out: dict, **more):
     try:
         return Stepping(t["dt"], t["T"], out["save_every"], out["frames"], **more)
     except InputError as e:
-        message = str(e)
-        raise InputError(SECTIONS.get(message.split("=")[0], "") + message) from None
+        raise named_section(e) from None

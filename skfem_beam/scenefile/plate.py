@@ -18,7 +18,7 @@ from ..errors import InputError
 from ..plate.model import EDGES, ELEMENTS, SUPPORTS, MeshPlate, Plate
 from ..scheme import Stepping
 from .forcing import _time_function
-from .parts import need, stepping_of, warn_implausible
+from .parts import named_section, need, stepping_of, warn_implausible
 from .read import Parsed, Tables
 from .schema import OUTPUT_DEFAULTS, PLATE_KEYS
 
@@ -314,10 +314,13 @@ def method_of(data: dict) -> methods.Method:
                          "take it")
     if solver != "auto":
         check_choice("[contact] solver", solver, SOLVERS)
-    return methods.make(law, solver, c.get("restitution", 0.0), c.get("stiffness"),
-                        words=PLATE_WORDS,
-                        params={**PLATE_KEYS["contact"].method_params(c),
-                                "beta": data.get("time", {}).get("beta")})
+    try:
+        return methods.make(law, solver, c.get("restitution", 0.0), c.get("stiffness"),
+                            words=PLATE_WORDS,
+                            params={**PLATE_KEYS["contact"].method_params(c),
+                                    "beta": data.get("time", {}).get("beta")})
+    except InputError as e:
+        raise named_section(e) from None
 
 
 def plate_scene(parsed: Parsed, tables: Tables, dynamic: bool = True) -> PlateScene:

@@ -18,8 +18,8 @@ V = None          # a value (checked by the object it builds)
 
 
 class Number:
-    """In a schema: a number (TOML integer or float, inf included; not a string such as
-    "0.25mm", not a boolean), checked where the file is read."""
+    """In a schema: a number (TOML integer or float, inf included; not nan, not a string
+    such as "0.25mm", not a boolean), checked where the file is read."""
 
 
 N = Number()
@@ -198,7 +198,9 @@ def key_path(path: tuple) -> str:
 
 
 def _is_number(value) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
+    """An int or float, inf included; not a boolean and not nan (which no key means:
+    ``amplitude = nan`` had run to "the initial state u0, v0 is not finite")."""
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and value == value
 
 
 SI = "in SI units (m, s, kg, N, Pa; e.g. 0.25 mm is 0.00025)"

@@ -60,7 +60,8 @@ def command_starting() -> None:
     argv = getattr(sys, "orig_argv", [])
     i = argv.index("-m") if "-m" in argv else -1
     command = " ".join(argv[i + 1:i + 3]) if i >= 0 else ""
-    if command.startswith(CHARTING):
+    helping = {"-h", "--help"} & set(argv[i + 1:]) if i >= 0 else set()
+    if command.startswith(CHARTING) and not helping:     # --help draws nothing
         from . import chart_process
         try:
             chart_process.start(CHART_MODULES)

@@ -236,3 +236,7 @@ def test_a_bad_charts_value_is_one_line_and_nothing_written(tmp_path, monkeypatc
     assert exit_code(flat_obstacles.main, [*ARGS, "--out", str(out)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and f"SKFEM_BEAM_CHARTS={value!r}" in err[0] and not out.exists()
+    for command in (["skfem_beam.cases.flat_obstacles"], ["skfem_beam", "run"]):
+        p = subprocess.run([sys.executable, "-m", *command, "--help"], capture_output=True,
+                           text=True)      # --help draws nothing: it is shown
+        assert p.returncode == 0 and p.stdout.startswith("usage:") and not p.stderr, p

@@ -113,7 +113,7 @@ DISK = example("plate_disk").read_text()
     # in the mesh's bounding box, outside the disk (its corner): no vertex, no area
     ("region = [-0.2, -0.2, 0.2, 0.2]", "region = [0.4, 0.4, 0.5, 0.5]", "no vertex"),
     ("[time]", "[[loads]]\npressure = 1e3\nregion = [0.4, 0.4, 0.5, 0.5]\n[time]",
-     "loads.0.region = [0.4, 0.4, 0.5, 0.5] holds no quadrature point"),
+     "loads.0.region = [0.4, 0.4, 0.5, 0.5] holds none of the plate"),
     ('element = "argyris"', 'element = "argyrus"', "not one of: morley, argyris"),
     ("probes = [[0.0, 0.0], [0.25, 0.0]]", "probes = [[0.0, 0.7]]", "off the plate"),
     ("probes = [[0.0, 0.0], [0.25, 0.0]]", "probes = [[0.01, 0.0]]", "not a vertex"),

@@ -24,6 +24,7 @@ from ..checks import check_bound, check_finite
 from ..errors import InputError
 from ..system import SemiDiscrete
 from .space import PlateSpace, check_space, load_vector, values_at
+from .region import cells_in, region_load
 from .static import static_deflection
 
 
@@ -44,8 +45,8 @@ def checked_region(what: str, region, space, area: bool, written=None):
     """``region`` = (x0, x1, y0, y1) (m) on the plate's bounding box, x0 ≤ x1 and y0 ≤ y1
     (``area``: both strict, a load's; else one side may be zero, a line of vertices, but
     not both: a point is ``points``), or None; else one line naming it and the order.  It
-    must hold what it acts on: a load's (``area``) a quadrature point of the mesh, where
-    the load is integrated, an obstacle's a vertex.  ``written``: the region as a scene
+    must hold what it acts on: a load's (``area``) some of the plate, an obstacle's a
+    vertex.  ``written``: the region as a scene
     file writes it, [x0, y0, x1, y1], ``what`` its key."""
     if region is None:
         return None
@@ -69,9 +70,8 @@ def checked_region(what: str, region, space, area: bool, written=None):
         raise InputError(f"{label} is off {plate.outline()}: {order}")
     region = x0, x1, y0, y1
     if area and not region_holds_plate(space, region):
-        raise InputError(f"{label} holds no quadrature point of the plate's mesh, where the "
-                         "load is integrated (off the plate, or narrower than an element: "
-                         "widen it or refine the mesh)")
+        raise InputError(f"{label} holds none of the plate (a mesh's notch or hole): a "
+                         "pressure there would load nothing")
     if not area and not region_vertices(space, region).any():
         raise InputError(f"{label} holds no vertex of the mesh")
     return region
@@ -84,10 +84,10 @@ def region_vertices(space, region) -> np.ndarray:
 
 
 def region_holds_plate(space, region) -> bool:
-    """Whether some of the plate lies in ``region`` (checked; one of its quadrature points
-    of the mesh does): a pressure there loads it."""
-    x, y = space.basis.mapping.F(space.basis.X)
-    return bool(_inside(region, x, y, 1e-9 * space.plate.size).any())
+    """Whether some of the plate lies in ``region`` (checked): some cell, whole or in
+    part (plate.region): a pressure there loads it."""
+    whole, cut = cells_in(space.basis.mesh, region, 1e-9 * space.plate.size)
+    return bool(whole.size or cut)
 
 
 @dataclass(frozen=True)
@@ -126,8 +126,8 @@ class PlateObstacle:
 @dataclass(frozen=True)
 class Pressure:
     """A pressure p(x, y)·a(t) (Pa, positive along w) over ``region`` = (x0, x1, y0, y1)
-    (None: the whole plate; a region whose sides are not grid lines is integrated at the
-    quadrature points, i.e. approximately)."""
+    (None: the whole plate; a region whose sides cut cells is integrated exactly over
+    each cell's part in it: plate.region)."""
     p: float | Callable = 0.0
     time: Callable = one
     region: tuple[float, float, float, float] | None = None
@@ -153,8 +153,12 @@ class Pressure:
         """b = ∫ p·1_region φ (N), all dofs."""
         tol = 1e-9 * space.plate.size
         region = checked_region("Pressure", self.region, space, area=True)
-        return load_vector(space, lambda x, y: values_at(self.p, x, y, "Pressure p")
-                           * _inside(region, x, y, tol))
+
+        def p(x, y):
+            return values_at(self.p, x, y, "Pressure p")
+        b = None if region is None else region_load(space.basis, p, region, tol)
+        return load_vector(space, lambda x, y: p(x, y) * _inside(region, x, y, tol)) \
+            if b is None else b
 
 
 @dataclass(frozen=True)

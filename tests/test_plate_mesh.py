@@ -285,3 +285,31 @@ def test_a_binary_mesh_file_is_stored_and_read_back_exactly(tmp_path):
     a, b = first.problem.space.plate.mesh, again.problem.space.plate.mesh
     assert np.array_equal(a.points, b.points) and np.array_equal(a.triangles, b.triangles)
     assert a.source == b.source == "bin.msh"
+
+
+def _two_disks(degenerate: bool):
+    """The 6-ring disk and, beside it, a second disk no edge names (unsupported), or (with
+    ``degenerate``) the disk with one more triangle of no area (a repeated point)."""
+    d = disk(0.5, 6)
+    if degenerate:
+        p = np.column_stack([d.points, d.points[:, :1]])
+        t = np.column_stack([d.triangles, [0, 1, p.shape[1] - 1]])
+    else:
+        p = np.column_stack([d.points, d.points + [[2.0], [0.0]]])
+        t = np.column_stack([d.triangles, d.triangles + d.points.shape[1]])
+    return type(d)(p, t, {"rim": d.boundaries["rim"]})
+
+
+@pytest.mark.parametrize("degenerate, scene, word", [
+    (True, DISK, "has no area (a repeated or collinear point"),
+    # the scene's static start of a plate whose second part nothing holds (energy_J[0] was
+    # 9e13 J, then "unstable")
+    (False, DISK, "a static deflection needs edges that hold the plate"),
+])
+def test_a_mesh_of_a_flat_triangle_or_an_unheld_part_is_refused(tmp_path, capsys, degenerate,
+                                                                 scene, word):
+    write_msh(_two_disks(degenerate), tmp_path / "two.msh")
+    scene = scene.replace("plate_disk.msh", "two.msh")
+    assert "two.msh" in scene
+    assert_scene_refused(tmp_path, capsys, {"two.msh": (tmp_path / "two.msh").read_bytes(),
+                                            "plate.toml": scene}, "plate.toml", word)

@@ -124,6 +124,9 @@ EDGES = 'left = "clamped"\nright = "clamped"\nbottom = "clamped"\ntop = "clamped
     ('element = "bfs"', 'element = "hermite"', "element"),
     ("nx = 6", "nx = 0", "nx"),
     ("probes = [[0.2, 0.6], [0.2, 0.2]]", "probes = [[0.2, 0.61]]", "probes"),
+    # one column per vertex: a second probe there was an IndexError and a folder "running"
+    ("probes = [[0.2, 0.6], [0.2, 0.2]]", "probes = [[0.2, 0.6], [0.2, 0.6000000001]]",
+     "output.probes[1] = [0.2, 0.6] is the vertex of output.probes[0]"),
     ('law = "position"', 'law = "springs"', "law"),
     ('law = "position"', 'law = "penalty"', "stiffness"),
     ("static_pressure = 1.0e5 ", "static_pressure = -1.0e5 ", "initial deflection"),
@@ -252,3 +255,18 @@ def test_bad_plate_obstacle_shape_one_line(tmp_path, capsys, g2, word):
     text = GOOD.replace("[[obstacles]]\ng1 = -1.75e-4", shaped + "[[obstacles]]\ng1 = -1.75e-4")
     assert_scene_refused(tmp_path, capsys, {"plate.toml": text}, "plate.toml",
                          word.replace("obstacles.0", "obstacles.1"))
+
+
+def test_the_largest_contact_force_counts_an_obstacle_above_the_plate(tmp_path):
+    """plate_on_stops mirrored (pressed up, released onto an obstacle above it, w ≤ g2): its
+    forces are negative, and summary.json's max_contact_force_N (a signed maximum: 0 N
+    with 69 impacts) is the largest |contact_force_N|."""
+    out = tmp_path / "run"
+    assert exit_code(run_main, [str(example("plate_on_stops")), "--T", "0.004", "--out",
+                                str(out), "--format", "none", "--set",
+                                "initial.static_pressure=-1e5", "--set",
+                                "obstacles.0.g2=1.75e-4", "--set", "obstacles.0.g1=-1"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    force = np.genfromtxt(out / "timeseries.csv", delimiter=",", names=True)["contact_force_N"]
+    assert summary["impacts"] > 0 and force.min() < -1e3 and force.max() <= 0.0
+    assert summary["max_contact_force_N"] == np.abs(force).max()

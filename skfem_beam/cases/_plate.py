@@ -95,7 +95,9 @@ def plate_charts(case: str, system, setup):
             if r.frames_force.size else None
         draw(deflection_chart, folder / "deflection.png", points, cells, w,
              title=f"{case}: w at t = {r.frames_t[k]:.4g} s\n({about})", held=held)
-        return {"max_contact_force_N": float(np.max(data["contact_force_N"], initial=0.0)),
+        # the largest magnitude of the total force (g2 pushes down: a signed max read 0 N)
+        return {"max_contact_force_N": float(np.max(np.abs(data["contact_force_N"]),
+                                                    initial=0.0)),
                 "max_contact_area_fraction":
                     float(np.max(data["contact_area_fraction"], initial=0.0))}
     return finish

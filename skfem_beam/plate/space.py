@@ -49,7 +49,11 @@ def rectangle_mesh(plate: Plate):
 def file_mesh(plate: MeshPlate) -> MeshTri:
     """The triangles of a mesh file's plate, with its named boundaries (facet indices)."""
     m = plate.mesh
-    mesh = MeshTri(np.asarray(m.points, dtype=float), np.asarray(m.triangles, dtype=np.int64))
+    # C order: skfem transposes a Fortran-ordered one itself, saying so on stderr
+    points = np.ascontiguousarray(m.points, dtype=float)
+    triangles = np.ascontiguousarray(m.triangles, dtype=np.int64)
+    _check_areas(points, triangles, m.source)
+    mesh = MeshTri(points, triangles)
     n = mesh.p.shape[1]
     key = mesh.facets[0] * n + mesh.facets[1]          # skfem's facets: sorted pairs
     order = np.argsort(key)
@@ -64,6 +68,21 @@ def file_mesh(plate: MeshPlate) -> MeshTri:
                              f"boundary {name!r} are not edges of its triangles")
         named[name] = np.unique(order[at])
     return mesh.with_boundaries(named)
+
+
+def _check_areas(points, triangles, source: str) -> None:
+    """Refuse a triangle of no area (a repeated or collinear point): its element's
+    matrices are singular, and numpy raised LinAlgError from inside skfem."""
+    a, b, c = (points[:, triangles[i]] for i in range(3))
+    twice = np.abs((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
+    size = np.ptp(points, axis=1).max() if points.size else 0.0
+    flat = np.flatnonzero(twice <= 1e-12 * size * size)
+    if flat.size:
+        k = int(flat[0])
+        raise InputError(f"the mesh {source}: triangle {k} (vertices "
+                         f"{', '.join(str(int(v)) for v in triangles[:, k])}) has no area (a "
+                         f"repeated or collinear point; {flat.size} such triangle(s)): a "
+                         "plate's triangles need area")
 
 
 def plate_mesh(plate):

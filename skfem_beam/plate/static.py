@@ -32,12 +32,33 @@ def static_deflection(space: PlateSpace, f: np.ndarray) -> np.ndarray:
 
 def rigid_motions(space: PlateSpace) -> int:
     """How many independent rigid motions w = a + bx + cy the supports leave the plate
-    (0: K is positive definite on the free dofs): the rank that the fixed dofs' values of
-    1, x/L and y/L (:func:`rigid_dofs`) leave out of 3."""
-    if space.fixed_dofs.size == 0:
-        return 3
-    s = np.linalg.svd(rigid_dofs(space)[space.fixed_dofs], compute_uv=False)
-    return 3 - int(np.sum(s > 1e-9 * s[0]))
+    (0: K is positive definite on the free dofs): for each part of the mesh (cells joined
+    by a vertex; a mesh file may hold two plates, one of them unsupported), the rank that
+    its fixed dofs' values of 1, x/L and y/L (:func:`rigid_dofs`) leave out of 3."""
+    R, part = rigid_dofs(space), dof_parts(space)
+    fixed = np.zeros(space.basis.N, dtype=bool)
+    fixed[space.fixed_dofs] = True
+    free = 0
+    for p in range(part.max() + 1):
+        held = R[fixed & (part == p)]
+        s = np.linalg.svd(held, compute_uv=False) if held.size else np.zeros(1)
+        free += 3 - (int(np.sum(s > 1e-9 * s[0])) if s[0] > 0 else 0)
+    return free
+
+
+def dof_parts(space: PlateSpace) -> np.ndarray:
+    """Each dof's part of the mesh (0, 1, ...: the connected components of its cells,
+    joined by their vertices)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    t = space.basis.mesh.t
+    nv, nc = space.basis.mesh.p.shape[1], t.shape[1]
+    cells = coo_matrix((np.ones(t.size), (np.repeat(np.arange(nc), t.shape[0]),
+                                          t.T.ravel())), shape=(nc, nv)).tocsr()
+    _, cell_part = connected_components(cells @ cells.T, directed=False)
+    part = np.zeros(space.basis.N, dtype=np.int64)
+    part[space.basis.element_dofs] = cell_part[None, :]
+    return part
 
 
 def rigid_dofs(space: PlateSpace) -> np.ndarray:

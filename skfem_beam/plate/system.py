@@ -283,9 +283,14 @@ def _observers(space, points, position) -> dict[str, np.ndarray]:
         x, y = space.vertices
         c = int(np.argmin(np.hypot(x - space.plate.centre[0], y - space.plate.centre[1])))
         points = [(float(x[c]), float(y[c]))]
-    rows = {}
-    for px, py in points:
-        j = position[space.w_dofs[vertex_index(space, px, py)]]
+    rows, seen = {}, {}
+    for k, (px, py) in enumerate(points):
+        vertex = vertex_index(space, px, py)
+        first = seen.setdefault(vertex, k)
+        if first != k:                      # one row per name: a second one crashed a run
+            raise InputError(f"plate_system observe[{k}] = ({px:g}, {py:g}) is the vertex of "
+                             f"observe[{first}]: give each vertex once")
+        j = position[space.w_dofs[vertex]]
         row = np.zeros(space.free_dofs.size)
         if j >= 0:                          # a held vertex reads 0
             row[j] = 1.0

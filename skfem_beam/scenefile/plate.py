@@ -289,8 +289,13 @@ def probes_of(data: dict, space) -> tuple:
         c = int(np.argmin(np.hypot(x - space.plate.centre[0], y - space.plate.centre[1])))
         return ((float(x[c]), float(y[c])),)
     points = tuple(_point(p, space.plate, f"output.probes[{k}]") for k, p in enumerate(given))
+    seen = {}
     for k, (x, y) in enumerate(points):
         _vertex(space, x, y, f"output.probes[{k}]", vertex_index)
+        first = seen.setdefault(vertex_index(space, x, y), k)
+        if first != k:         # one column per vertex: a second one crashed the run
+            raise InputError(f"output.probes[{k}] = [{x:g}, {y:g}] is the vertex of "
+                             f"output.probes[{first}]: give each vertex once")
     return points
 
 

@@ -872,7 +872,7 @@ def test_a_hole_radius_like_the_hole_s_own_warns(tmp_path, capsys):
     (["--set", "time.dt=-1e-5"], "error: scene.toml: [time] dt=-1e-05 must be > 0"),
     (["--set", "output.frames=0"], "error: scene.toml: [output] frames=0 must be a whole "
                                    "number ≥ 1"),
-    (["--T", "1e-6"], "error: --T 1e-06: dt=5e-05 must be at most T/2=5e-07"),
+    (["--T", "1e-6"], "error: --T 1e-06: dt=5e-05 must be less than T=1e-06"),
 ])
 def test_a_bad_time_grid_names_its_key_or_flag(tmp_path, capsys, argv, line):
     out = tmp_path / "out"
@@ -1075,3 +1075,14 @@ def test_a_refusal_found_after_the_file_is_read_names_the_file_and_key(tmp_path,
     out = tmp_path / "out"
     out.mkdir()
     assert_refused(run_main, [str(src), "--out", str(out / "run"), *args], line, capsys, out)
+
+
+def test_dt_is_checked_against_the_t_that_runs(tmp_path):
+    """--T overrides [time] T before Δt is checked: Δt = 0.01 s is refused against the
+    file's T = 0.01 s and runs its 10 steps under --T 0.1 (it was checked against the
+    file's T while --set time.T=0.1 ran)."""
+    scene, out = example("plate_on_stops"), tmp_path / "run"
+    argv = [str(scene), "--set", "time.dt=0.01", "--format", "none", "--out", str(out)]
+    assert exit_code(run_main, argv) == 2
+    assert exit_code(run_main, argv + ["--T", "0.1"]) == 0
+    assert json.loads((out / "summary.json").read_text())["steps"] == 10

@@ -47,7 +47,7 @@ def run_main(argv) -> int:
     from ..cli import stored_args
     p = _run_parser()
     args = stored_args(p.parse_args(argv), p, argv)
-    scene = _scene_of(args.scene, args.set, args.resume)
+    scene = _scene_of(args.scene, args.set, args.resume, args.T)
     try:
         return _run_scene(scene, args)
     except InputError as e:     # found once the scene is built: say which file it is about
@@ -71,8 +71,9 @@ def _run_scene(scene: Scene, args) -> int:
     return run_beam_case(name, scene.problem, spec, stops=_chart_stops(scene.problem))
 
 
-def _scene_of(path, sets, resume) -> Scene:
-    """The scene file (or, resuming, the text the run stored) with the --set overrides."""
+def _scene_of(path, sets, resume, T=None) -> Scene:
+    """The scene file (or, resuming, the text the run stored) with the --set overrides
+    and (a new run) --T as its [time] T, so that Δt is checked against the T that runs."""
     from ..output.checkpoint import read_summary
     stored, summary = {}, {}
     if resume:
@@ -84,7 +85,13 @@ def _scene_of(path, sets, resume) -> Scene:
                   "meshes": config.get("scene_meshes", {})}
     elif path is None:
         raise InputError("run needs a scene file: python -m skfem_beam run SCENE.toml")
-    scene = load(path or "scene.toml", sets or (), **stored)
+    overrides = list(sets or ()) + ([f"time.T={T!r}"] if T is not None and not resume else [])
+    try:
+        scene = load(path or "scene.toml", overrides, **stored)
+    except InputError as e:     # T, or Δt against it: named as the flag
+        if T is None or resume or not ("[time] dt=" in str(e) or "[time] T=" in str(e)):
+            raise
+        raise InputError(f"--T {T:g}: {str(e).split('[time] ', 1)[1]}") from None
     if resume and scene.kind == "plate":
         _same_mesh(scene, summary, resume)
         for name in scene.meshes:       # read from the scene's folder: no stored copy
@@ -138,7 +145,7 @@ def _grid(scene, flags: dict, resume) -> tuple[OutputOptions, object]:
                                 frames=options.frames)
     except InputError as e:       # a flag's value (the file's own were checked at load)
         key = str(e).split("=")[0].strip()
-        flag = "T" if key in ("T", "dt", "T/dt") else key    # dt: "must be at most T/2"
+        flag = "T" if key in ("T", "dt", "T/dt") else key    # dt: "must be less than T"
         if not isinstance(flags.get(flag), (int, float)):
             raise
         raise InputError(f"--{flag.replace('_', '-')} {flags[flag]:g}: {e}") from None

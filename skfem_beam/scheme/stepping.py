@@ -47,7 +47,8 @@ class Stepping:
         check_choice("load_window", self.load_window, LOAD_WINDOWS)
         check_choice("massless", self.massless, MASSLESS)
         if self.steps < 2:
-            raise InputError(f"dt={dt:g} must be at most T/2={T / 2:g}")
+            raise InputError(f"dt={dt:g} must be less than T={T:g}: a run computes "
+                             "⌈T/dt⌉ ≥ 2 steps")
         if self.steps > MAX_STEPS:
             raise InputError(f"T/dt = {self.steps:.3g} steps is more than {MAX_STEPS:.0e}: "
                              "raise dt or shorten T")

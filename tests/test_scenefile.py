@@ -943,6 +943,11 @@ def test_the_bar_refuses_keys_it_ignored(tmp_path, capsys, setting, word):
      "[loads.0] amplitude and omega go together"),
     ("point_stops.toml", "motion={end=\"left\",omega=10.0}",
      "[motion] amplitude and omega go together"),
+    # a phase without its sine, ignored silently
+    ("flat_obstacles.toml", "loads=[{per_mass=true,phase=1.5}]",
+     "[loads.0] phase belongs to amplitude · sin(omega t + phase): give amplitude and omega"),
+    ("flat_obstacles.toml", "loads=[{per_mass=true,value=1.0,phase=1.5}]",
+     "[loads.0] phase belongs to amplitude · sin(omega t + phase): not to value"),
 ])
 def test_malformed_values_are_one_line(tmp_path, capsys, scene, setting, word):
     assert_refused(run_main, [str(example(scene)), "--set", setting, "--out",

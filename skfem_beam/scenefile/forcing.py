@@ -21,6 +21,10 @@ def _time_function(d: dict, where: str, reader: Tables):
     if len(forms) > 1:
         raise InputError(f"[{where}] give one of amplitude/omega, value, sines, table, "
                          f"random, psd (got {', '.join(forms)})")
+    if "phase" in d and (not forms or forms[0] != "amplitude"):   # it was ignored
+        other = f"not to {forms[0]}" if forms else "give amplitude and omega with it"
+        raise InputError(f"[{where}] phase belongs to amplitude · sin(omega t + phase): "
+                         f"{other}")
     if not forms:
         return None
     form = forms[0]

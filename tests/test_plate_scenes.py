@@ -270,3 +270,20 @@ def test_the_largest_contact_force_counts_an_obstacle_above_the_plate(tmp_path):
     force = np.genfromtxt(out / "timeseries.csv", delimiter=",", names=True)["contact_force_N"]
     assert summary["impacts"] > 0 and force.min() < -1e3 and force.max() <= 0.0
     assert summary["max_contact_force_N"] == np.abs(force).max()
+
+
+@pytest.mark.parametrize("sets, n, line", [
+    (["mesh.nx=1", "mesh.ny=1"], "1", "plate_on_stops.toml: the plate has no free dofs"),
+    (["mesh.nx=2", "mesh.ny=2"], "5", "plate_on_stops.toml: n=5 must be a whole number in "
+                                      "[1, 4] (the plate has 4 free dofs)"),
+])
+def test_modes_of_a_plate_with_few_free_dofs_say_what_is_allowed(capsys, sets, n, line):
+    """(they printed [1, -1] and [1, 0]; a dense solve gives all the free dofs' modes)"""
+    from skfem_beam.scenefile import modes_main
+    argv = [str(example("plate_on_stops")), "--n", n] + [a for s in sets for a in ("--set", s)]
+    assert exit_code(modes_main, argv) == 2
+    assert line in capsys.readouterr().err
+    argv[2] = "4"
+    if sets[0] == "mesh.nx=2":       # all four
+        assert exit_code(modes_main, argv) == 0
+        assert len(capsys.readouterr().out.strip().splitlines()) == 5

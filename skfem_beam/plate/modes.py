@@ -14,9 +14,13 @@ def natural_frequencies(space: PlateSpace, n: int = 6) -> tuple[np.ndarray, np.n
     (all dofs, one column each, M-normalised)."""
     check_space(space, "natural_frequencies")
     free = space.free_dofs
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 1 <= n < len(free):
-        raise InputError(f"n={n!r} must be a whole number in [1, {len(free) - 1}] (the "
-                         f"plate has {len(free)} free dofs)")
+    if not len(free):
+        raise InputError("the plate has no free dofs (its edges hold them all): it has no "
+                         "modes; free an edge or refine the mesh")
+    most = len(free) if len(free) <= DENSE_UP_TO else len(free) - 1   # eigsh: k < n
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 1 <= n <= most:
+        raise InputError(f"n={n!r} must be a whole number in [1, {most}] (the plate has "
+                         f"{len(free)} free dofs)")
     K = space.K[free][:, free]
     M = space.M[free][:, free]
     if len(free) <= DENSE_UP_TO:
@@ -24,7 +28,7 @@ def natural_frequencies(space: PlateSpace, n: int = 6) -> tuple[np.ndarray, np.n
     else:
         # shift-invert about 0 finds the eigenvalues nearest 0: the lowest ones
         omega2, phi = eigsh(K.tocsc(), k=n, M=M.tocsc(), sigma=0.0, which="LM")
-    order = np.argsort(omega2)
+    order = np.argsort(np.abs(omega2))      # rigid modes' ω² ≈ ±1e-9: by the ω printed
     shapes = np.zeros((space.basis.N, n))
     shapes[free] = phi[:, order]
     return np.sqrt(np.abs(omega2[order])), shapes

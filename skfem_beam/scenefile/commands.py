@@ -51,10 +51,13 @@ def run_main(argv) -> int:
     try:
         return _run_scene(scene, args)
     except InputError as e:     # found once the scene is built: say which file it is about
-        file = f"{Path(args.scene or 'scene.toml').name}: "
-        if str(e).startswith((file, "--")):
-            raise
-        raise InputError(file + str(e)) from None
+        raise about_file(e, args.scene) from None
+
+
+def about_file(e: InputError, scene) -> InputError:
+    """``e``'s line naming the scene file, unless it names it or a flag already."""
+    file = f"{Path(scene or 'scene.toml').name}: "
+    return e if str(e).startswith((file, "--")) else InputError(file + str(e))
 
 
 def _run_scene(scene: Scene, args) -> int:
@@ -233,7 +236,10 @@ def modes_main(argv) -> int:
     args = _modes_parser().parse_args(argv)
     scene = load(args.scene, args.set or (), dynamic=False)
     if scene.kind == "plate":
-        return _plate_modes(scene, args)
+        try:
+            return _plate_modes(scene, args)
+        except InputError as e:     # the plate's own check: say which file it is about
+            raise about_file(e, args.scene) from None
     if scene.kind != "beam":
         raise InputError(f"modes: {args.scene} is a {scene.kind}; modes are computed for "
                          "beams")

@@ -943,6 +943,9 @@ def test_the_bar_refuses_keys_it_ignored(tmp_path, capsys, setting, word):
      "[loads.0] amplitude and omega go together"),
     ("point_stops.toml", "motion={end=\"left\",omega=10.0}",
      "[motion] amplitude and omega go together"),
+    # the time function's own refusal, named by its table (it named no key)
+    ("tube_round_holes.toml", "loads.0.random={rms=1.0,f_low=100.0,f_high=10.0}",
+     "tube_round_holes.toml: [loads.0] f_high=10 must exceed f_low=100"),
     # a phase without its sine, ignored silently
     ("flat_obstacles.toml", "loads=[{per_mass=true,phase=1.5}]",
      "[loads.0] phase belongs to amplitude · sin(omega t + phase): give amplitude and omega"),

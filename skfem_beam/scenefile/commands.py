@@ -15,6 +15,7 @@ from ..output.options import OutputOptions
 from ..problem import BeamProblem
 from ..spec import RunSpec
 from .build import Scene, load, wear
+from .parts import named_section
 from .read import scene_path
 
 
@@ -57,7 +58,7 @@ def run_main(argv) -> int:
 def about_file(e: InputError, scene) -> InputError:
     """``e``'s line naming the scene file, unless it names it or a flag already."""
     file = f"{Path(scene or 'scene.toml').name}: "
-    return e if str(e).startswith((file, "--")) else InputError(file + str(e))
+    return e if str(e).startswith((file, "--")) else InputError(file + str(named_section(e)))
 
 
 def _run_scene(scene: Scene, args) -> int:

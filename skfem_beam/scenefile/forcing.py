@@ -14,7 +14,15 @@ from .read import Tables
 
 
 def _time_function(d: dict, where: str, reader: Tables):
-    """A time function from the keys of TIME (one form), or None when none is given."""
+    """A time function from the keys of TIME (one form), or None when none is given; its
+    object's refusals name the table (``[loads.1] f_high=10 must exceed f_low=100``)."""
+    try:
+        return _time_form(d, where, reader)
+    except InputError as e:
+        raise e if str(e).startswith("[") else InputError(f"[{where}] {e}") from None
+
+
+def _time_form(d: dict, where: str, reader: Tables):
     forms = [k for k in ("amplitude", "value", "sines", "table", "random", "psd") if k in d]
     if "omega" in d and "amplitude" not in d:
         forms.append("omega")

@@ -82,7 +82,7 @@ def outer_radius(section: dict) -> float | None:
 
 
 SECTIONS = {"dt": "[time] ", "T": "[time] ", "load_window": "[time] ", "beta": "[time] ",
-            "save_every": "[output] ", "frames": "[output] "}
+            "save_every": "[output] ", "frames": "[output] ", "solver": "[contact] "}
 
 
 def named_section(e: InputError) -> InputError:

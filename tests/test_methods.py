@@ -172,3 +172,18 @@ def test_theta_reaches_moreau_jean_from_the_command_line_and_a_scene_file(tmp_pa
                            capture_output=True, text=True)
         assert p.returncode == 2 and p.stderr.count("\n") == 1 and word in p.stderr, p.stderr
         assert not (tmp_path / "bad").exists()
+
+
+def test_a_penalty_in_newtons_per_metre_needs_the_beams_mass_per_length():
+    """A beam known by k² alone has no ρS to divide N/m by: Penalty(1e8) was taken per unit
+    mass silently (8.4× softer on the pipe); it is one line, and equation_units=True runs."""
+    import pytest
+    from skfem_beam import Beam, BeamProblem, InputError, Obstacles, beam_system, solve
+    from skfem_beam.methods import Penalty
+    problem = BeamProblem(Beam(1.501, k2=282.84), Obstacles.point_stops(1.501, -0.1, 0.1),
+                          J=10)
+    with pytest.raises(InputError, match=r"Penalty stiffness=100000000.0 is in N/m, which "
+                                         r"needs the beam's mass per length ρS"):
+        solve(beam_system(problem), 1e-4, 0.01, method=Penalty(1e8), progress=False)
+    assert solve(beam_system(problem), 1e-4, 0.01, progress=False,
+                 method=Penalty(1e8, equation_units=True)).success

@@ -143,7 +143,8 @@ def class_rows(N: int = 80, settings=SETTINGS, courants=COURANTS):
 def class_line(r: dict) -> str:
     cells = [f"{100 * r[key] if key == 'energy_drift' else r[key]:{fmt}}"
              for _, key, fmt in COLUMNS]
-    return f"{r['method']:34s} {r['courant']:5g} " + " ".join(cells)
+    status = "" if r["status"] == "success" else f"  {r['status']}: no error measured"
+    return f"{r['method']:34s} {r['courant']:5g} " + " ".join(cells) + status
 
 
 def class_header() -> str:

@@ -128,6 +128,14 @@ class Penalty:
         object.__setattr__(self, "beta", _beta(self))
 
     def law(self, system) -> ContactLaw:
+        view = None if system is None else system.view
+        if not self.equation_units and view is not None and view.kind == "beam" \
+                and not view.rho_S:     # N/m of a beam known by k² alone: it was taken
+            raise InputError(          # per unit mass, silently (8.4× softer, measured)
+                f"Penalty stiffness={self.stiffness} is in N/m, which needs the beam's mass "
+                "per length ρS (this beam gives k² only): give it rho_S (Beam(L, k2, "
+                "rho_S) or Beam.physical), or the stiffness per unit mass with "
+                "equation_units=True")
         scale = 1.0 if self.equation_units or system is None else mass_scale(system)
         k, c = np.asarray(self.stiffness), np.asarray(self.damping)
         problem = None if system is None else system.meta.get("problem")

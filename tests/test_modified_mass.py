@@ -215,3 +215,24 @@ def test_quasi_static_quarter_can_gain_energy_on_the_chattering_pipe(beta, dt, g
         assert r.energy[-1] == pytest.approx(36.5, rel=0.01)    # chaotic: a loose pin
     else:
         assert r.work["contact"][-1] < 0.0 and r.energy[-1] < 3 * r.energy[0]
+
+
+def test_a_case_reports_the_limit_of_the_dofs_with_mass(tmp_path, capsys):
+    """point_stops --mass redistributed: the warning and summary.json named the limit of the
+    beam before its mass was redistributed (1.265e-5 s), while the run's own was 1.485e-5
+    s; both are now the run's, and Δt = 1.4e-5 is not warned."""
+    import json
+    from skfem_beam.cases import point_stops
+    from skfem_beam.stability import kappa_h, linear_limit
+    from skfem_beam.spaces.redistribution import redistributed
+    from skfem_beam.semidiscrete import beam_system
+    args = ["--mass", "redistributed", "--massless", "quasi-static", "--beta", "0.01",
+            "--T", "0.01", "--format", "none"]
+    limit = linear_limit(kappa_h(redistributed(beam_system(scenes.point_stops()))), 0.01)
+    assert limit == pytest.approx(1.485e-5, rel=1e-3)
+    for dt, warned in (("1.4e-5", False), ("1.5e-5", True)):
+        out = tmp_path / dt
+        assert point_stops.main(args + ["--dt", dt, "--out", str(out)]) == 0
+        summary = json.loads((out / "summary.json").read_text())
+        assert summary["linear_stability_limit_dt"] == pytest.approx(limit, rel=1e-12)
+        assert ("above the linear stability limit" in capsys.readouterr().err) == warned

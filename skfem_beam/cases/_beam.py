@@ -32,11 +32,11 @@ def run_beam_case(case: str, problem, spec: RunSpec, stops=(), extra=None) -> in
     prepare(spec.options)                         # fail before the run, not after it
     system = beam_system(problem)
     add_probes(system, list(spec.probes))
+    if spec.mass == "redistributed":    # before the limit: κ_h of the dofs with mass
+        system = redistributed(system)
     # Moreau–Jean (θ ≥ ½) has no β and no limit: a scene file's [time] beta is not its
     kh, limit = stability_warning(system, spec.stepping.dt,
                                   0.5 if isinstance(spec.method, MoreauJean) else spec.beta)
-    if spec.mass == "redistributed":
-        system = redistributed(system)
     run = spec.method.build(system, spec.stepping)
     rho_S = problem.beam.rho_S
     penalty = isinstance(spec.method, Penalty)

@@ -236,3 +236,17 @@ def test_a_case_reports_the_limit_of_the_dofs_with_mass(tmp_path, capsys):
         summary = json.loads((out / "summary.json").read_text())
         assert summary["linear_stability_limit_dt"] == pytest.approx(limit, rel=1e-12)
         assert ("above the linear stability limit" in capsys.readouterr().err) == warned
+
+
+@pytest.mark.parametrize("args, word", [
+    (["--mass", "redistributed", "--beta", "0.2"], "error: beta=0.2 with a mass matrix that"),
+    (["--mass", "redistributed", "--massless", "quasi-static", "--beta", "0"],
+     "error: beta=0 with massless='quasi-static'"),
+])
+def test_a_refused_method_is_one_line_without_the_limits_warning(tmp_path, capsys, args,
+                                                                  word):
+    """The stability warning came first: two lines on stderr for one refusal."""
+    from conftest import assert_refused
+    from skfem_beam.cases import point_stops
+    assert_refused(point_stops.main, args + ["--T", "0.01", "--out", str(tmp_path / "run")],
+                   word, capsys, tmp_path)

@@ -34,10 +34,10 @@ def run_beam_case(case: str, problem, spec: RunSpec, stops=(), extra=None) -> in
     add_probes(system, list(spec.probes))
     if spec.mass == "redistributed":    # before the limit: κ_h of the dofs with mass
         system = redistributed(system)
+    run = spec.method.build(system, spec.stepping)      # its refusals before any warning
     # Moreau–Jean (θ ≥ ½) has no β and no limit: a scene file's [time] beta is not its
     kh, limit = stability_warning(system, spec.stepping.dt,
                                   0.5 if isinstance(spec.method, MoreauJean) else spec.beta)
-    run = spec.method.build(system, spec.stepping)
     rho_S = problem.beam.rho_S
     penalty = isinstance(spec.method, Penalty)
     summary = {

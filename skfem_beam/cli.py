@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
+import os
 import shlex
 import signal
 import sys
@@ -220,6 +221,9 @@ def main_guard(main) -> None:
     except (InputError, SolverError) as e:
         print(f"error: {e}", file=sys.stderr)
         code = EXIT_INPUT if isinstance(e, InputError) else EXIT_SOLVER
+    except BrokenPipeError:     # stdout's reader went away (| head): nothing to say there,
+        _quiet_stdout()         # and the folder's summary.json says how the run ended
+        code = EXIT_PIPE
     except OSError as e:   # disk full, folder removed under us, ...
         print(f"error: could not write the results: {e}", file=sys.stderr)
         code = EXIT_SOLVER
@@ -235,6 +239,17 @@ def main_guard(main) -> None:
         for sig, handler in old.items():
             signal.signal(sig, handler)
     _startup.end(code)
+
+
+EXIT_PIPE = 128 + signal.SIGPIPE      # a closed pipe's code (a shell's, for `yes | head`)
+
+
+def _quiet_stdout() -> None:
+    """stdout onto /dev/null: the exit flushes it, and would raise again."""
+    try:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
 
 
 def warn(message: str) -> None:

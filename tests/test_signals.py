@@ -110,3 +110,16 @@ def test_the_kept_rows_line_reads_the_last_rows_time(tmp_path):
                         fields=None, folder=SimpleNamespace(path=tmp_path))
     assert "kept 42001 whole rows of timeseries.csv (to t=8.4 s)" in _Stream.what_is_kept(s)
     rows.close()
+
+
+def test_a_closed_stdout_ends_a_finished_run_silently_with_the_pipes_code(tmp_path):
+    """`| true`: the run's end line met a closed pipe, and the command said "could not write
+    the results" with code 3 over a folder whose summary.json said success."""
+    out = tmp_path / "run"
+    p = subprocess.Popen([sys.executable, "-m", "skfem_beam.cases.point_stops", "--T", "0.05",
+                          "--format", "none", "--out", str(out)], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True)
+    p.stdout.close()                # the reader has gone before the first line
+    err = p.stderr.read()
+    assert p.wait(timeout=120) == 128 + signal.SIGPIPE and err == "", err
+    assert json.loads((out / "summary.json").read_text())["status"] == "success"

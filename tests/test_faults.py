@@ -419,6 +419,8 @@ def test_full_disk_keeps_whole_rows_and_resumes_once_there_is_room(small_disk, t
     assert exit_code(point_stops.main, argv + ["--out", str(ref)]) == 0
     kept, full = whole_rows(out), whole_rows(ref)
     assert 1000 < len(kept) < len(full) and kept == full[:len(kept)]
+    # the line names the kept rows' last time (it named the refused chunk's)
+    assert f"kept {len(kept) - 1} whole rows of timeseries.csv (to t={float(kept[-1].split(',')[0]):.6g} s)" in err[0]
     assert int(checkpoint(out)["rows"]) <= len(kept) - 1
     subprocess.run(["mount", "-o", "remount,size=16m", str(small_disk)], check=True)
     assert exit_code(point_stops.main, ["--resume", str(out)]) == 0

@@ -86,7 +86,7 @@ class SeriesFile:
     row held, for a command whose analysis needs them all (else KEEP_ROWS rows, then the
     envelope).
     """
-    last_t = None       # the time of the last row appended by this process
+    last_t = None       # the time of the last row this process wrote whole
 
     def __init__(self, path: Path, names: list[str], keep: dict | None = None,
                  whole: bool = False):
@@ -147,8 +147,6 @@ class SeriesFile:
     def append(self, columns: dict) -> None:
         """Rows to write (copied: the run's buffers move on); written in the background."""
         cols = {k: np.array(columns[k], dtype=float) for k in self.names}
-        if "t" in cols and cols["t"].size:
-            self.last_t = float(cols["t"][-1])      # the last row's time, as written
         self._chunks.append(cols)
         self._held += len(cols[self.names[0]])
         if self.limit is not None and self._held > self.limit:
@@ -158,8 +156,10 @@ class SeriesFile:
 
     def _write_rows(self, cols: dict) -> None:
         text = csv_rows(cols, self.names)
-        self._write(text.encode())
+        self._write(text.encode())      # a full disk: cut back to the last whole chunk
         self.rows += text.count("\n")
+        if "t" in cols and cols["t"].size:    # after the write: a refused chunk is not kept
+            self.last_t = float(cols["t"][-1])
         os.fsync(self.fd)
 
     def _wait(self) -> None:

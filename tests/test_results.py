@@ -341,3 +341,11 @@ def test_study_commands_refuse_bad_flags_in_one_line(tmp_path, module, argv, wor
     p = subprocess.run([sys.executable, "-m", module, *argv], capture_output=True, text=True,
                        timeout=120)
     assert p.returncode == 2 and p.stderr.count("\n") == 1 and word in p.stderr, p.stderr
+
+
+def test_the_speed_benchmark_checks_its_out_before_it_measures(tmp_path, capsys):
+    """It wrote --out after minutes of measuring: a folder failed there ("Is a directory")
+    and the run was lost.  A file in a missing folder is refused at once."""
+    from skfem_beam.bench import speed
+    assert exit_code(speed.main, ["--quick", "--out", str(tmp_path / "no" / "s.json")]) == 2
+    assert "is not a writable folder" in capsys.readouterr().err

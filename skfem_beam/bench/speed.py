@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import resource
 import subprocess
 import sys
@@ -18,6 +19,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from ..errors import InputError
 from ..parser import Parser, count
 
 # (label, scene, parameters, target seconds for the time loop or None)
@@ -188,13 +190,19 @@ def main(argv=None) -> int:
     ap.add_argument("--repeat", type=count, default=5,
                     help="time loops per configuration; the best counts (this VM's speed "
                          "drifts by ±30%% over seconds)")
-    ap.add_argument("--out", default="speed.json")
+    ap.add_argument("--out", default="speed.json",
+                    help="the JSON file written (a folder: speed.json in it), checked first")
     ap.add_argument("--child", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.child:
         scene, p, solver, repeat = json.loads(args.child)
         print(json.dumps(child(scene, p, solver, repeat)))
         return 0
+    if os.path.isdir(args.out):      # it had failed "Is a directory" after the whole run
+        args.out = os.path.join(args.out, "speed.json")
+    folder = os.path.dirname(os.path.abspath(args.out))   # written at the end: checked now
+    if not (os.path.isdir(folder) and os.access(folder, os.W_OK)):
+        raise InputError(f"--out {args.out}: its folder {folder} is not a writable folder")
     repeat = 1 if args.quick else args.repeat
     rows = []
     print(f"{'configuration':48s} {'solver':11s} {'steps':>8s} {'loop s':>8s} {'µs/step':>8s} "

@@ -371,6 +371,9 @@ class Obstacles:
                 raise InputError(f"point stops: {name} must be a number (m; ±inf: no bound)")
             check_bound(name, g, "x")
         g1, g2 = float(g1), float(g2)
+        if not g1 < g2:         # where it is built, not at beam_system
+            raise InputError(f"g1 ≥ g2 at x={x:g} (g1={g1:g}, g2={g2:g}); obstacles need "
+                             "g1 < g2")
 
         def lower(z, x=x, g=g1):
             return np.where(np.isclose(z, x, rtol=0, atol=1e-12 * max(1.0, abs(x))), g, -np.inf)

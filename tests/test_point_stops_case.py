@@ -122,6 +122,8 @@ def test_unstable_run_exit_code_and_valid_files(tmp_path):
 def test_api_refuses_bad_obstacles_and_initial_state():
     with pytest.raises(InputError, match="g1 ≥ g2"):
         BeamProblem(Beam(1.0, 1.0), Obstacles.point_stops(1.0, 0.1, -0.1), J=4)
+    with pytest.raises(InputError, match=r"g1 ≥ g2 at x=0.5 \(g1=0.1, g2=-0.1\)"):
+        Obstacles.stops([0.5], 0.1, -0.1)          # where it is built (docs/api.md)
     with pytest.raises(InputError, match="u0 violates"):
         beam_system(BeamProblem(Beam(1.0, 1.0), Obstacles.point_stops(1.0, -0.01, 0.01),
                                 initial=InitialState(u0=lambda x: 0.1 * x**2), J=4))

@@ -221,6 +221,10 @@ def main_guard(main) -> None:
     except (InputError, SolverError) as e:
         print(f"error: {e}", file=sys.stderr)
         code = EXIT_INPUT if isinstance(e, InputError) else EXIT_SOLVER
+    except MemoryError:         # numpy's own (an array too large): its traceback
+        print("error: not enough memory for this run: a coarser mesh, fewer frames "
+              "(--frames) or a machine with more memory", file=sys.stderr)
+        code = EXIT_SOLVER
     except BrokenPipeError:     # stdout's reader went away (| head): nothing to say there,
         _quiet_stdout()         # and the folder's summary.json says how the run ended
         code = EXIT_PIPE

@@ -573,3 +573,23 @@ def test_a_penalty_failure_says_why(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()[-1]
     assert "the penalty contact solver failed at step" in err and \
         "its set of compressed springs did not settle" in err, err
+
+
+def test_a_run_beyond_the_memory_is_one_line_and_no_folder(tmp_path):
+    """A 600 × 600 plate in 1.5 GB of address space: numpy's _ArrayMemoryError was a
+    traceback; it is one line, exit 3, and no folder."""
+    import resource
+    import sys
+    from skfem_beam.scenefile import example as example_scene
+
+    def limit():
+        resource.setrlimit(resource.RLIMIT_AS, (1_500_000_000, 1_500_000_000))
+    out = tmp_path / "run"
+    p = subprocess.run([sys.executable, "-m", "skfem_beam", "run",
+                        str(example_scene("plate_on_stops")), "--set", "mesh.nx=600", "--set",
+                        "mesh.ny=600", "--T", "0.001", "--out", str(out)],
+                       capture_output=True, text=True, preexec_fn=limit,
+                       env={**os.environ, "SKFEM_BEAM_CHARTS": "0",
+                            "OPENBLAS_NUM_THREADS": "1"})   # its threads' buffers need more
+    assert p.returncode == 3 and p.stderr.startswith("error: not enough memory for this run")
+    assert p.stderr.count("\n") == 1 and not out.exists(), p.stderr

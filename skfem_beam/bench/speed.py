@@ -198,11 +198,7 @@ def main(argv=None) -> int:
         scene, p, solver, repeat = json.loads(args.child)
         print(json.dumps(child(scene, p, solver, repeat)))
         return 0
-    if os.path.isdir(args.out):      # it had failed "Is a directory" after the whole run
-        args.out = os.path.join(args.out, "speed.json")
-    folder = os.path.dirname(os.path.abspath(args.out))   # written at the end: checked now
-    if not (os.path.isdir(folder) and os.access(folder, os.W_OK)):
-        raise InputError(f"--out {args.out}: its folder {folder} is not a writable folder")
+    args.out = _out_file(args.out)
     repeat = 1 if args.quick else args.repeat
     rows = []
     print(f"{'configuration':48s} {'solver':11s} {'steps':>8s} {'loop s':>8s} {'µs/step':>8s} "
@@ -245,6 +241,17 @@ def main(argv=None) -> int:
         json.dump({"machine": "see README (2-core CI machine)", "rows": rows}, fh, indent=2)
     print(f"written {args.out}")
     return 0
+
+
+def _out_file(out: str) -> str:
+    """The JSON file --out names (a folder: speed.json in it), checked before the
+    measurements: it had failed "Is a directory" after the whole run."""
+    if os.path.isdir(out):
+        out = os.path.join(out, "speed.json")
+    folder = os.path.dirname(os.path.abspath(out))
+    if not (os.path.isdir(folder) and os.access(folder, os.W_OK)):
+        raise InputError(f"--out {out}: its folder {folder} is not a writable folder")
+    return out
 
 
 if __name__ == "__main__":

@@ -142,3 +142,17 @@ def test_a_load_too_large_for_floats_is_one_line_and_no_folder(tmp_path, capfd, 
                               "point"), err
     assert not any("Warning" in line for line in err), err
     assert not out.exists()
+
+
+def test_an_unstable_penalty_run_says_its_springs_lower_the_limit_it_names(tmp_path, capsys):
+    """A stiff plate penalty at β = 0 went unstable at Δt = 5e-6 s below the limit it named
+    (6.5e-6 s, the structure's alone) without saying why."""
+    from conftest import exit_code
+    from skfem_beam.scenefile import example, run_main
+    argv = [str(example("plate_on_stops")), "--T", "0.002", "--format", "none", "--out",
+            str(tmp_path / "run")] + [a for s in ("contact.law=penalty", "time.dt=5e-6",
+                                                  "contact.stiffness=1e12", "time.beta=0")
+                                      for a in ("--set", s)]
+    assert exit_code(run_main, argv) == 4
+    assert "= 6.512e-06 s of the structure alone: the penalty springs lower it" in \
+        capsys.readouterr().err

@@ -339,6 +339,8 @@ class Run:
             limit = linear_limit(kappa_h(self.system), self.beta)
             if math.isfinite(limit):        # β ≥ 1/4 has none
                 self.message += f", linear stability limit 2/√(κ_h(1−4β)) = {limit:.4g} s"
+                if self.springs:            # the limit a Δt below it went unstable under
+                    self.message += " of the structure alone: the penalty springs lower it"
         self.n = good
 
     # the saved series by saved-row number (see SavedRows), as the output pipeline reads them

@@ -59,7 +59,9 @@ class Hole:
 
     @classmethod
     def faces(cls, rows, centre=(0.0, 0.0), shape: str = "faces") -> "Hole":
-        """Faces n·((v, w) − centre) ≤ gap, rows (ny, nz, gap); n is normalised."""
+        """Faces n·((v, w) − centre) ≤ gap, rows (ny, nz, gap), as written: a row with
+        |n| ≠ 1 is normalised with its gap (2v ≤ 0.0004 is v ≤ 0.0002; the gap was kept,
+        a hole twice as wide as written)."""
         rows = np.asarray(rows, dtype=float) if _is_table(rows) else None
         if rows is None or rows.ndim != 2 or rows.shape[1] != 3 or rows.shape[0] < 1:
             raise InputError("hole faces must be [[ny, nz, gap], ...] (at least one face)")
@@ -69,6 +71,8 @@ class Hole:
         if np.any(norm == 0):
             raise InputError(f"hole face {int(np.argmin(norm))} has the normal (0, 0)")
         n = rows[:, :2] / norm[:, None]
+        unit = np.abs(norm - 1.0) <= 1e-12        # (cos a, sin a): the gap kept to the bit
+        rows[~unit, 2] /= norm[~unit]
         n[np.abs(n) < 1e-14] = 0.0         # cos(π/2) is 6e-17: a square's faces are exact
         rows = np.column_stack([n / np.hypot(n[:, 0], n[:, 1])[:, None], rows[:, 2]])
         hole = cls(_pair("centre", centre), None, tuple(map(tuple, rows.tolist())), shape)

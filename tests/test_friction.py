@@ -510,3 +510,25 @@ def test_a_square_hole_wears_on_the_face_the_tube_is_pushed_onto(tmp_path):
     assert worst["from_rad"] == pytest.approx(-np.pi) and worst["volume"] > 0.9 * sum(
         k["volume"] for k in sectors)
     assert sectors[6]["volume"] == 0.0          # [0°, 30°): no face is touched there
+
+
+@pytest.mark.parametrize("change, word", [
+    # [contact] friction over flat stops only: it ran frictionless without a word
+    (lambda t: (t[:t.index("[wear]")] + t[t.index("[mesh]"):])
+     .replace("hole = { radius = 0.0004 }", "g1 = -0.0004\ng2 = 0.0004"),
+     "[contact] friction=0.3 acts at a hole's wall: this scene has no hole"),
+    # [wear] on a beam known by k² alone: K × W per kg/m was printed as mm³ and mm
+    (lambda t: t.replace('[material]\nE = 2.0e11               # Pa\nrho = 8000.0             '
+                         '# kg/m³\n', '[mass_normalised]\nk2 = 282.84\n')
+     .replace("[section]\ntube = { outer_diameter = 0.01905, wall = 0.00165 }\n", "")
+     .replace("distributed = true", "per_mass = true")
+     .replace("land = 0.019 ", "radius = 0.0095\nland = 0.019 "),
+     "[wear] needs forces in newtons, so the beam's mass per length"),
+])
+def test_friction_without_a_hole_and_wear_without_newtons_are_refused(tmp_path, capsys,
+                                                                      change, word):
+    from conftest import assert_scene_refused
+    text = example("tube_round_holes_friction").read_text()
+    new = change(text)
+    assert new != text
+    assert_scene_refused(tmp_path, capsys, {"t.toml": new}, "t.toml", word)

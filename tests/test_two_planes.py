@@ -418,3 +418,13 @@ def test_the_linear_laws_take_a_polygons_faces():
         assert r.success and r.impacts > 20
     with pytest.raises(InputError, match="independent constraint rows"):
         solve(system, 1e-4, 0.2, method=PositionLevel("daqp"))
+
+
+def test_a_face_is_the_half_plane_written_whatever_its_normals_length():
+    """faces = [[2, 0, 4e-4], ...] is 2v ≤ 4e-4 (docs: n·(v, w) ≤ gap): the normal was
+    made a unit vector and the gap kept, a hole twice as wide as written."""
+    from skfem_beam.holes import Hole
+    scaled = Hole.faces([[2.0, 0.0, 4e-4], [-2.0, 0.0, 4e-4], [0.0, 1.0, 4e-4]])
+    unit = Hole.faces([[1.0, 0.0, 2e-4], [-1.0, 0.0, 2e-4], [0.0, 1.0, 4e-4]])
+    assert scaled.faces_ == unit.faces_
+    assert Hole.regular(4, 4e-4).faces_[0][2] == 4e-4        # unit normals: the gap exact

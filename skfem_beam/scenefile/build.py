@@ -196,6 +196,9 @@ def wear(scene: Scene):
     if not holes:
         raise InputError("[wear] needs holes (planes = 2 and [[obstacles]] hole = ...): wear "
                          "comes from the normal force times the sliding along a wall")
+    if not scene.problem.beam.rho_S:    # K × W per kg/m was printed as mm³ and mm
+        raise InputError("[wear] needs forces in newtons, so the beam's mass per length: "
+                         "give [material] and [section], or rho_S in [mass_normalised]")
     radius = d.get("radius", outer_radius(scene.data.get("section", {})))
     if radius is None and "land" in d:
         raise InputError("[wear] radius (m, the tube's outer radius) is needed for the depth "

@@ -108,6 +108,9 @@ def obstacles_and_holes(data: dict) -> tuple[Obstacles, tuple]:
         if "friction" in o and "hole" not in o:
             raise InputError(f"[obstacles.{i}] friction acts at a hole's wall: this obstacle "
                              "has no hole")
+    if mu and not holes:        # it ran frictionless without a word
+        raise InputError(f"[contact] friction={mu:g} acts at a hole's wall: this scene has "
+                         "no hole ([[obstacles]] hole = ...)")
     if holes and plane_count(data) != 2:
         raise InputError("[[obstacles]] hole bounds (v, w) in the cross-section: it needs "
                          "planes = 2 at the top of the file")

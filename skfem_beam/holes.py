@@ -101,6 +101,7 @@ class Hole:
                 or not np.isfinite(p).all():
             raise InputError("hole polygon must be [[y1, z1], [y2, z2], ...] (at least three "
                              "vertices, m)")
+        p = _plain_corners(p)
         e = np.roll(p, -1, axis=0) - p
         cross = e[:, 0] * np.roll(e, -1, axis=0)[:, 1] - e[:, 1] * np.roll(e, -1, axis=0)[:, 0]
         if np.any(cross <= 0):
@@ -237,6 +238,23 @@ def land_excess(pa: float, pb: float, r: float, lands: float, half: float,
     off = math.atan2(pb, pa) - angle
     off -= step * math.floor(off / step + 0.5)     # from the nearest land's centre
     return rho * math.cos(max(abs(off) - half, 0.0)) - r
+
+
+def _plain_corners(p: np.ndarray) -> np.ndarray:
+    """A polygon's vertices without a repeated one (a closed outline's last, as CAD writes
+    it) or one in the middle of an edge: the same hole, which the convexity check refused
+    ("not convex ... at vertex N")."""
+    scale = float(np.abs(p).max()) or 1.0
+    keep = np.linalg.norm(p - np.roll(p, -1, axis=0), axis=1) > 1e-12 * scale
+    p = p[keep] if keep.any() else p[:1]
+    while len(p) > 3:
+        a, b = p - np.roll(p, 1, axis=0), np.roll(p, -1, axis=0) - p
+        straight = (np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]) <= 1e-12 * scale * scale) \
+            & (np.einsum("ij,ij->i", a, b) > 0)
+        if not straight.any():
+            break
+        p = np.delete(p, int(np.argmax(straight)), axis=0)
+    return p
 
 
 def _is_table(value) -> bool:

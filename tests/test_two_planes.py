@@ -428,3 +428,15 @@ def test_a_face_is_the_half_plane_written_whatever_its_normals_length():
     unit = Hole.faces([[1.0, 0.0, 2e-4], [-1.0, 0.0, 2e-4], [0.0, 1.0, 4e-4]])
     assert scaled.faces_ == unit.faces_
     assert Hole.regular(4, 4e-4).faces_[0][2] == 4e-4        # unit normals: the gap exact
+
+
+def test_a_polygon_closed_by_its_first_vertex_or_with_one_mid_edge_is_the_same_hole():
+    """As CAD writes an outline (the first vertex again at the end), or with a vertex in the
+    middle of an edge: the same faces, where "not convex ... at vertex 4" refused them."""
+    from skfem_beam.holes import Hole
+    square = [[1e-3, 0.0], [0.0, 1e-3], [-1e-3, 0.0], [0.0, -1e-3]]
+    plain = Hole.polygon(square).faces_
+    assert Hole.polygon(square + [square[0]]).faces_ == plain
+    assert Hole.polygon(square[:1] + [[5e-4, 5e-4]] + square[1:]).faces_ == plain
+    with pytest.raises(InputError, match="not convex and counter-clockwise at vertex 4"):
+        Hole.polygon(square + [[5e-4, -2e-4]])

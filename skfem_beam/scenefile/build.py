@@ -199,10 +199,14 @@ def wear(scene: Scene):
     if not scene.problem.beam.rho_S:    # K × W per kg/m was printed as mm³ and mm
         raise InputError("[wear] needs forces in newtons, so the beam's mass per length: "
                          "give [material] and [section], or rho_S in [mass_normalised]")
-    radius = d.get("radius", outer_radius(scene.data.get("section", {})))
+    sections = [s.get("section", {}) for s in scene.data.get("segments", [])] or \
+        [scene.data.get("section", {})]
+    radii = {outer_radius(section) for section in sections}     # a stepped tube's: one?
+    radius = d.get("radius", radii.pop() if len(radii) == 1 else None)
     if radius is None and "land" in d:
         raise InputError("[wear] radius (m, the tube's outer radius) is needed for the depth "
-                         "(land) when [section] is not a tube or a rod")
+                         "(land) when the section is not a tube or a rod, or its segments' "
+                         "outer diameters differ")
     given = need(d, ("coefficient", "service_years"), "wear")
     return Wear(given["coefficient"], given["service_years"], d.get("land"), radius)
 

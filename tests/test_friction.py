@@ -532,3 +532,17 @@ def test_friction_without_a_hole_and_wear_without_newtons_are_refused(tmp_path, 
     new = change(text)
     assert new != text
     assert_scene_refused(tmp_path, capsys, {"t.toml": new}, "t.toml", word)
+
+
+def test_a_stepped_tube_of_one_outer_diameter_gives_wear_its_radius(tmp_path):
+    """[wear] land on [[segments]] of one tube: "radius is needed ... when [section] is not a
+    tube" was said though every segment is one."""
+    from skfem_beam.scenefile import load
+    from skfem_beam.scenefile.build import wear
+    text = example("tube_round_holes_friction").read_text()
+    one = "{ E = 2.0e11, rho = 8000.0 }", "{ tube = { outer_diameter = 0.01905, wall = 0.00165 } }"
+    segments = "".join(f"[[segments]]\nlength = 0.75\nmaterial = {one[0]}\nsection = {one[1]}\n"
+                       for _ in range(2))
+    start, end = text.index("[material]"), text.index("[ends]")
+    (tmp_path / "s.toml").write_text(text[:start] + segments + text[end:])
+    assert wear(load(tmp_path / "s.toml")).radius == 0.01905 / 2

@@ -196,17 +196,7 @@ class Hole:
             return c + self.radius * np.column_stack([np.cos(a), np.sin(a)])
         if self.is_broached:
             return c + self._broached_outline(points)
-        f = np.asarray(self.faces_)
-        ang = np.arctan2(f[:, 1], f[:, 0])
-        f = f[np.argsort(ang)]
-        verts = []
-        for k in range(len(f)):
-            a, b = f[k], f[(k + 1) % len(f)]
-            A = np.array([a[:2], b[:2]])
-            if abs(np.linalg.det(A)) < 1e-12:
-                continue           # parallel faces: open (flat bars)
-            verts.append(c + np.linalg.solve(A, [a[2], b[2]]))
-        return np.array(verts + verts[:1]) if verts else np.zeros((0, 2))
+        return c + faces_outline(np.asarray(self.faces_))
 
 
     def _broached_outline(self, points: int) -> np.ndarray:
@@ -238,6 +228,49 @@ def land_excess(pa: float, pb: float, r: float, lands: float, half: float,
     off = math.atan2(pb, pa) - angle
     off -= step * math.floor(off / step + 0.5)     # from the nearest land's centre
     return rho * math.cos(max(abs(off) - half, 0.0)) - r
+
+
+def _clip(poly: np.ndarray, face) -> np.ndarray:
+    """The convex ``poly`` (k × 2, in order) ∩ {p : n·p ≤ gap}, ``face`` = (ny, nz, gap)."""
+    d = poly @ np.asarray(face[:2]) - face[2]
+    out = []
+    for i in range(len(poly)):
+        j = (i + 1) % len(poly)
+        if d[i] <= 0:
+            out.append(poly[i])
+        if (d[i] < 0) != (d[j] < 0) and d[i] != d[j]:
+            out.append(poly[i] + d[i] / (d[i] - d[j]) * (poly[j] - poly[i]))
+    return np.array(out).reshape(-1, 2)
+
+
+def faces_outline(f: np.ndarray) -> np.ndarray:
+    """The walls of the faces n·p ≤ gap (rows of ``f``), for a chart: the region's edges
+    that lie on a face, in order, closed when the region is bounded; an open one's (flat
+    bars, faces open on one side) up to three times the largest gap, NaN rows between its
+    pieces.  (Each pair of neighbouring faces' corner had been drawn, closing an open
+    hole with a wall the orbit crossed.)"""
+    gap = max(float(np.abs(f[:, 2]).max()), 1e-300)
+    for reach in (1e3 * gap, 3 * gap):      # bounded: well inside the first box
+        poly = reach * np.array([[1.0, 1.0], [-1.0, 1.0], [-1.0, -1.0], [1.0, -1.0]])
+        for face in f:
+            poly = _clip(poly, face)
+        if not len(poly):
+            return np.zeros((0, 2))
+        mid = 0.5 * (poly + np.roll(poly, -1, axis=0))        # edge i: poly[i] → poly[i+1]
+        on = (np.abs(mid @ f[:, :2].T - f[:, 2]) <= 1e-9 * reach).any(axis=1)
+        if on.all():
+            return np.vstack([poly, poly[:1]])
+    start = int(np.argmin(on)) + 1          # just after an edge on the box
+    rows = []
+    for k in range(start, start + len(poly)):
+        i = k % len(poly)
+        if on[i]:
+            if not rows or np.isnan(rows[-1][0]):
+                rows.append(poly[i])
+            rows.append(poly[(i + 1) % len(poly)])
+        elif rows and not np.isnan(rows[-1][0]):
+            rows.append(np.full(2, np.nan))
+    return np.array(rows).reshape(-1, 2)
 
 
 def _plain_corners(p: np.ndarray) -> np.ndarray:

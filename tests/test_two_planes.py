@@ -440,3 +440,21 @@ def test_a_polygon_closed_by_its_first_vertex_or_with_one_mid_edge_is_the_same_h
     assert Hole.polygon(square[:1] + [[5e-4, 5e-4]] + square[1:]).faces_ == plain
     with pytest.raises(InputError, match="not convex and counter-clockwise at vertex 4"):
         Hole.polygon(square + [[5e-4, -2e-4]])
+
+
+def test_an_open_holes_chart_wall_is_its_faces_not_a_closing_corner():
+    """Three faces open on one side were drawn as a closed triangle whose third corner broke
+    a face by the clearance; flat bars had no wall at all.  Every wall point is on a face
+    and inside the others; a bounded hole's outline is still closed."""
+    from skfem_beam.holes import Hole
+    r = 4e-4
+    for rows, closed in (([[0, 1, r], [0, -1, r]], False),
+                         ([[1, 0, r], [0.5, 0.866, r], [-0.5, 0.866, r]], False),
+                         ([[1, 0, r], [0, 1, r], [-1, 0, r], [0, -1, r]], True)):
+        hole = Hole.faces(rows)
+        o = hole.outline()
+        p = o[~np.isnan(o[:, 0])]
+        f = np.asarray(hole.faces_)
+        d = p @ f[:, :2].T - f[:, 2]
+        assert len(p) >= 3 and (d <= 1e-12 * r).all() and (np.abs(d) <= 1e-12 * r).any(axis=1).all()
+        assert np.array_equal(o[0], o[-1]) == closed

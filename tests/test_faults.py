@@ -575,6 +575,19 @@ def test_a_penalty_failure_says_why(tmp_path, capsys):
         "its set of compressed springs did not settle" in err, err
 
 
+def test_a_friction_failure_says_why(tmp_path, capsys):
+    """μ = 50 on the friction tube: the line said only "the round-hole-friction contact
+    solver failed at step 3003"."""
+    from skfem_beam.scenefile import example as example_scene, run_main
+    out = tmp_path / "run"
+    assert exit_code(run_main, [str(example_scene("tube_round_holes_friction")), "--set",
+                                "contact.friction=50", "--T", "0.35", "--format", "none",
+                                "--out", str(out)]) == 3
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert "the round-hole-friction contact solver failed at step" in err and \
+        "its block Gauss–Seidel sweeps did not converge" in err, err
+
+
 def test_a_run_beyond_the_memory_is_one_line_and_no_folder(tmp_path):
     """A 600 × 600 plate in 1.5 GB of address space: numpy's _ArrayMemoryError was a
     traceback; it is one line, exit 3, and no folder."""

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import contextlib
 import time
+import uuid
 
 from .errors import InputError
 
@@ -90,9 +91,13 @@ def on_cluster(client, task, settings: dict, todo: list[float], give_up):
     finished, at once."""
     attempts = {v: 1 for v in todo}
     key, finished = {}, set()
+    # this sweep's own keys: on a shared scheduler another sweep's task of the same value
+    # had the same key, and Dask handed this one its results (other settings, silently)
+    this = uuid.uuid4().hex[:12]
 
     def submit(v):
-        f = client.submit(task, settings, v, key=f"sweep-{v!r}-{attempts[v]}", pure=False)
+        f = client.submit(task, settings, v, key=f"sweep-{this}-{v!r}-{attempts[v]}",
+                          pure=False)
         key[f.key] = v
         return f
 

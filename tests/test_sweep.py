@@ -325,3 +325,25 @@ def test_without_dask_a_sweep_runs_its_values_in_turn(tmp_path, capsys, monkeypa
     err = capsys.readouterr().err
     assert "note: Dask is not installed" in err and "one after the other" in err, err
     assert len(list((out / "runs").glob("*.json"))) == 2
+
+
+def test_two_sweeps_on_one_scheduler_have_keys_of_their_own(tmp_path):
+    """Two sweeps sent to one scheduler at once, with other settings: their tasks of the
+    same value had the same key (sweep-<value>-<attempt>), so Dask gave the second the
+    first's results, silently.  Each sweep's keys are now its own."""
+    distributed = pytest.importorskip("distributed")
+    from skfem_beam.sweep_cluster import on_cluster
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, host="127.0.0.1",
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        keys = []
+        real = client.submit
+
+        def submit(*args, **kw):
+            keys.append(kw["key"])
+            return real(*args, **kw)
+        client.submit = submit
+        for zeta in (0.0, 0.02):
+            list(on_cluster(client, lambda s, v: (s["zeta"], v), {"zeta": zeta}, [10.0],
+                            give_up=None))
+    assert len(keys) == 2 and keys[0] != keys[1] and all("10.0" in k for k in keys)

@@ -288,6 +288,14 @@ def test_a_scene_file_run_stopped_before_its_first_checkpoint_runs_again_on_resu
     command = [sys.executable, "-m", "skfem_beam", "run"] + SCENE + ["--out", str(out)]
     assert 1 < kill_before_the_first_checkpoint(command, out) < len(rows(ref))
     monkeypatch.chdir(tmp_path)
+    # a file of the user's there (an export's .mat): named and kept, the resume refused
+    # (starting again from step 0 deleted it), then run once it is moved out
+    (out / "out.mat").write_bytes(b"mine")
+    before = sorted(p.name for p in out.iterdir())
+    assert exit_code(run_main, ["--resume", str(out)]) == 2
+    assert "holds files of yours (out.mat)" in capsys.readouterr().err
+    assert sorted(p.name for p in out.iterdir()) == before
+    (out / "out.mat").unlink()
     run_again_from_step_0(run_main, out, capsys)
     assert_same_run(out, ref)
 

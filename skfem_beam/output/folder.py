@@ -123,6 +123,19 @@ def _check_replaceable(out: Path, overwrite: bool) -> None:
                          "folder")
 
 
+def check_clearable(out: Path) -> None:
+    """A stopped run's folder to be started again from step 0 (``Folder.clear``) holds
+    only what runs write: files of the user's (an export's .mat, notes) are named and the
+    resume refused, as --overwrite does (they went with the run's)."""
+    foreign = sorted(p.name for p in out.iterdir()
+                     if not any(fnmatch.fnmatch(p.name, w) for w in WRITTEN))
+    if foreign:
+        shown = ", ".join(foreign[:3]) + (", …" if len(foreign) > 3 else "")
+        raise InputError(f"--resume {out}: it has no checkpoint, so the run starts again "
+                         f"from step 0 and replaces what a run writes; the folder also "
+                         f"holds files of yours ({shown}): move them out first")
+
+
 def _empty(out: Path, keep: tuple[str, ...]) -> None:
     """Remove everything in folder ``out`` but the names in ``keep``."""
     for p in out.iterdir():
@@ -239,7 +252,7 @@ class Folder:
         """Remove what a stopped run left (rows, frames, charts, tables, temporary files),
         so that a run started again from step 0 here writes what it would into an empty
         folder.  The summary stays: it holds the run's configuration, and a run killed
-        in the middle of this must still find it."""
+        in the middle of this must still find it (:func:`check_clearable` first)."""
         _empty(self.path, keep=(*OURS, SUMMARY))
 
     def discard(self) -> None:

@@ -35,7 +35,8 @@ from ..scheme import Run, drive
 from .checkpoint import (CHECKPOINT, _resume_folder, checkpoint_of, has_checkpoint,
                          read_checkpoint, restore, write_checkpoint)
 from .fields import FieldWriter
-from .folder import EXIT_SOLVER, Folder, Interrupted, check_output_dir, report
+from .folder import (EXIT_SOLVER, Folder, Interrupted, check_clearable, check_output_dir,
+                     report)
 from .options import OutputOptions
 from .series import SeriesFile
 
@@ -216,6 +217,8 @@ def execute(run: Run, options: OutputOptions, summary: dict, series, finish) -> 
         # checkpoint leaves a summary that still names it
         summary = {**summary, "checkpoint_step": int(ck["n"])}
     _note_last_step(run)
+    if restart:
+        check_clearable(out)            # before anything is written
     with Signals() as stop:
         folder = Folder.open(out, summary, overwrite=options.overwrite, resume=resume)
         try:

@@ -51,7 +51,8 @@ import numpy as np
 
 from . import cli, scenes
 from .errors import InputError, SolverError
-from .output.folder import EXIT_SOLVER, Folder, atomic_write, check_output_dir, stamp
+from .output.folder import (EXIT_SOLVER, EXIT_UNSTABLE, Folder, atomic_write,
+                             check_output_dir, stamp)
 from .output.stream import Signals
 from .checks import check_beta, check_nonnegative, check_positive
 from .sweep_cluster import dask_client, on_cluster
@@ -83,6 +84,9 @@ def parse_values(spec: str) -> list[float]:
     an explicit comma list ``v1,v2,...``.  ``a:b:c`` is refused: MATLAB reads it as
     start:step:stop, an older version of this command read it as start:stop:count."""
     spec = str(spec).strip()
+    if re.search(r"[\d.]\s+[\d.]", spec):     # "5 10" had run one value, 510
+        raise InputError(f"--values {spec!r}: numbers separated by spaces; a list is comma "
+                         "separated (5,10,20), or linspace(5, 40, 200)")
     text = spec.replace(" ", "")
     if ":" in text:
         raise InputError(f"--values {spec!r}: a:b:c is ambiguous (start:step:stop in MATLAB); "
@@ -504,6 +508,10 @@ def parser():
 def main(argv=None) -> int:
     args = parser().parse_args(argv)
     fixed = {n: getattr(args, n) for n in SCENES["point_stops"][1] if hasattr(args, n)}
+    if args.param in fixed:     # it was ignored (and recorded in the summary's config)
+        raise InputError(f"--{args.param} {fixed[args.param]:g} is the swept parameter's "
+                         f"value: --values gives them (--{args.param} fixes it when another "
+                         "is swept)")
     settings = make_settings(args.scene, args.param,
                              **{k: getattr(args, k) for k in SETTINGS}, **fixed)
     values = parse_values(args.values)
@@ -534,8 +542,8 @@ def main(argv=None) -> int:
                 (out / "runs").mkdir(exist_ok=True)
                 results, timing = run_values(settings, values, out, client, progress)
                 with Signals() as held:     # every value done: the files are completed
-                    summary = folder.close(**assemble(out, settings, results,
-                                                      {"timing": timing}))
+                    summary = folder.close(sweep_status(results), **assemble(
+                        out, settings, results, {"timing": timing}))
     except KeyboardInterrupt as e:     # SIGINT, or SIGTERM (main_guard)
         n = sum(run_path(out, settings["param"], v).exists() for v in values)
         print(f"interrupted: {n} of {len(values)} values done in {out / 'runs'}; "
@@ -553,7 +561,17 @@ def main(argv=None) -> int:
     print(f"{len(values)} values: {len(values) - failed} done, {failed} failed{why}; "
           f"{tm['values_run']} run, {tm['values_resumed']} resumed in "
           f"{tm['total_wall_s']:.3g} s{rate} -> {out}", file=sys.stderr if failed else sys.stdout)
+    if summary["status"] != "success":      # no value ran through: as a single run's
+        return EXIT_UNSTABLE if summary["status"] == "unstable" else EXIT_SOLVER
     return EXIT_SOLVER if lost_ else 0
+
+
+def sweep_status(results) -> str:
+    """The sweep's status: "success" when some value ran through, else "unstable" (every
+    one went unstable: it had said success, exit 0) or "failed"."""
+    statuses = {r["status"] for r in results}
+    return "success" if "success" in statuses or not statuses else \
+        "unstable" if statuses == {"unstable"} else "failed"
 
 
 if __name__ == "__main__":

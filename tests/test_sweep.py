@@ -347,3 +347,19 @@ def test_two_sweeps_on_one_scheduler_have_keys_of_their_own(tmp_path):
             list(on_cluster(client, lambda s, v: (s["zeta"], v), {"zeta": zeta}, [10.0],
                             give_up=None))
     assert len(keys) == 2 and keys[0] != keys[1] and all("10.0" in k for k in keys)
+
+
+def test_sweep_values_and_params_that_ran_wrong_are_refused_or_reported(tmp_path, capsys):
+    from skfem_beam.errors import InputError
+    """'5 10' ran one value, 510; --omega 5 beside --param omega was ignored; a sweep whose
+    every value went unstable said success, exit 0."""
+    with pytest.raises(InputError, match="numbers separated by spaces"):
+        parse_values("5 10")
+    base = ["--workers", "0", "--no-progress", "--periods", "2", "--transient", "0"]
+    assert exit_code(main, base + ["--param", "omega", "--omega", "5", "--values", "10,20",
+                                   "--out", str(tmp_path / "fixed")]) == 2
+    assert "--omega 5 is the swept parameter's value" in capsys.readouterr().err
+    out = tmp_path / "unstable"
+    assert exit_code(main, base + ["--values", "10,20", "--beta", "0", "--dt", "1e-4",
+                                   "--out", str(out)]) == 4
+    assert json.loads((out / "summary.json").read_text())["status"] == "unstable"

@@ -325,8 +325,9 @@ def export(folder, to: str, out=None) -> Path:
     out = Path(out) if out is not None else folder / f"{folder.resolve().name}.{to}"
     if out.suffix != f".{to}":
         raise InputError(f"--out {out} must end in .{to} for --to {to}")
-    if out.resolve() == (folder / CHECKPOINT).resolve():
-        raise InputError(f"--out {out} is the run's own checkpoint (what --resume reads): "
+    if out.name == CHECKPOINT and (out.resolve() == (folder / CHECKPOINT).resolve()
+                                   or (out.parent / "summary.json").is_file()):
+        raise InputError(f"--out {out} is a run's checkpoint (what --resume reads): "
                          "choose another file")
     if not out.parent.is_dir():
         raise InputError(f"--out {out}: folder {out.parent} does not exist")

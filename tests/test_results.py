@@ -278,15 +278,21 @@ def test_a_field_not_in_the_folder_says_which_are(folder):
         run.fields["displacement_v"]
 
 
-def test_export_does_not_overwrite_the_checkpoint(folder, capsys):
+def test_export_does_not_overwrite_the_checkpoint(folder, tmp_path, capsys):
     """`--out DIR/checkpoint.npz` replaced what --resume reads (a stopped run could no
     longer be resumed): refused, the checkpoint as it was."""
     before = (folder / "checkpoint.npz").read_bytes()
     argv = [str(folder), "--to", "npz", "--out", str(folder / "checkpoint.npz")]
     assert exit_code(export_main, argv) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "the run's own checkpoint" in err, err
+    assert err.count("\n") == 1 and "is a run's checkpoint" in err, err
     assert (folder / "checkpoint.npz").read_bytes() == before
+    # another run's checkpoint is as precious (it was replaced, exit 0)
+    other = tmp_path / "other"
+    shutil.copytree(folder, other)
+    argv = [str(folder), "--to", "npz", "--out", str(other / "checkpoint.npz")]
+    assert exit_code(export_main, argv) == 2
+    assert (other / "checkpoint.npz").read_bytes() == before
 
 
 def test_export_of_a_folder_a_run_is_writing_is_refused(folder, tmp_path, capsys):

@@ -223,11 +223,18 @@ def read_run(folder, fields: str = "auto") -> SavedRun:
     series = read_csv(folder / SERIES)
     xdmf, pvd = folder / "fields.xdmf", folder / "fields.pvd"
     frames = None
-    if fields in ("auto", "xdmf") and xdmf.is_file():
-        frames = read_xdmf(xdmf)
-    elif fields in ("auto", "vtu") and pvd.is_file():
-        frames = read_pvd(pvd)
-    elif fields in ("xdmf", "vtu"):
+    try:
+        if fields in ("auto", "xdmf") and xdmf.is_file():
+            frames = read_xdmf(xdmf)
+        elif fields in ("auto", "vtu") and pvd.is_file():
+            frames = read_pvd(pvd)
+    except InputError as e:     # a run writing them now: not damaged, read in mid-flush
+        if summary.get("status") != "running":
+            raise
+        raise InputError(f"{folder}: a run is writing its fields now ({e}): read it again, "
+                         "or read_run(folder, fields='none') for the rows") from None
+    if frames is None and fields in ("xdmf", "vtu") and not (
+            xdmf.is_file() if fields == "xdmf" else pvd.is_file()):
         raise InputError(f"{folder} has no {fields} field files "
                          f"({'fields.xdmf' if fields == 'xdmf' else 'fields.pvd'})")
     impacts = read_csv(folder / IMPACTS) if (folder / IMPACTS).is_file() else None

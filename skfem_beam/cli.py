@@ -20,8 +20,8 @@ from . import methods
 from .contact import SOLVERS
 from .checks import check_choice, check_positive
 from .errors import Deferred, InputError, SolverError
-from .output.folder import (EXIT_INPUT, EXIT_SOLVER, EXIT_UNSTABLE, OPENED,  # noqa: F401
-                            Interrupted, release, report, stamp)
+from .output.folder import (EXIT_INPUT, EXIT_SOLVER, EXIT_UNSTABLE, NO_MEMORY,  # noqa: F401
+                            OPENED, Interrupted, release, report, stamp)
 from .output.options import OutputOptions
 from .output.folder import lock_folder
 from .output.checkpoint import (_resume_folder, check_resumable, has_checkpoint,
@@ -222,8 +222,8 @@ def main_guard(main) -> None:
         print(f"error: {e}", file=sys.stderr)
         code = EXIT_INPUT if isinstance(e, InputError) else EXIT_SOLVER
     except MemoryError:         # numpy's own (an array too large): its traceback
-        print("error: not enough memory for this run: a coarser mesh, fewer frames "
-              "(--frames) or a machine with more memory", file=sys.stderr)
+        print(f"error: {NO_MEMORY}: a coarser mesh, fewer frames (--frames) or a machine "
+              "with more memory", file=sys.stderr)
         code = EXIT_SOLVER
     except BrokenPipeError:     # stdout's reader went away (| head): nothing to say there,
         _quiet_stdout()         # and the folder's summary.json says how the run ended

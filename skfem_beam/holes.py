@@ -59,10 +59,10 @@ class Hole:
 
     @classmethod
     def faces(cls, rows, centre=(0.0, 0.0), shape: str = "faces") -> "Hole":
-        """Faces n·((v, w) − centre) ≤ gap, rows (ny, nz, gap), as written: a row with
-        |n| ≠ 1 is normalised with its gap (2v ≤ 0.0004 is v ≤ 0.0002; the gap was kept,
-        a hole twice as wide as written)."""
-        rows = np.asarray(rows, dtype=float) if _is_table(rows) else None
+        """Faces n·((v, w) − centre) ≤ gap, rows (ny, nz, gap), as written: a row whose
+        normal is not of length 1 is normalised with its gap (2v ≤ 0.0004 is v ≤ 0.0002;
+        the gap was kept, a hole twice as wide as written).  ``rows`` is not changed."""
+        rows = np.array(rows, dtype=float) if _is_table(rows) else None      # a copy
         if rows is None or rows.ndim != 2 or rows.shape[1] != 3 or rows.shape[0] < 1:
             raise InputError("hole faces must be [[ny, nz, gap], ...] (at least one face)")
         if not np.isfinite(rows).all():
@@ -101,13 +101,13 @@ class Hole:
                 or not np.isfinite(p).all():
             raise InputError("hole polygon must be [[y1, z1], [y2, z2], ...] (at least three "
                              "vertices, m)")
-        p = _plain_corners(p)
+        p, number = _plain_corners(p)
         e = np.roll(p, -1, axis=0) - p
         cross = e[:, 0] * np.roll(e, -1, axis=0)[:, 1] - e[:, 1] * np.roll(e, -1, axis=0)[:, 0]
         if np.any(cross <= 0):
             i = int(np.argmax(cross <= 0))
             raise InputError(f"hole polygon is not convex and counter-clockwise at vertex "
-                             f"{(i + 1) % len(p)} ({p[(i + 1) % len(p)].tolist()})")
+                             f"{number[(i + 1) % len(p)]} ({p[(i + 1) % len(p)].tolist()})")
         turning = np.sum(np.arctan2(cross, np.einsum("ij,ij->i", e, np.roll(e, -1, axis=0))))
         if turning > 2 * np.pi * (1 + 1e-9):    # left turns all, but round more than once
             raise InputError(f"hole polygon crosses itself (its edges turn {turning / np.pi:g}π, "
@@ -273,21 +273,23 @@ def faces_outline(f: np.ndarray) -> np.ndarray:
     return np.array(rows).reshape(-1, 2)
 
 
-def _plain_corners(p: np.ndarray) -> np.ndarray:
+def _plain_corners(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """A polygon's vertices without a repeated one (a closed outline's last, as CAD writes
     it) or one in the middle of an edge: the same hole, which the convexity check refused
-    ("not convex ... at vertex N")."""
+    ("not convex ... at vertex N"); with each kept vertex's number as given."""
     scale = float(np.abs(p).max()) or 1.0
+    number = np.arange(len(p))
     keep = np.linalg.norm(p - np.roll(p, -1, axis=0), axis=1) > 1e-12 * scale
-    p = p[keep] if keep.any() else p[:1]
+    p, number = (p[keep], number[keep]) if keep.any() else (p[:1], number[:1])
     while len(p) > 3:
         a, b = p - np.roll(p, 1, axis=0), np.roll(p, -1, axis=0) - p
         straight = (np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]) <= 1e-12 * scale * scale) \
             & (np.einsum("ij,ij->i", a, b) > 0)
         if not straight.any():
             break
-        p = np.delete(p, int(np.argmax(straight)), axis=0)
-    return p
+        k = int(np.argmax(straight))
+        p, number = np.delete(p, k, axis=0), np.delete(number, k)
+    return p, number
 
 
 def _is_table(value) -> bool:

@@ -606,3 +606,21 @@ def test_a_run_beyond_the_memory_is_one_line_and_no_folder(tmp_path):
                             "OPENBLAS_NUM_THREADS": "1"})   # its threads' buffers need more
     assert p.returncode == 3 and p.stderr.startswith("error: not enough memory for this run")
     assert p.stderr.count("\n") == 1 and not out.exists(), p.stderr
+
+
+def test_memory_running_out_after_the_folder_is_made_marks_it_failed(tmp_path, monkeypatch,
+                                                                     capsys):
+    """The folder's summary.json stayed "running" (and read_run then said a run was writing
+    it): it is "failed", with the one line's reason."""
+    from skfem_beam.output import series
+    from skfem_beam.scenefile import example as example_scene, run_main
+
+    def no_memory(self, columns):
+        raise MemoryError
+    monkeypatch.setattr(series.SeriesFile, "append", no_memory)
+    out = tmp_path / "run"
+    assert exit_code(run_main, [str(example_scene("flat_obstacles")), "--T", "0.05",
+                                "--format", "none", "--out", str(out)]) == 3
+    assert "error: not enough memory for this run" in capsys.readouterr().err
+    assert summary(out)["status"] == "failed"
+    assert summary(out)["message"] == "not enough memory for this run"

@@ -287,3 +287,13 @@ def test_modes_of_a_plate_with_few_free_dofs_say_what_is_allowed(capsys, sets, n
     if sets[0] == "mesh.nx=2":       # all four
         assert exit_code(modes_main, argv) == 0
         assert len(capsys.readouterr().out.strip().splitlines()) == 5
+
+
+def test_cells_too_small_for_the_elements_basis_are_one_line(capsys):
+    """A 200 × 600 BFS plate: skfem's global monomials made the cells' matrices singular,
+    a LinAlgError traceback."""
+    from skfem_beam.scenefile import modes_main
+    argv = [str(example("plate_on_stops")), "--n", "1", "--set", "mesh.nx=200", "--set",
+            "mesh.ny=600"]
+    assert exit_code(modes_main, argv) == 2
+    assert "the mesh's cells are too small for the bfs element" in capsys.readouterr().err

@@ -1094,3 +1094,19 @@ def test_dt_is_checked_against_the_t_that_runs(tmp_path):
     assert exit_code(run_main, argv) == 2
     assert exit_code(run_main, argv + ["--T", "0.1"]) == 0
     assert json.loads((out / "summary.json").read_text())["steps"] == 10
+
+
+@pytest.mark.parametrize("sets, T, line", [
+    (["time.dt=-2"], "1", "error: plate_on_stops.toml: [time] dt=-2 must be > 0"),
+    ([], "nan", "error: --T nan: T must be a positive number of seconds"),
+    ([], "1e300", "error: --T 1e+300: T/dt = "),
+    ([], "1e-6", "error: --T 1e-06: dt=2e-05 must be less than T=1e-06"),
+])
+def test_errors_about_t_name_the_flag_and_others_the_file(tmp_path, capsys, sets, T, line):
+    """Only T and Δt against it are the flag's: a bad dt of the file's was blamed on --T,
+    and --T nan named a --set the user never typed."""
+    out = tmp_path / "out"
+    out.mkdir()
+    assert_refused(run_main, [str(example("plate_on_stops")), "--T", T, "--out",
+                              str(out / "run")] + [a for s in sets for a in ("--set", s)],
+                   line, capsys, out)

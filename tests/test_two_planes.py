@@ -428,6 +428,9 @@ def test_a_face_is_the_half_plane_written_whatever_its_normals_length():
     unit = Hole.faces([[1.0, 0.0, 2e-4], [-1.0, 0.0, 2e-4], [0.0, 1.0, 4e-4]])
     assert scaled.faces_ == unit.faces_
     assert Hole.regular(4, 4e-4).faces_[0][2] == 4e-4        # unit normals: the gap exact
+    rows = np.array([[2.0, 0.0, 4e-4], [-1.0, 0.0, 2e-4], [0.0, 1.0, 4e-4]])
+    assert Hole.faces(rows).faces_ == Hole.faces(rows).faces_ == unit.faces_
+    assert rows[0, 2] == 4e-4         # the caller's array as it was (its gaps were halved)
 
 
 def test_a_polygon_closed_by_its_first_vertex_or_with_one_mid_edge_is_the_same_hole():
@@ -440,6 +443,8 @@ def test_a_polygon_closed_by_its_first_vertex_or_with_one_mid_edge_is_the_same_h
     assert Hole.polygon(square[:1] + [[5e-4, 5e-4]] + square[1:]).faces_ == plain
     with pytest.raises(InputError, match="not convex and counter-clockwise at vertex 4"):
         Hole.polygon(square + [[5e-4, -2e-4]])
+    with pytest.raises(InputError, match=r"at vertex 3 \(\[0.2, 0.2\]\)"):   # as given
+        Hole.polygon([[0, 0], [0, 0], [1, 0], [0.2, 0.2], [0, 1]])
 
 
 def test_an_open_holes_chart_wall_is_its_faces_not_a_closing_corner():

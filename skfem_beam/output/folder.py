@@ -32,6 +32,7 @@ from ..errors import (EXIT_INPUT, EXIT_SOLVER, EXIT_UNSTABLE,  # noqa: F401 (her
 from ..lock import LOCK, check_not_busy, lock_folder, release  # noqa: F401 (here too)
 
 SUMMARY = "summary.json"
+NO_MEMORY = "not enough memory for this run"     # a MemoryError's line (cli.main_guard)
 RESERVE = ".reserve"    # a little disk kept back, freed to write the final summary
 OURS = (LOCK, RESERVE)
 # what the project's commands write in a folder, by name, which --overwrite may remove:
@@ -307,6 +308,8 @@ class Folder:
     def __exit__(self, kind, error, tb):
         if isinstance(error, (SolverError, OSError)):
             self.fail(error)
+        elif isinstance(error, MemoryError):    # main_guard's one line
+            self.fail(MemoryError(NO_MEMORY))
         elif isinstance(error, KeyboardInterrupt):
             self.fail(error, status="interrupted", message=f"interrupted ({error or 'SIGINT'})")
         self.release()

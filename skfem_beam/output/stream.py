@@ -35,8 +35,8 @@ from ..scheme import Run, drive
 from .checkpoint import (CHECKPOINT, _resume_folder, checkpoint_of, has_checkpoint,
                          read_checkpoint, restore, write_checkpoint)
 from .fields import FieldWriter
-from .folder import (EXIT_SOLVER, Folder, Interrupted, check_clearable, check_output_dir,
-                     report)
+from .folder import (EXIT_SOLVER, NO_MEMORY, Folder, Interrupted, check_clearable,
+                     check_output_dir, report)
 from .options import OutputOptions
 from .series import SeriesFile
 
@@ -285,6 +285,9 @@ def _stream(s: _Stream, finish) -> int:
         raise
     except OSError as e:
         return s.failed_write(e)
+    except MemoryError:         # main_guard's one line; the folder said "running"
+        folder.fail(MemoryError(NO_MEMORY))
+        raise
     phase("summary")
     final = folder.close(**entries)
     code = report(final, folder.path)

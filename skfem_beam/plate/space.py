@@ -265,7 +265,13 @@ def plate_space(plate) -> PlateSpace:
     if not isinstance(plate, (Plate, MeshPlate)):
         raise InputError(f"plate_space needs a Plate or a MeshPlate, not {plate!r}")
     mesh = plate_mesh(plate)
-    basis = Basis(mesh, make_element(plate.element))
+    try:
+        basis = Basis(mesh, make_element(plate.element))
+    except np.linalg.LinAlgError:   # skfem's global monomials on a tiny cell: a traceback
+        size = float(np.min(np.ptp(mesh.p[:, mesh.t], axis=1).max(axis=0)))
+        raise InputError(f"the mesh's cells are too small for the {plate.element} element "
+                         f"(smallest {size:.3g} m: its matrices in global monomials are "
+                         "singular there): use a coarser mesh") from None
     fixed = fixed_dofs(basis, plate)
     return PlateSpace(
         plate=plate, basis=basis,

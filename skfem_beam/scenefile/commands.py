@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import math
 import sys
 from dataclasses import replace
 from pathlib import Path
@@ -89,13 +90,17 @@ def _scene_of(path, sets, resume, T=None) -> Scene:
                   "meshes": config.get("scene_meshes", {})}
     elif path is None:
         raise InputError("run needs a scene file: python -m skfem_beam run SCENE.toml")
-    overrides = list(sets or ()) + ([f"time.T={T!r}"] if T is not None and not resume else [])
+    given = T is not None and not resume
+    if given and not (math.isfinite(T) and T > 0):
+        raise InputError(f"--T {T:g}: T must be a positive number of seconds")
+    overrides = list(sets or ()) + ([f"time.T={T!r}"] if given else [])
     try:
         scene = load(path or "scene.toml", overrides, **stored)
-    except InputError as e:     # T, or Δt against it: named as the flag
-        if T is None or resume or not ("[time] dt=" in str(e) or "[time] T=" in str(e)):
+    except InputError as e:     # Δt against the flag's T (its steps): named as the flag
+        rule = str(e).partition("[time] ")[2] or str(e).partition(": ")[2]
+        if not given or not ("must be less than T" in rule or rule.startswith("T/dt")):
             raise
-        raise InputError(f"--T {T:g}: {str(e).split('[time] ', 1)[1]}") from None
+        raise InputError(f"--T {T:g}: {rule}") from None
     if resume and scene.kind == "plate":
         _same_mesh(scene, summary, resume)
         for name in scene.meshes:       # read from the scene's folder: no stored copy

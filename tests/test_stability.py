@@ -156,3 +156,18 @@ def test_an_unstable_penalty_run_says_its_springs_lower_the_limit_it_names(tmp_p
     assert exit_code(run_main, argv) == 4
     assert "= 6.512e-06 s of the structure alone: the penalty springs lower it" in \
         capsys.readouterr().err
+
+
+def test_a_load_too_large_for_floats_leaves_an_overwritten_run_as_it_was(tmp_path, capsys):
+    """--overwrite over an earlier run with a load found too large by the run: the earlier
+    folder was emptied first and then removed; the loads are now checked before it is."""
+    from conftest import exit_code
+    from skfem_beam.scenefile import example, run_main
+    out = tmp_path / "run"
+    argv = [str(example("point_stops")), "--T", "0.01", "--format", "none", "--out", str(out)]
+    assert exit_code(run_main, argv) == 0
+    before = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
+    assert exit_code(run_main, argv + ["--overwrite", "--set",
+                                       "loads=[{per_mass=true,amplitude=1e300,omega=10.0}]"]) == 2
+    assert "the load is too large for floating point" in capsys.readouterr().err
+    assert {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()} == before

@@ -219,6 +219,7 @@ def execute(run: Run, options: OutputOptions, summary: dict, series, finish) -> 
     _note_last_step(run)
     if restart:
         check_clearable(out)            # before anything is written
+    run.check_loads(options.flush_every)
     with Signals() as stop:
         folder = Folder.open(out, summary, overwrite=options.overwrite, resume=resume)
         try:

@@ -309,6 +309,21 @@ class Run:
         if n1 == self.n_steps:
             self.status, self.message = "success", "the run reached T"
 
+    def check_loads(self, chunk: int) -> None:
+        """The next chunk's loads, computed now (``advance`` takes them) and refused when
+        too large for floats: a command calls it before its folder is made or emptied
+        (found in the run, the refusal had removed an --overwrite's earlier run)."""
+        n0, n1 = self.n, min(self.n + int(chunk), self.n_steps)
+        if self.done or n1 <= n0:
+            return
+        with np.errstate(over="ignore", invalid="ignore"):
+            self._next = self.scheme.inputs(n0, n1)
+        saved = self.load_bound
+        try:
+            self._energy_bound(self._next[1].G, n1)
+        finally:
+            self.load_bound = saved
+
     def _energy_bound(self, G, n1: int) -> float:
         """The a-priori energy bound at state ``n1`` (docs/design.md), the chunk's loads
         ``G`` added to the load's work so far; a load too large for floats refused."""

@@ -333,7 +333,7 @@ def test_two_sweeps_on_one_scheduler_have_keys_of_their_own(tmp_path):
     first's results, silently.  Each sweep's keys are now its own."""
     distributed = pytest.importorskip("distributed")
     from skfem_beam.sweep_cluster import on_cluster
-    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, host="127.0.0.1",
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
                                   dashboard_address=None) as cluster, \
             distributed.Client(cluster) as client:
         keys = []

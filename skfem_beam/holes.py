@@ -31,6 +31,7 @@ import numpy as np
 
 from .checks import check_count, check_finite, check_positive
 from .errors import InputError
+from .polygons import clip
 
 
 def _pair(name: str, value) -> tuple[float, float]:
@@ -230,19 +231,6 @@ def land_excess(pa: float, pb: float, r: float, lands: float, half: float,
     return rho * math.cos(max(abs(off) - half, 0.0)) - r
 
 
-def _clip(poly: np.ndarray, face) -> np.ndarray:
-    """The convex ``poly`` (k × 2, in order) ∩ {p : n·p ≤ gap}, ``face`` = (ny, nz, gap)."""
-    d = poly @ np.asarray(face[:2]) - face[2]
-    out = []
-    for i in range(len(poly)):
-        j = (i + 1) % len(poly)
-        if d[i] <= 0:
-            out.append(poly[i])
-        if (d[i] < 0) != (d[j] < 0) and d[i] != d[j]:
-            out.append(poly[i] + d[i] / (d[i] - d[j]) * (poly[j] - poly[i]))
-    return np.array(out).reshape(-1, 2)
-
-
 def faces_outline(f: np.ndarray) -> np.ndarray:
     """The walls of the faces n·p ≤ gap (rows of ``f``), for a chart: the region's edges
     that lie on a face, in order, closed when the region is bounded; an open one's (flat
@@ -253,7 +241,7 @@ def faces_outline(f: np.ndarray) -> np.ndarray:
     for reach in (1e3 * gap, 3 * gap):      # bounded: well inside the first box
         poly = reach * np.array([[1.0, 1.0], [-1.0, 1.0], [-1.0, -1.0], [1.0, -1.0]])
         for face in f:
-            poly = _clip(poly, face)
+            poly = clip(poly, face[:2], face[2])
         if not len(poly):
             return np.zeros((0, 2))
         mid = 0.5 * (poly + np.roll(poly, -1, axis=0))        # edge i: poly[i] → poly[i+1]

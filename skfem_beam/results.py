@@ -233,8 +233,7 @@ def read_run(folder, fields: str = "auto") -> SavedRun:
             raise
         raise InputError(f"{folder}: a run is writing its fields now ({e}): read it again, "
                          "or read_run(folder, fields='none') for the rows") from None
-    if frames is None and fields in ("xdmf", "vtu") and not (
-            xdmf.is_file() if fields == "xdmf" else pvd.is_file()):
+    if frames is None and fields in ("xdmf", "vtu"):      # the file asked for is not there
         raise InputError(f"{folder} has no {fields} field files "
                          f"({'fields.xdmf' if fields == 'xdmf' else 'fields.pvd'})")
     impacts = read_csv(folder / IMPACTS) if (folder / IMPACTS).is_file() else None

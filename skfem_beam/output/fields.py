@@ -355,6 +355,8 @@ class FieldWriter:
     :meth:`flush`, which also makes them readable during a run).
     """
 
+    _indexed = None     # how many frames the written indexes list (None: none written yet)
+
     def __init__(self, folder, system, fmt: str = "both", samples_per_element: int = 8,
                  name: str = "fields"):
         check_format(fmt, "format=")
@@ -368,7 +370,6 @@ class FieldWriter:
         self.times: list[float] = []
         self._vtu_files: list[str] = []
         self._xdmf = None
-        self._indexed = None    # how many frames the written indexes list (None: no index yet)
         self.closed = False
         if fmt in ("xdmf", "both"):
             from .xdmf import XdmfSeries    # meshio and h5py: loaded with a run's first frame

@@ -110,16 +110,12 @@ def _check_replaceable(out: Path, overwrite: bool) -> None:
     except (OSError, ValueError, TypeError):
         ours = False
     if not ours:
-        names = sorted(p.name for p in out.iterdir() if p.name not in OURS)
-        shown = ", ".join(names[:3]) + (", …" if len(names) > 3 else "")
-        raise InputError(f"--out {out} holds files no run wrote ({shown}); --overwrite "
-                         f"replaces only a run's folder (one with its {SUMMARY}): choose "
-                         f"a new or empty folder")
-    foreign = sorted(p.name for p in out.iterdir()
-                     if not any(fnmatch.fnmatch(p.name, w) for w in WRITTEN))
+        raise InputError(f"--out {out} holds files no run wrote ({_shown(out, OURS)}); "
+                         f"--overwrite replaces only a run's folder (one with its {SUMMARY}): "
+                         f"choose a new or empty folder")
+    foreign = _shown(out)
     if foreign:
-        shown = ", ".join(foreign[:3]) + (", …" if len(foreign) > 3 else "")
-        raise InputError(f"--out {out} holds files besides the run's ({shown}): --overwrite "
+        raise InputError(f"--out {out} holds files besides the run's ({foreign}): --overwrite "
                          "replaces only what a run writes; move them out or choose another "
                          "folder")
 
@@ -128,13 +124,21 @@ def check_clearable(out: Path) -> None:
     """A stopped run's folder to be started again from step 0 (``Folder.clear``) holds
     only what runs write: files of the user's (an export's .mat, notes) are named and the
     resume refused, as --overwrite does (they went with the run's)."""
-    foreign = sorted(p.name for p in out.iterdir()
-                     if not any(fnmatch.fnmatch(p.name, w) for w in WRITTEN))
+    foreign = _shown(out)
     if foreign:
-        shown = ", ".join(foreign[:3]) + (", …" if len(foreign) > 3 else "")
         raise InputError(f"--resume {out}: it has no checkpoint, so the run starts again "
                          f"from step 0 and replaces what a run writes; the folder also "
-                         f"holds files of yours ({shown}): move them out first")
+                         f"holds files of yours ({foreign}): move them out first")
+
+
+def _shown(out: Path, ours=None) -> str:
+    """The first three names in ``out`` that are not ``ours`` (None: not a name a run
+    writes, WRITTEN), for an error line ("" when there is none)."""
+    def theirs(name: str) -> bool:
+        return name not in ours if ours is not None else \
+            not any(fnmatch.fnmatch(name, w) for w in WRITTEN)
+    names = sorted(p.name for p in out.iterdir() if theirs(p.name))
+    return ", ".join(names[:3]) + (", …" if len(names) > 3 else "")
 
 
 def _empty(out: Path, keep: tuple[str, ...]) -> None:

@@ -154,7 +154,6 @@ class PlateFieldWriter(FieldWriter):
         self.m, self.n = system.C.shape[0], system.n
         self.ops = curvature_operators(system.meta["space"])
         self.times, self._vtu_files, self._xdmf, self.closed = [], [], None, False
-        self._indexed = None
         if fmt in ("xdmf", "both"):
             from .xdmf import XdmfSeries
             self._room_for_hdf5()

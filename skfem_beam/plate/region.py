@@ -15,33 +15,19 @@ from skfem import Basis, LinearForm, asm
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefTri
 
+from ..polygons import area, clip
+
 TRI_ORDER = 8       # exact to degree 8: BFS's bicubics (degree 6), Argyris's quintics
 SLIVER = 1e-12      # a clipped area within this share of its cell's: the whole cell, or none
 
 
-def clip(polygon: np.ndarray, region) -> np.ndarray:
-    """The convex ``polygon`` (k × 2, its vertices in order) ∩ the rectangle ``region`` =
-    (x0, x1, y0, y1): its vertices in order (none: no overlap)."""
+def clip_to(polygon: np.ndarray, region) -> np.ndarray:
+    """The convex ``polygon`` ∩ the rectangle ``region`` = (x0, x1, y0, y1)."""
     x0, x1, y0, y1 = region
-    for axis, bound, below in ((0, x0, False), (0, x1, True), (1, y0, False), (1, y1, True)):
-        kept = []
-        for a, b in zip(polygon, np.roll(polygon, -1, axis=0)):
-            a_in = a[axis] <= bound if below else a[axis] >= bound
-            b_in = b[axis] <= bound if below else b[axis] >= bound
-            if a_in:
-                kept.append(a)
-            if a_in != b_in:            # the side crosses the line: where it does
-                kept.append(a + (bound - a[axis]) / (b[axis] - a[axis]) * (b - a))
-        polygon = np.array(kept).reshape(-1, 2)
-        if not len(polygon):
-            break
+    for normal, gap in (((-1.0, 0.0), -x0), ((1.0, 0.0), x1), ((0.0, -1.0), -y0),
+                        ((0.0, 1.0), y1)):
+        polygon = clip(polygon, normal, gap)
     return polygon
-
-
-def area(polygon: np.ndarray) -> float:
-    """The shoelace area of a polygon (k × 2)."""
-    x, y = polygon[:, 0], polygon[:, 1]
-    return 0.5 * abs(float(x @ np.roll(y, -1) - y @ np.roll(x, -1)))
 
 
 def cells_in(mesh, region, tol: float) -> tuple[np.ndarray, list]:
@@ -55,7 +41,7 @@ def cells_in(mesh, region, tol: float) -> tuple[np.ndarray, list]:
     whole, cut = list(np.flatnonzero(inside)), []
     for k in np.flatnonzero(~inside & ~apart):
         cell = mesh.p[:, mesh.t[:, k]].T
-        part = clip(cell, region)
+        part = clip_to(cell, region)
         share = area(part) / area(cell) if len(part) > 2 else 0.0
         if share >= 1.0 - SLIVER:
             whole.append(k)

@@ -215,7 +215,7 @@ def test_scheduler_address_sends_the_same_work(tmp_path):
     args = ["--values", "9,13,17", "--transient", "0.2", "--periods", "3", "--no-progress"]
     assert exit_code(main, args + ["--workers", "0", "--out", str(tmp_path / "serial")]) == 0
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, host="127.0.0.1",
-                                  dashboard_address=None) as cluster:
+                                  dashboard_address=":0") as cluster:
         out = tmp_path / "remote"
         assert exit_code(main, args + ["--scheduler", cluster.scheduler_address,
                                        "--out", str(out)]) == 0
@@ -249,7 +249,7 @@ def test_killed_worker_is_retried_then_marked_failed(tmp_path):
     out = tmp_path / "sweep"
     with dask.config.set({"distributed.scheduler.allowed-failures": 0}), \
             distributed.LocalCluster(n_workers=1, threads_per_worker=1, host="127.0.0.1",
-                                     dashboard_address=None) as cluster, \
+                                     dashboard_address=":0") as cluster, \
             distributed.Client(cluster) as client:
         s = sweep(settings, values, out, client=client, progress=False, warm=False,
                   task=dies_at_13)
@@ -271,7 +271,7 @@ def test_a_cluster_left_without_workers_gives_up_instead_of_waiting(tmp_path, mo
     settings = make_settings("point_stops", "omega", transient=0.2, periods=2)
     out = tmp_path / "sweep"
     t0 = time.monotonic()
-    with distributed.LocalCluster(n_workers=0, host="127.0.0.1", dashboard_address=None) \
+    with distributed.LocalCluster(n_workers=0, host="127.0.0.1", dashboard_address=":0") \
             as cluster, distributed.Client(cluster) as client:
         s = sweep(settings, [9.0, 13.0], out, client=client, progress=False, warm=False)
     assert time.monotonic() - t0 < 30
@@ -334,7 +334,7 @@ def test_two_sweeps_on_one_scheduler_have_keys_of_their_own(tmp_path):
     distributed = pytest.importorskip("distributed")
     from skfem_beam.sweep_cluster import on_cluster
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
-                                  dashboard_address=None) as cluster, \
+                                  dashboard_address=":0") as cluster, \
             distributed.Client(cluster) as client:
         keys = []
         real = client.submit

@@ -97,8 +97,9 @@ SECTION_DOCS = {
     'mesh': (
         '`J` (elements, default 19; a node must fall on every obstacle end, support and '
         'segment step), `element = "hermite"\\|"bspline"`, `nodes = [...]` (non-uniform), `mass = '
-        '"consistent"\\|"redistributed"`; bar: `J` (P1 elements), `mass = '
-        '"average"\\|"consistent"\\|"lumped"\\|"redistributed"`; both: `massless = '
+        '"consistent"\\|"redistributed"`; bar: `J` (elements), `mass = '
+        '"average"\\|"consistent"\\|"lumped"\\|"redistributed"`, `element = "p1"\\|"p2"` '
+        '(Lagrange degree 1, the default, or 2; as `--element`); both: `massless = '
         '"beta"\\|"quasi-static"` (only with `mass = "redistributed"`, as `--massless`)'
     ),
     'time': (

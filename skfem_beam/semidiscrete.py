@@ -3,7 +3,7 @@
     M ü + B u̇ + K u = Σ_k a_k(t) b_k + Cᵀλ,   lo ≤ C u ≤ hi   (λ: nodal contact forces)
 
 The same object (:class:`~skfem_beam.system.SemiDiscrete`, importable from here too)
-serves the beam (Hermite or B-spline, B = 0) and the bar (P1, with Kelvin–Voigt damping),
+serves the beam (Hermite or B-spline, B = 0) and the bar (P1 or P2, with Kelvin–Voigt damping),
 so there is one time scheme for all scenes.
 """
 from __future__ import annotations

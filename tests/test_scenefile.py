@@ -341,9 +341,22 @@ def test_massless_key_is_the_case_flag(tmp_path, capsys):
                                   *[x for s in sets for x in ("--set", s)]], word, capsys, bad)
 
 
+def test_bar_element_and_mass_are_named_when_refused(tmp_path, capsys):
+    """A bar's [mesh] element and mass: one line naming the key, the value and the
+    choices; nothing written."""
+    bad = tmp_path / "bad"
+    bad.mkdir()
+    for key, word in (("element=p3", "[mesh] element='p3' is not one of: p1, p2"),
+                      ("mass=heavy", "[mesh] mass='heavy' is not one of: consistent, lumped")):
+        assert_refused(run_main, [str(example("impacting_bar")), "--out", str(bad / "run"),
+                                  "--set", f"mesh.{key}"], word, capsys, bad)
+
+
 @pytest.mark.parametrize("scene, sets, flags", [
     ("impacting_bar", ["contact.law=moreau-jean", "time.T=0.5"],
      (impacting_bar.main, ["--T", "0.5", "--law", "moreau-jean"])),
+    ("impacting_bar", ["mesh.element=p2", "time.beta=0.09", "time.T=0.5"],
+     (impacting_bar.main, ["--T", "0.5", "--element", "p2", "--beta", "0.09"])),
     ("point_stops", ["contact.law=moreau-jean", "time.T=0.3"],
      (point_stops.main, ["--T", "0.3", "--law", "moreau-jean"])),
     ("point_stops", ["mesh.mass=redistributed", "mesh.massless=quasi-static", "time.T=0.3"],

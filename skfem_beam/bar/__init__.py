@@ -1,6 +1,6 @@
 """The impacting bar of Do, Raupp & Feijoo: a 1-D (visco)elastic bar with an obstacle at
 an end, in the beam's layers: :mod:`.problem` (the scene :class:`Bar` and its profiles),
-:mod:`.system` (its P1 semi-discretisation, :func:`bar_system`), :mod:`.run` (its method,
+:mod:`.system` (its P1 or P2 semi-discretisation, :func:`bar_system`), :mod:`.run` (its method,
 run and series) and :mod:`.analysis` (errors against exact solutions, contact periods,
 the energy report).  Each module imports only those before it."""
 from .problem import (FAR_ENDS, OBSTACLES, SIDES, Bar, Table, describe, profile_values,

@@ -19,7 +19,7 @@ import numpy as np
 from ..errors import InputError
 from ..checks import (MAX_ELEMENTS, check_choice, check_count, check_finite,
                       check_nonnegative, check_positive)
-from ..spaces.lagrange import MASSES
+from ..spaces.lagrange import ELEMENTS, MASSES
 
 OBSTACLES = ("rigid", "elastic")
 FAR_ENDS = ("free", "clamped")
@@ -126,6 +126,8 @@ class Bar:
     (ρA, EA, bA, fA): forces are in N, energies in J, and k is a spring in N/m.
     ``mass`` is the mass matrix; the default ``average`` is the one that meets the
     accuracy targets (see :mod:`skfem_beam.spaces.lagrange` and docs/design.md §6).
+    ``element``: P1 (the paper's) or P2 (twice the unknowns; with β = 0.09 the rod's
+    error at Δt/h = 0.4 is half P1's best: docs/methods.md, "The rod's accuracy study").
     """
     a: float = 1.0           # Young's modulus E (Pa)
     b: float = 0.0           # Kelvin–Voigt viscosity (Pa·s)
@@ -138,6 +140,7 @@ class Bar:
     k: float = 100.0         # spring stiffness of the elastic obstacle (Pa/m; N/m with A)
     N: int = 100             # number of elements
     mass: str = "average"    # 'consistent' | 'lumped' | 'average'
+    element: str = "p1"      # 'p1' | 'p2' (Lagrange elements of degree 1 or 2)
     far_end: str = "free"    # 'free' | 'clamped': the end without the obstacle
     obstacle_at: object = "left"   # 'left' (x = 0) | 'right' (x = L), or 0 | L
     A: float | None = None   # cross-section (m²); None: per unit cross-section
@@ -150,6 +153,7 @@ class Bar:
         object.__setattr__(self, "N", check_count("N", self.N, most=MAX_ELEMENTS))
         check_choice("obstacle", self.obstacle, OBSTACLES)
         check_choice("mass", self.mass, MASSES)
+        check_choice("element", self.element, ELEMENTS)
         check_choice("far_end", self.far_end, FAR_ENDS)
         object.__setattr__(self, "obstacle_at", _side(self.obstacle_at, self.L))
         if self.A is not None:

@@ -1,4 +1,4 @@
-"""The bar's semi-discretisation (P1).  Units: everything is per unit cross-section
+"""The bar's semi-discretisation (P1 or P2).  Units: everything is per unit cross-section
 area (times A when the bar has one).  The semi-discrete equation is the paper's (2.9)
 with the density kept:
 
@@ -21,7 +21,7 @@ from .problem import Bar
 
 
 def bar_system(bar: Bar) -> SemiDiscrete:
-    """P1 semi-discretisation of the bar: M = ρA·M_mass, K = aA·S, B = bA·S (A = 1 per
+    """P1 or P2 semi-discretisation of the bar: M = ρA·M_mass, K = aA·S, B = bA·S (A = 1 per
     unit cross-section), a clamped far end's node dropped, one constrained value at
     the obstacle: u(0) ≥ 0 or u(L) ≤ 0.
 
@@ -30,7 +30,7 @@ def bar_system(bar: Bar) -> SemiDiscrete:
     """
     left = bar.obstacle_at == "left"
     fixed = () if bar.far_end == "free" else ((bar.N,) if left else (0,))
-    space = LagrangeSpace(np.linspace(0.0, bar.L, bar.N + 1), bar.mass, fixed)
+    space = LagrangeSpace(np.linspace(0.0, bar.L, bar.N + 1), bar.mass, fixed, bar.element)
     n, A = space.n, bar.section
     nodal = space.C.toarray()
     e0, eL = nodal[0], nodal[-1]
@@ -51,7 +51,8 @@ def bar_system(bar: Bar) -> SemiDiscrete:
         space=space,
         meta={"kind": "bar", "L": bar.L, "a": bar.a, "b": bar.b, "rho": bar.rho,
               "obstacle": bar.obstacle, "k": bar.k, "N": bar.N, "mass": bar.mass,
-              "far_end": bar.far_end, "obstacle_at": bar.obstacle_at, "A": bar.A},
+              "far_end": bar.far_end, "obstacle_at": bar.obstacle_at, "A": bar.A,
+              "element": bar.element},
         view=SceneView("bar", bar.L))
     if bar.mass == "redistributed":      # no inertia at the contact node (modified mass)
         from ..spaces.redistribution import redistributed
@@ -63,7 +64,9 @@ def spring_step_ratio(bar: Bar, dt: float) -> float:
     """ω₀Δt, ω₀ = √(k/m₀): the contact node (mass m₀ = M₀₀) on the spring.  Well above 1
     the β-weighted one-sided spring mis-times each impact on the node and can gain
     energy there (measured: ×36 over Example 2 with k = 1e8, Δt = 1e-3)."""
-    share = {"consistent": 1 / 3, "lumped": 1 / 2, "average": 5 / 12}.get(bar.mass, 0.0)
+    share = {"consistent": 1 / 3, "lumped": 1 / 2, "average": 5 / 12} if bar.element == "p1" \
+        else {"consistent": 2 / 15, "lumped": 1 / 6, "average": 3 / 20}
+    share = share.get(bar.mass, 0.0)
     if share == 0.0:      # a massless contact node has no impact to mis-time
         return 0.0
     m0 = bar.rho * bar.section * bar.h * share

@@ -3,7 +3,9 @@ area, the one obstacle at an end, the far end, the load and the initial profiles
 from __future__ import annotations
 
 from ..bar import Bar
+from ..checks import check_choice
 from ..errors import InputError
+from ..spaces.lagrange import ELEMENTS, MASSES
 from .parts import material_of, need, section_of
 from .read import Tables
 
@@ -50,6 +52,9 @@ def bar_problem(data: dict, reader: Tables) -> Bar:
     if len(loads) > 1:
         raise InputError("a bar takes one [[loads]] value = f (a uniform body force, N/m³)")
     ini, mesh = data.get("initial", {}), data.get("mesh", {})
+    for key, allowed in (("mass", MASSES), ("element", ELEMENTS)):
+        if key in mesh:
+            check_choice(f"[mesh] {key}", mesh[key], allowed)
     law = data.get("contact", {}).get("law", "auto")
     return Bar(a=mat.E, b=data.get("damping", {}).get("viscosity", 0.0), rho=mat.rho, L=L,
                f=loads[0].get("value", 0.0) if loads else 0.0,
@@ -57,5 +62,5 @@ def bar_problem(data: dict, reader: Tables) -> Bar:
                u0=_bar_profile(ini.get("u0", 0.0), "u0", "u"),
                obstacle="elastic" if "stiffness" in o and law != "penalty" else "rigid",
                k=o.get("stiffness", 100.0), N=mesh.get("J", 100),
-               mass=mesh.get("mass", "average"),
+               mass=mesh.get("mass", "average"), element=mesh.get("element", "p1"),
                far_end=ends["right" if side == "left" else "left"], obstacle_at=o["x"], A=A)

@@ -165,7 +165,7 @@ BAR_KEYS = {
     "loads": [{"value": N}],
     "initial": {"u0": NumberOr(U0, "{ x = [...], u = [...] }"),
                 "v0": NumberOr(V0, "{ x = [...], v = [...] }")},
-    "mesh": {"J": N, "mass": W, "massless": W},
+    "mesh": {"J": N, "mass": W, "massless": W, "element": W},
     # no friction (no cross-section to slide in) and no probes (it writes u(0), u(L)):
     # they were read and ignored
     "time": TIME_KEYS, "contact": ContactKeys(law=W, stiffness=N, restitution=N, theta=N),

@@ -1,4 +1,4 @@
-"""Finite element spaces V_h ⊂ V = {w ∈ H²(0,L): the end conditions and supports} (and P1
+"""Finite element spaces V_h ⊂ V = {w ∈ H²(0,L): the end conditions and supports} (and P1, P2
 for the bar).  The beam spaces take ``ends`` (default clamped at 0, free at L: the papers'
 V = {w(0) = w'(0) = 0}) and ``supports`` (abscissae of rigid supports), see :mod:`.ends`.
 

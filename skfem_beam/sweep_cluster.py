@@ -42,7 +42,9 @@ def dask_client(workers: int | None = None, scheduler: str | None = None):
     with dask.config.set(no_trim), \
             LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                          host="127.0.0.1", dashboard_address="127.0.0.1:0", scheduler_port=0,
-                         silence_logs=logging.CRITICAL) as cluster, \
+                         silence_logs=logging.CRITICAL,
+                         # Ctrl-C reaches the workers too: they ignore it (sweep_worker)
+                         preload=["skfem_beam.sweep_worker"]) as cluster, \
             Client(cluster) as client:
         yield client
 

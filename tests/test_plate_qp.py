@@ -185,3 +185,25 @@ def test_a_large_w_is_announced_on_stderr(plate, monkeypatch, capsys):
     said = [line for line in err if line.startswith("building W")]
     assert said == [f"building W = A⁻¹Cᵀ for the contact law: {system.C.shape[0]} columns, "
                     f"{size * 1e-9:.2f} GB (solver pdas-sparse builds none) …"]
+
+
+def test_the_active_sets_primal_dual_start_runs_the_same_plate(monkeypatch):
+    """From PDAS_MIN constrained values on (a 20 × 20 plate: 361) the active-set law starts
+    each step with the primal–dual active set; with it off (Goldfarb–Idnani alone) the
+    bench's plate, pressed onto the obstacle under the whole plate, runs the same to
+    round-off, contact exact, with a fifth of the passes or fewer (measured: 95 against 702
+    over 40 steps)."""
+    from skfem_beam.contact import active_set
+    from skfem_beam.plate import bench
+    _, pressed = bench.systems(20)
+    runs = []
+    for minimum in (active_set.PDAS_MIN, 10**9):
+        monkeypatch.setattr(active_set, "PDAS_MIN", minimum)
+        runs.append(solve(pressed, bench.DT, 40 * bench.DT, method=PositionLevel("active-set")))
+    pd, gi = runs
+    assert pd.success and gi.success and pd.contact_fraction > 0.5
+    scale = np.abs(gi.frames_u).max()
+    assert np.abs(pd.frames_u - gi.frames_u).max() <= 1e-10 * scale
+    assert pd.max_nodal_violation <= 1e-15 * scale
+    assert np.abs(closure(pd)).max() <= 1e-9 * np.abs(pd.energy).max()
+    assert 5 * pd.qp_iterations <= gi.qp_iterations

@@ -84,6 +84,26 @@ def test_section_is_sampled_exactly_once_per_period(pipe):
     assert 0 < r["contact_fraction"] < 1 and 0 <= r["impacts"] <= r["impacts_total"]
 
 
+def test_ctrl_c_on_a_sweep_with_workers_prints_one_line(tmp_path):
+    """Ctrl-C reaches the whole process group, the Dask workers too: they ignore it
+    (skfem_beam.sweep_worker), so the user reads the sweep's one line, not the workers'
+    KeyboardInterrupt tracebacks (30–80 lines before)."""
+    pytest.importorskip("distributed")
+    out = tmp_path / "sweep"
+    args = ["--values", "linspace(8, 30, 24)", "--transient", "0.2", "--periods", "3",
+            "--workers", "2", "--no-progress", "--out", str(out)]
+    p = subprocess.Popen(SWEEP + args, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                         text=True, start_new_session=True)
+    deadline = time.time() + 120
+    while not list((out / "runs").glob("*.json")) and time.time() < deadline:
+        time.sleep(0.02)
+    os.killpg(p.pid, signal.SIGINT)            # what a terminal's Ctrl-C does
+    text, _ = p.communicate(timeout=60)
+    assert p.returncode == 130, text
+    assert text.strip().splitlines() == [text.strip()] and "Traceback" not in text, text
+    assert "run the same command again to resume" in text
+
+
 def test_interrupted_sweep_resumes_without_redoing(tmp_path):
     out = tmp_path / "sweep"
     args = ["--values", "linspace(8, 30, 10)", "--transient", "0.2", "--periods", "3", "--workers", "0",

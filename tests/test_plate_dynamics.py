@@ -154,6 +154,10 @@ def test_a_regional_pressure_and_point_stops():
     ({"obstacles": [PlateObstacle(g1=-1e-3, points=((0.0, 0.5),))]}, "it would never act"),
     ({"obstacles": [PlateObstacle(points=((0.3, 0.3),), g1=0.0)]}, "not a vertex"),
     ({"obstacles": [PlateObstacle(g1=1e-3, g2=0.0)]}, "need g1 < g2"),
+    # two obstacles that cross: the line names which one gave each bound
+    ({"obstacles": [PlateObstacle(g1=-1e-3, g2=1e-3),
+                    PlateObstacle(g1=2e-3, region=(0.5, 1, 0, 1))]},
+     r"g1=0.002 of obstacle 1, g2=0.001 of obstacle 0\)"),
     ({"obstacles": [PlateObstacle(g1=1e-6, region=(0.5, 1, 0, 1))],
       "initial": PlateInitial(static=Pressure(-1e3))},
      "violates the obstacles"),

@@ -241,6 +241,7 @@ def _contact_rows(space, obstacles, position):
     of the obstacles at each vertex whose w is free and bounded."""
     nv = space.vertices.shape[1]
     lo, hi = np.full(nv, -np.inf), np.full(nv, np.inf)
+    lo_of, hi_of = np.full(nv, -1), np.full(nv, -1)     # the obstacle giving each bound
     held = position[space.w_dofs] < 0       # w fixed to 0 by a support
     for k, obstacle in enumerate(obstacles):
         g1, g2 = obstacle.bounds(space)
@@ -249,11 +250,14 @@ def _contact_rows(space, obstacles, position):
         if acts.any() and held[acts].all() and not np.any((g1 > 0) | (g2 < 0)):
             raise InputError(f"obstacle {k} acts only at vertices its plate's supports "
                              "hold at w = 0: it would never act")
+        lo_of[(g1 > lo) | np.isnan(g1)] = k
+        hi_of[(g2 < hi) | np.isnan(g2)] = k
         lo, hi = np.maximum(lo, g1), np.minimum(hi, g2)
     if np.isnan(lo).any() or np.isnan(hi).any() or np.any(lo >= hi):
         i = int(np.argmax(np.isnan(lo) | np.isnan(hi) | (lo >= hi)))
         raise InputError(f"obstacles at vertex ({space.vertices[0, i]:g}, "
-                         f"{space.vertices[1, i]:g}) need g1 < g2 (g1={lo[i]:g}, g2={hi[i]:g})")
+                         f"{space.vertices[1, i]:g}) need g1 < g2 (g1={lo[i]:g} of obstacle "
+                         f"{lo_of[i]}, g2={hi[i]:g} of obstacle {hi_of[i]})")
     if np.any(held & ((lo > 0) | (hi < 0))):
         i = int(np.argmax(held & ((lo > 0) | (hi < 0))))
         raise InputError(f"vertex ({space.vertices[0, i]:g}, {space.vertices[1, i]:g}) is "

@@ -186,3 +186,13 @@ def test_a_bar_that_starts_on_its_obstacle_opens_its_event_at_the_first_step(tmp
         first = next(csv.DictReader(fh))
     assert float(first["t_start"]) == pytest.approx(1e-3, rel=1e-12)
     assert float(first["velocity"]) == -1.0
+
+
+def test_a_flat_profile_is_not_called_point_stops():
+    """One breakpoint is a point stop only where the bounds act at that x alone: the flat
+    obstacles' profile (x ≥ L/2, kink at L/2) was labelled "point stops at x=5" in the
+    spring-support table, summary.json and exports."""
+    from skfem_beam.output.events import _describe
+    assert _describe(scenes.flat_profile(10.0)) == "profile, kink at x=5"
+    assert _describe(Obstacles.point_stops(1.5, -0.1, 0.1)) == "point stops at x=1.5"
+    assert _describe(Obstacles.span(1.0, 2.0, g1=-0.1)) == "span [1, 2]"

@@ -57,6 +57,37 @@ def test_energy_decay_only_at_impacts(tmp_path):
         assert steady.mean() > 0.5               # constant between impacts
 
 
+def test_energy_decay_compares_its_own_law_and_reports_an_unstable_comparison(tmp_path,
+                                                                            capsys):
+    """energy.csv: the comparison is the run's own law at --compare-beta (penalty: its
+    springs, not exact contact; the column beside it is the run's), none where the βs
+    agree; an unstable comparison (β = 0 above its step limit) is one warning and NaN from
+    its end, the run's folder complete; Moreau–Jean has no β to compare."""
+    for name, args, columns in (
+            ("penalty", ["--law", "penalty", "--compare-beta", "0.5"],
+             ["t", "energy_beta_0.25", "energy_beta_0.5"]),
+            ("same", ["--restitution", "0.5", "--compare-beta", "0.5"],
+             ["t", "energy_beta_0.5"]),
+            ("unstable", ["--compare-beta", "0"], ["t", "energy_beta_0.5", "energy_beta_0"]),
+            ("mj", ["--law", "moreau-jean"], ["t", "energy_theta_0.5"])):
+        (tmp_path / name).mkdir()
+        code, out = run_case(energy_decay, tmp_path / name, "--T", "0.2", *args)
+        assert code == 0, name
+        rows = list(csv.DictReader(open(out / "energy.csv")))
+        assert list(rows[0]) == columns, name
+        assert json.loads((out / "summary.json").read_text())["status"] == "success"
+        own = np.array([float(r[columns[1]]) for r in rows])
+        series = list(csv.DictReader(open(out / "timeseries.csv")))
+        assert own[-1] == pytest.approx(float(series[-1]["energy"]), rel=1e-12), name
+        if name == "unstable":
+            other = np.array([float(r["energy_beta_0"]) for r in rows])
+            assert np.isnan(other[-1]) and np.isfinite(other[0])
+            assert "--compare-beta 0: that run is unstable" in capsys.readouterr().err
+    code, out = run_case(energy_decay, tmp_path, "--law", "moreau-jean", "--compare-beta", "0.3")
+    assert code == 2 and "Moreau–Jean has no β to compare" in capsys.readouterr().err
+    assert not out.exists()
+
+
 MESHES = __import__("pathlib").Path(__file__).parents[1] / "meshes"
 
 

@@ -93,7 +93,11 @@ def _acting(obstacles, x: float, bound: int) -> int | None:
 
 def _describe(part) -> str:
     br = tuple(getattr(part, "breakpoints", ()))
-    if len(br) == 1:
+    if len(br) == 1:     # point stops, or a profile with one kink (flat obstacles' x = L/2)
+        near = br[0] + np.array([-1e-6, 1e-6]) * max(1.0, abs(br[0]))
+        lo, hi = part.bounds(near)
+        if np.isfinite(lo).any() or np.isfinite(hi).any():
+            return f"profile, kink at x={br[0]:g}"
         return f"point stops at x={br[0]:g}"
     if len(br) == 2:
         return f"span [{br[0]:g}, {br[1]:g}]"

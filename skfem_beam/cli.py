@@ -119,14 +119,26 @@ def parse(p: Parser, argv=None):
     args = stored_args(p.parse_args(argv), p, argv)
     if hasattr(args, "law"):
         check_law(args, p)
-        if args.law == methods.MOREAU_JEAN and not args.resume \
-                and "beta" in _given(p, argv):
-            # it was checked and not used: --beta 0 ran as stable, warned of its limit
-            raise InputError(f"--beta {args.beta:g} is the β-scheme's β; --law "
-                             f"{methods.MOREAU_JEAN} has none (its θ: --theta)")
+        if not args.resume:
+            not_its_law(args, _given(p, argv))
         if args.beta is None:
             args.beta = methods.default_beta(method(args))
     return args
+
+
+def not_its_law(args, given: dict) -> None:
+    """Flags of another law than the one named are refused: they were checked and not used
+    (--beta 0 with Moreau–Jean ran as stable; --stiffness nan ran exact contact)."""
+    if args.law == methods.MOREAU_JEAN and "beta" in given:
+        raise InputError(f"--beta {args.beta:g} is the β-scheme's β; --law "
+                         f"{methods.MOREAU_JEAN} has none (its θ: --theta)")
+    if args.law != "penalty" and "stiffness" in given:
+        raise InputError(f"--stiffness {args.stiffness:g} is the penalty law's spring (N/m); "
+                         f"--law {args.law} has none (give --law penalty)")
+    if "method" in given and "law" in given \
+            and methods.summary_word(args.law) != given["method"]:
+        raise InputError(f"--method {given['method']} and --law {given['law']} name two "
+                         "laws: give one of them")
 
 
 def check_law(args, p: Parser) -> None:

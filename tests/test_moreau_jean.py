@@ -118,3 +118,20 @@ def test_a_beta_given_to_moreau_jean_is_refused(tmp_path, capsys):
                                 "contact.law=moreau-jean", "--set", "time.beta=0", "--T", "0.1",
                                 "--format", "none", "--out", str(out)]) == 0
     assert "stability limit" not in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("args, line", [
+    (["--stiffness", "nan"], "--stiffness nan is the penalty law's spring (N/m); --law "
+     "position has none (give --law penalty)"),
+    (["--law", "moreau-jean", "--stiffness", "-1"], "--law moreau-jean has none"),
+    (["--method", "penalty", "--law", "position"],
+     "--method penalty and --law position name two laws: give one of them"),
+    (["--method", "contact", "--law", "penalty"], "name two laws"),
+])
+def test_a_flag_of_another_law_is_refused(tmp_path, capsys, args, line):
+    """--stiffness without the penalty law, and --method and --law naming two laws, were
+    accepted and not used (nan and −1 ran exact contact, stored in summary.json)."""
+    from conftest import assert_refused
+    from skfem_beam.cases import point_stops
+    assert_refused(point_stops.main, [*args, "--T", "0.01", "--out", str(tmp_path / "a")],
+                   line, capsys, tmp_path)

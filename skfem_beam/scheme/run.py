@@ -207,6 +207,38 @@ class Run:
         self._hold_rows(n1 // self.save_every)
         return self.scheme.steps(self.out, n0, n1, Ebound, inputs)
 
+    def _chunk(self, n0, n1, Ebound, inputs) -> int:
+        """Steps n0..n1−1 (``inputs`` from n0), the impact events taken as they fill their
+        buffer; the loop's stop code."""
+        code = self._steps(n0, n1, Ebound, inputs)
+        while code == EVENTS_FULL:       # take the impact events, go on from where it stopped
+            self._take_events()
+            k = self.stopped_at - n0
+            code = self._steps(self.stopped_at, n1, Ebound,
+                               Inputs(inputs.G[k:], inputs.phi[k:],
+                                      inputs.H[k:] if inputs.H.shape[0] else inputs.H))
+        self._take_events()
+        return code
+
+    def _snapshot(self) -> dict:
+        """The integrator's state now (its CHECKPOINT fields, a Python law's warm start),
+        the events so far; ``again``: False for a Python law that cannot save its state
+        (stepping again would not give the same states)."""
+        sc = self.scheme
+        again = sc.pysolver is None or hasattr(sc.pysolver, "checkpoint")
+        return {"st": {v: getattr(sc.st, v).copy() for v in sc.CHECKPOINT.values()},
+                "solver": sc.pysolver.checkpoint() if sc.pysolver is not None and again
+                else None, "events": len(self.events), "again": again}
+
+    def _back_to(self, snap: dict) -> None:
+        sc = self.scheme
+        for v, a in snap["st"].items():
+            getattr(sc.st, v)[...] = a
+        sc.restored()
+        if snap["solver"] is not None:
+            sc.pysolver.restore(snap["solver"])
+        del self.events[snap["events"]:]
+
     def _take_events(self) -> None:
         k = int(self.st.counters[EVENTS_WRITTEN])
         if k:
@@ -266,17 +298,10 @@ class Run:
                       else self.scheme.inputs(n0, n1))[1]
         G = inputs.G
         Ebound = self._energy_bound(G, n1)
-        # the running diagnostics before the chunk: an unstable chunk's are not the run's
-        self._before = self.st.stats.copy(), self.st.counters[:3].copy(), n0
-        code, at = self._steps(n0, n1, Ebound, inputs), n0
-        while code == EVENTS_FULL:       # take the impact events, go on from where it stopped
-            self._take_events()
-            at = self.stopped_at
-            k = at - n0
-            code = self._steps(at, n1, Ebound, Inputs(G[k:], inputs.phi[k:],
-                                                      inputs.H[k:] if inputs.H.shape[0]
-                                                      else inputs.H))
-        self._take_events()
+        # the state before the chunk: an unstable chunk is stepped again from it, up to its
+        # last good state (_unstable)
+        self._before = self._snapshot(), n0, Ebound, inputs
+        code = self._chunk(n0, n1, Ebound, inputs)
         if code == 0 and n1 < self.n_steps:
             # the next chunk's inputs now, while the writer thread may still be formatting
             # the last chunk's rows but has not got this one's: computed while it formats
@@ -341,15 +366,26 @@ class Run:
 
     def _unstable(self, k: int, why: str, good: int) -> None:
         """Stop as unstable at state ``k`` (``why``), keeping the saved states up to
-        ``good`` (the last one that passed every test) but not after the chunk's start,
-        whose running diagnostics (penetration, impacts, contact steps) are kept."""
-        self.st.stats[:], self.st.counters[:3], n0 = self._before
-        # the states after the chunk's start have no diagnostics of their own: keeping their
-        # rows made summary.json's impacts and penetration disagree with impacts.csv
-        good = min(good, n0 // self.save_every * self.save_every)
+        ``good`` (the last one that passed every test): the chunk is stepped again from
+        its start to ``good`` (the same bits), so that the running diagnostics
+        (penetration, impacts, contact steps) are those of the states kept."""
+        snap, n0, Ebound, inputs = self._before
+        self._back_to(snap)
+        if not (snap["again"] and self.watch.norm()) or good <= n0 \
+                or self._chunk(n0, good, Ebound, inputs) != 0:
+            # the chunk's start: the energy is no norm (Watch.norm), a Python law without a
+            # checkpoint, or a code ≠ 0 stepping again to good (not seen: the same states)
+            self._back_to(snap)
+            good, cut = min(good, n0 // self.save_every * self.save_every), n0 < good
+        else:
+            cut = False
         self.status = "unstable"
         self.message = f"unstable at step {k} (t={k * self.dt:.6g} s): {why}; " \
             f"dt={self.dt:g} s, {self.label}"
+        if cut:
+            self.message += (f"; rows kept up to the chunk's start, step {good}: this "
+                             "run's energy is no norm of its state (massless rows, or Δt "
+                             "beyond the linear limit) and can hide the growth before")
         if self.beta is not None:
             limit = linear_limit(kappa_h(self.system), self.beta)
             if math.isfinite(limit):        # β ≥ 1/4 has none

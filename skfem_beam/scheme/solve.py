@@ -35,7 +35,8 @@ def solve(system, dt: float, T: float, beta: float | None = None, method=None, *
     The run stops with status "unstable" when the discrete energy exceeds
     ``growth_limit`` × the a-priori bound (√E¹ + Σ‖Gⁿ‖_{N⁻¹}Δt)² (operators.load_norms),
     turns negative, or a state is non-finite or runs away (scheme.watch); what was
-    computed up to the start of the 20,000-step chunk where that was found is returned.
+    computed up to the last state that passed is returned (up to the start of the
+    20,000-step chunk where that was found, when the energy is no norm: Watch.norm).
     """
     if not isinstance(system, SemiDiscrete):
         raise InputError(f"solve needs a semi-discrete system (beam_system(problem), "

@@ -14,9 +14,11 @@ energies and its last state.
 - **The last state of a chunk**, saved or not (``save_every`` may not divide the chunk, or
   be larger than the run): finite, and the two tests above.
 
-An unstable run keeps no row after the start of the chunk it was found in (scheme.Run):
-½E_β can hide the growth until the chunk's end, and only there are the running
-diagnostics (penetration, impacts) known.
+An unstable run keeps its saved rows up to the last state that passed these tests, stepped
+again from its chunk's start so that its running diagnostics (penetration, impacts) are
+theirs, where the energy is a norm of the state (:meth:`Watch.norm`); where it is not (Δt
+at or beyond the linear limit, massless rows) ½E_β can hide the growth until the chunk's
+end, and the run keeps no row after the start of the chunk it was found in.
 
 A redistributed mass (massless rows: M singular) leaves ½E_β indefinite on those rows
 whatever Δt: there only finiteness and the loop's bound are checked."""
@@ -81,6 +83,14 @@ class Watch:
         if kinetic > Ebound and kinetic > Ebound / (1 - min(self._r2(), R2_CAP)):
             return f"kinetic energy {kinetic:.3g} above {Ebound:.3g}/(1 − r²)"
         return None
+
+    def norm(self) -> bool:
+        """Whether the saved energy is a norm of the state (Moreau–Jean's always; ½E_β
+        with no massless rows and β ≥ ¼ or Δt below the linear limit, r² < 1): then every
+        saved state that passed the loop's bound is a state of bounded energy, and an
+        unstable run keeps its rows up to the last one (scheme.Run._unstable); else the
+        growth can hide in it (module docstring) and they end at the chunk's start."""
+        return self.run.beta is None or (self.definite and self._r2() < 1.0)
 
     def _r2(self) -> float:
         if self._kappa is None:

@@ -66,6 +66,8 @@ def run_beam_case(case: str, problem, spec: RunSpec, stops=(), extra=None) -> in
         print_supports(Path(spec.options.out), spec.wear)
         print_springs(Path(spec.options.out))
         warn_no_contact(run, system)
+        if penalty:
+            warn_spring_gain(run)
     return code
 
 
@@ -117,6 +119,20 @@ def warn_no_contact(run, system) -> None:
         cli.warn(f"no contact in {run.n} steps: the largest displacement at the obstacles "
                  f"was {reach:.3g} m, their smallest clearance {gaps.min():.4g} m; g1, g2 "
                  "and x are in metres")
+
+
+def warn_spring_gain(run) -> None:
+    """One warning line when, with nothing doing work on the beam (no load, no moving
+    support or obstacle), the penalty springs' work raised its energy by more than 1 % of
+    its start: stiff springs under-resolved by Δt gain energy at impacts (docs/design.md,
+    "Penalty units"), and the run's numbers look like any other's."""
+    gain, start = float(run.st.work[2]), float(run.E1)
+    driven = run.st.work[1] != 0.0 or run.system.bound_motion is not None
+    if not driven and start > 0 and gain > 0.01 * start:
+        cli.warn(f"the penalty springs did {gain:.4g} of work, {100 * gain / start:.0f} % of "
+                 f"the starting energy {start:.4g}, with no load (work_contact in "
+                 "timeseries.csv): stiff springs that Δt does not resolve gain energy at "
+                 "impacts; lower --dt or --stiffness, or use exact contact (--law position)")
 
 
 def stability_warning(system, dt: float, beta: float):

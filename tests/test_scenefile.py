@@ -342,14 +342,24 @@ def test_massless_key_is_the_case_flag(tmp_path, capsys):
 
 
 def test_bar_element_and_mass_are_named_when_refused(tmp_path, capsys):
-    """A bar's [mesh] element and mass: one line naming the key, the value and the
-    choices; nothing written."""
+    """A bar's keys are named in its refusals (they named Bar's fields: N=0, k=-100,
+    b=-0.1): one line with the key, the value and what is allowed; nothing written.  A P2
+    run's summary.json says p2 (it said p1 whatever the element)."""
     bad = tmp_path / "bad"
     bad.mkdir()
     for key, word in (("element=p3", "[mesh] element='p3' is not one of: p1, p2"),
-                      ("mass=heavy", "[mesh] mass='heavy' is not one of: consistent, lumped")):
+                      ("mass=heavy", "[mesh] mass='heavy' is not one of: consistent, lumped"),
+                      ("J=0", "[mesh] J=0 must be a whole number ≥ 1"),
+                      ("obstacles.0.stiffness=-100", "[obstacles.0] stiffness=-100 must be"),
+                      ("damping.viscosity=-0.1", "[damping] viscosity=-0.1 must be ≥ 0")):
+        key = key if "." in key.split("=")[0] else f"mesh.{key}"
         assert_refused(run_main, [str(example("impacting_bar")), "--out", str(bad / "run"),
-                                  "--set", f"mesh.{key}"], word, capsys, bad)
+                                  "--set", key], word, capsys, bad)
+    out = tmp_path / "p2"
+    assert exit_code(run_main, [str(example("impacting_bar")), "--set", "mesh.element=p2",
+                                "--set", "time.T=0.1", "--format", "none",
+                                "--out", str(out)]) == 0
+    assert json.loads((out / "summary.json").read_text())["element"] == "p2"
 
 
 @pytest.mark.parametrize("scene, sets, flags", [

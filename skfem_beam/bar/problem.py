@@ -153,7 +153,7 @@ class Bar:
         object.__setattr__(self, "N", check_count("N", self.N, most=MAX_ELEMENTS))
         check_choice("obstacle", self.obstacle, OBSTACLES)
         check_choice("mass", self.mass, MASSES)
-        check_choice("element", self.element, ELEMENTS)
+        check_choice("element", self.element, tuple(ELEMENTS))
         check_choice("far_end", self.far_end, FAR_ENDS)
         object.__setattr__(self, "obstacle_at", _side(self.obstacle_at, self.L))
         if self.A is not None:

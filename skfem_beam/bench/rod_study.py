@@ -286,7 +286,8 @@ def accuracy_row(name: str, courant: float, N: int = 80, T: float = 12.0) -> dic
     return {"name": name, "dt_over_h": courant, "N": N, "set": dict(keys),
             "error": relative_error(r.observed["u0"], exact.u(0.0, r.t)),
             "drift": float(E[-1] / E[0] - 1.0), "drift_exact": float(E[-1] / E_exact - 1.0),
-            "impact_change": float(np.mean(changes)), "penetration": r.max_penetration,
+            "impact_change": float(np.mean(changes)) if changes else float("nan"),
+            "penetration": r.max_penetration,
             "status": r.status}
 
 

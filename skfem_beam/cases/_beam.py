@@ -126,8 +126,9 @@ def warn_spring_gain(run) -> None:
     support or obstacle), the penalty springs' work raised its energy by more than 1 % of
     its start: stiff springs under-resolved by Δt gain energy at impacts (docs/design.md,
     "Penalty units"), and the run's numbers look like any other's."""
-    gain, start = float(run.st.work[2]), float(run.E1)
-    driven = run.st.work[1] != 0.0 or run.system.bound_motion is not None
+    work = run.record.work
+    gain, start = float(work[WORK_TERMS.index("contact")]), float(run.E1)
+    driven = work[WORK_TERMS.index("input")] != 0.0 or run.system.bound_motion is not None
     if not driven and start > 0 and gain > 0.01 * start:
         cli.warn(f"the penalty springs did {gain:.4g} of work, {100 * gain / start:.0f} % of "
                  f"the starting energy {start:.4g}, with no load (work_contact in "

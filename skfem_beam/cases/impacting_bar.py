@@ -75,7 +75,7 @@ def main(argv=None) -> int:
                    help="p1 | p2: Lagrange elements of degree 1 or 2 (p2: twice the unknowns, "
                         "half the wave error at Δt/h = 0.4 with --beta 0.09)")
     args = cli.parse(p, argv)
-    check_choice("--element", args.element, ELEMENTS)
+    check_choice("--element", args.element, tuple(ELEMENTS))
 
     u0 = read_profile(args.u0_csv, "--u0-csv") if args.u0_csv else args.u0
     v0 = read_profile(args.v0_csv, "--v0-csv") if args.v0_csv else args.v0
@@ -127,7 +127,7 @@ def bar_summary(bar: Bar, run, series, method: str, config: dict) -> dict:
     spring = series.spring
     return {
         "case": CASE, "J": bar.N, "N": bar.N, "dt": run.dt, "T": series.n_steps * run.dt,
-        "beta": run.beta, "theta": run.theta, "element": "p1", "mass": bar.mass,
+        "beta": run.beta, "theta": run.theta, "element": bar.element, "mass": bar.mass,
         "method": method, "obstacle": bar.obstacle,
         "spring_stiffness": bar.k if spring else None,
         "bar": {"a": bar.a, "b": bar.b, "rho": bar.rho, "L": bar.L, "f": bar.f,

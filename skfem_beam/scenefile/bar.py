@@ -52,15 +52,28 @@ def bar_problem(data: dict, reader: Tables) -> Bar:
     if len(loads) > 1:
         raise InputError("a bar takes one [[loads]] value = f (a uniform body force, N/m³)")
     ini, mesh = data.get("initial", {}), data.get("mesh", {})
-    for key, allowed in (("mass", MASSES), ("element", ELEMENTS)):
+    for key, allowed in (("mass", MASSES), ("element", tuple(ELEMENTS))):
         if key in mesh:
             check_choice(f"[mesh] {key}", mesh[key], allowed)
     law = data.get("contact", {}).get("law", "auto")
-    return Bar(a=mat.E, b=data.get("damping", {}).get("viscosity", 0.0), rho=mat.rho, L=L,
-               f=loads[0].get("value", 0.0) if loads else 0.0,
-               v0=_bar_profile(ini.get("v0", 0.0), "v0", "v"),
-               u0=_bar_profile(ini.get("u0", 0.0), "u0", "u"),
-               obstacle="elastic" if "stiffness" in o and law != "penalty" else "rigid",
-               k=o.get("stiffness", 100.0), N=mesh.get("J", 100),
-               mass=mesh.get("mass", "average"), element=mesh.get("element", "p1"),
-               far_end=ends["right" if side == "left" else "left"], obstacle_at=o["x"], A=A)
+    try:
+        return Bar(a=mat.E, b=data.get("damping", {}).get("viscosity", 0.0), rho=mat.rho, L=L,
+                   f=loads[0].get("value", 0.0) if loads else 0.0,
+                   v0=_bar_profile(ini.get("v0", 0.0), "v0", "v"),
+                   u0=_bar_profile(ini.get("u0", 0.0), "u0", "u"),
+                   obstacle="elastic" if "stiffness" in o and law != "penalty" else "rigid",
+                   k=o.get("stiffness", 100.0), N=mesh.get("J", 100),
+                   mass=mesh.get("mass", "average"), element=mesh.get("element", "p1"),
+                   far_end=ends["right" if side == "left" else "left"], obstacle_at=o["x"],
+                   A=A)
+    except InputError as e:       # Bar's field names as the file's keys
+        name, eq, rest = str(e).partition("=")
+        if eq and name in BAR_FIELD_KEYS:
+            raise InputError(f"{BAR_FIELD_KEYS[name]}={rest}") from None
+        raise
+
+
+# Bar's fields whose refusals name them (``N=0 must be …``), as a scene file writes them
+BAR_FIELD_KEYS = {"N": "[mesh] J", "k": "[obstacles.0] stiffness", "b": "[damping] viscosity",
+                  "a": "[material] E", "rho": "[material] rho", "L": "[geometry] L",
+                  "f": "[loads.0] value", "A": "[section] A"}

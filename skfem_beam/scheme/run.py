@@ -42,6 +42,8 @@ class Record:
                        which tallies it even at μ = 0
     friction_residual  the largest residual of the friction's Gauss–Seidel (NSGS) so far;
                        None for a law without one (position level: each block exact)
+    work               the run's work sums so far, in the order of ``Run.work_terms``
+                       (damping, input, contact, …), in the units of the saved energy
     """
     contact_steps: int
     row_work: np.ndarray
@@ -49,6 +51,7 @@ class Record:
     row_planes: np.ndarray
     friction_tallied: bool
     friction_residual: float | None
+    work: np.ndarray
 
 
 def _frozen(a) -> np.ndarray:
@@ -154,7 +157,8 @@ class Run:
                       row_work=_frozen(st.rowwork), sector_work=_frozen(st.sectors),
                       row_planes=self._row_planes,
                       friction_tallied=bool(st.fc.shape[0]) or "friction" in self.work_terms,
-                      friction_residual=None if fres is None else float(fres[1]))
+                      friction_residual=None if fres is None else float(fres[1]),
+                      work=_frozen(st.work))
 
     @property
     def label(self) -> str:

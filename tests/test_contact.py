@@ -157,18 +157,26 @@ def test_lemma_4_1_decoupled_constraints():
 
 
 # ---------------------------------------------------------------- the exact method
+def small_box_problem(rng, trial: int):
+    """(D, y_f, lo, hi) of 1 to 5 coupled rows, some one-sided; every tenth degenerate
+    (free values exactly on a bound)."""
+    m = int(rng.integers(1, 6))
+    Q = rng.standard_normal((m, m))
+    D = Q @ Q.T + rng.uniform(0.01, 1) * np.eye(m)
+    yf = 2 * rng.standard_normal(m)
+    lo, hi = -rng.random(m), rng.random(m)
+    lo[rng.random(m) < 0.2] = -np.inf
+    if trial % 10 == 0:
+        yf[: m // 2 + 1] = hi[: m // 2 + 1]
+    return D, yf, lo, hi
+
+
 def test_box_qp_matches_enumeration_from_any_warm_start():
     rng = np.random.default_rng(11)
     worst, most = 0.0, 0
     for trial in range(200):
-        m = int(rng.integers(1, 6))
-        Q = rng.standard_normal((m, m))
-        D = Q @ Q.T + rng.uniform(0.01, 1) * np.eye(m)
-        yf = 2 * rng.standard_normal(m)
-        lo, hi = -rng.random(m), rng.random(m)
-        lo[rng.random(m) < 0.2] = -np.inf
-        if trial % 10 == 0:          # degenerate: free values exactly on a bound
-            yf[: m // 2 + 1] = hi[: m // 2 + 1]
+        D, yf, lo, hi = small_box_problem(rng, trial)
+        m = yf.size
         state = rng.integers(-1, 2, m).astype(np.int8)
         mu = np.zeros(m)
         its = box_qp(D, yf, lo, hi, state, mu)
@@ -211,14 +219,8 @@ def test_the_primal_dual_start_gives_goldfarb_idnanis_answer():
     μ to 1e-12, KKT in x to 1e-10, and fewer passes than Goldfarb–Idnani's one per row."""
     rng = np.random.default_rng(19)
     for trial in range(200):
-        m = int(rng.integers(1, 6))
-        Q = rng.standard_normal((m, m))
-        D = Q @ Q.T + rng.uniform(0.01, 1) * np.eye(m)
-        yf = 2 * rng.standard_normal(m)
-        lo, hi = -rng.random(m), rng.random(m)
-        lo[rng.random(m) < 0.2] = -np.inf
-        if trial % 10 == 0:
-            yf[: m // 2 + 1] = hi[: m // 2 + 1]
+        D, yf, lo, hi = small_box_problem(rng, trial)
+        m = yf.size
         mu = np.zeros(m)
         assert box_qp_pdas(D, yf, lo, hi, rng.integers(-1, 2, m).astype(np.int8), mu) > 0
         ref = enumerate_reference(D, yf, lo, hi)

@@ -559,3 +559,19 @@ def test_case_bad_csv_one_line_no_output(tmp_path, capsys, content, word):
     assert_refused(impacting_bar.main, ["--far-end", "clamped", "--v0", "0", "--u0-csv",
                                         str(path), "--out", str(folder / "run")], word, capsys,
                    folder)
+
+
+def test_a_restitution_that_cannot_act_on_the_first_impact_is_warned_of(tmp_path, capsys):
+    """Example 1 touches the obstacle at t = 0: the position-level restitution needs the
+    state before the first step, so e = 0 and e = 1 ran the same, without a word; one
+    warning line now (none with a gap the bar takes more than a step to close)."""
+    from conftest import exit_code
+    from skfem_beam.cases import impacting_bar
+    for args, warned in ((["--restitution", "1"], True),
+                         (["--restitution", "1", "--u0", "0.1"], False),
+                         (["--restitution", "1", "--law", "moreau-jean"], False)):
+        out = tmp_path / str(len(list(tmp_path.iterdir())))
+        assert exit_code(impacting_bar.main, [*args, "--T", "0.2", "--format", "none",
+                                              "--out", str(out)]) == 0
+        err = capsys.readouterr().err
+        assert ("restitution 1 does not act on the first impact" in err) == warned, args

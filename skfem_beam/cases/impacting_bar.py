@@ -31,14 +31,16 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+import numpy as np
+
 from .. import cli
 from ..bar import (Bar, BarSeries, bar_run, contact_periods, describe, energy_report, errors,
-                   read_profile, spring_step_ratio)
+                   profile_values, read_profile, spring_step_ratio)
 from ..chart_process import draw
 from ..output.charts import compare_chart
 from ..output.events import bar_impacts
 from ..output.stream import Series, execute, prepare
-from ..methods import Penalty
+from ..methods import Penalty, PositionLevel
 from ..spec import RunSpec
 from ..reference import BarExact
 from ..checks import check_choice
@@ -92,6 +94,7 @@ def run_bar_case(bar: Bar, spec: RunSpec) -> int:
     if isinstance(spec.method, Penalty) and bar.obstacle == "rigid":
         bar = replace(bar, k=spec.method.stiffness)   # the rigid obstacle as springs 1/ε
     prepare(spec.options)                                # fail before the run, not after
+    warn_first_step_restitution(bar, spec.method, s.dt)
     run = bar_run(bar, s.dt, s.T, beta=None, method=spec.method, frames=s.frames)
     exact = bar_exact(bar, s.T)
     method = "penalty" if isinstance(spec.method, Penalty) else "contact"
@@ -110,6 +113,24 @@ def run_bar_case(bar: Bar, spec: RunSpec) -> int:
                     events=lambda folder, run, last: bar_impacts(folder, run, bar, last))
     summary = bar_summary(bar, run, series, method, spec.config)
     return execute(run, spec.options, summary, stream, bar_charts(bar, series, exact, s.T))
+
+
+def warn_first_step_restitution(bar: Bar, method, dt: float) -> None:
+    """One warning line when a position-level restitution cannot act on the first impact:
+    the bar reaches the rigid obstacle within the first step (Example 1 touches it at
+    t = 0), and the Paoli–Schatzman rule restitutes from the state before, which the
+    first step does not have; e = 0 and e = 1 then gave the same run, silently."""
+    e = getattr(method, "restitution", 0.0)
+    if not isinstance(method, PositionLevel) or not e or bar.obstacle != "rigid":
+        return
+    end = 0.0 if bar.obstacle_at == "left" else bar.L
+    gap = bar.gap_sign * float(profile_values(bar.u0, np.array([end]))[0])
+    speed = -bar.gap_sign * float(profile_values(bar.v0, np.array([end]))[0])
+    if speed > 0 and gap <= speed * dt:
+        cli.warn(f"restitution {e:g} does not act on the first impact: the bar reaches the "
+                 f"obstacle within the first step (gap {gap:g} m at {speed:g} m/s), and the "
+                 "position-level rule needs the state before; it acts from the next impact "
+                 "on (--law moreau-jean restitutes this one)")
 
 
 def bar_exact(bar: Bar, T: float):

@@ -29,3 +29,16 @@ def test_gesv_refuses_where_np_linalg_solve_raises(bad):
         F[1] = np.inf
     assert not gesv(J, F.copy())
     assert not solve_numpy(J, F.copy())
+
+
+def test_matvec_is_numbas_d_at_x_bit_for_bit():
+    """The law's D @ x by BLAS dgemv through numba's entry point (contact.round_hole.matvec):
+    the call numba's own D @ x makes, so the same bits, empty shapes included."""
+    from skfem_beam.contact.round_hole import matvec, matvec_numpy
+    rng = np.random.default_rng(7)
+    for _ in range(300):
+        m, n = int(rng.integers(0, 12)), int(rng.integers(0, 12))
+        D = rng.standard_normal((m, n)) * 10.0 ** rng.uniform(-3, 3, (m, n))
+        x = rng.standard_normal(n)
+        mine, theirs = matvec(D, x), matvec_numpy(D, x)
+        assert mine.shape == (m,) and mine.tobytes() == theirs.tobytes()

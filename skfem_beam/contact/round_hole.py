@@ -172,7 +172,7 @@ def _active_rows(kind, piece, mu, act):
 @njit(cache=True)
 def _still_holds(D, yf, lo, hi, kind, lands, piece, mu, mu_new, tol):
     """Whether μ_new keeps the active set's signs and the inactive constraints."""
-    y = yf + D @ mu_new
+    y = yf + matvec(D, mu_new)
     for j in range(yf.size):
         if kind[j] == 0:
             if (mu[j] > 0.0 and mu_new[j] <= 0.0) or (mu[j] < 0.0 and mu_new[j] >= 0.0):
@@ -223,6 +223,43 @@ except (ImportError, AttributeError):
     _xgesv = None
 
 
+# BLAS dgemv the same way: the call numba's ``D @ x`` makes (C order: 't', n, m, lda = n;
+# numba.np.linalg.call_xxgemv), so the same bits, without compiling np.dot's generic
+# matrix-vector code (0.5 CPU s of a round-hole law's first compile, bench.cold_compile:
+# dot_2_impl and dot_3).  tests/test_round_hole_gesv.py holds it to D @ x.
+try:
+    from numba.np.linalg import ensure_blas
+    ensure_blas()
+    _dptr = types.CPointer(types.float64)
+    _xxgemv = types.ExternalFunction("numba_xxgemv", types.intc(
+        types.char, types.char, types.intp, types.intp, _dptr, _dptr, types.intp, _dptr,
+        _dptr, _dptr))
+except (ImportError, AttributeError):
+    _xxgemv = None
+
+
+@internal
+def matvec_numpy(D, x):
+    return D @ x
+
+
+if _xxgemv is None:
+    matvec = matvec_numpy
+else:
+    @internal
+    def matvec(D, x):
+        """D @ x for D C-contiguous (m × n) and x contiguous: BLAS dgemv, as numba's D @ x."""
+        m, n = D.shape
+        out = np.zeros(m)
+        if m == 0 or n == 0:
+            return out
+        one, zero = np.ones(1), np.zeros(1)
+        _xxgemv(100, 116, n, m, one.ctypes, D.ctypes, n, x.ctypes, zero.ctypes,
+                out.ctypes)                  # 100, 116: ord('d'), ord('t')
+        # one and zero used after the call: numba frees an array after its last use
+        return out if one.size + zero.size > 0 else out
+
+
 if _xgesv is None:
     gesv = solve_numpy
 else:
@@ -257,7 +294,7 @@ def _polish(D, yf, lo, hi, kind, lands, piece, mu, tol):
         return True
     mu_new = mu.copy()
     for _ in range(3):
-        y = yf + D @ mu_new
+        y = yf + matvec(D, mu_new)
         F = np.zeros(k)
         J = np.zeros((k, k))
         i = k - k       # 0, typed int64: a literal 0 compiled _piece_rows a second time

@@ -575,3 +575,16 @@ def test_a_restitution_that_cannot_act_on_the_first_impact_is_warned_of(tmp_path
                                               "--out", str(out)]) == 0
         err = capsys.readouterr().err
         assert ("restitution 1 does not act on the first impact" in err) == warned, args
+
+
+def test_a_row_every_k_states_keeps_the_runs_T_and_says_where_the_rows_end(tmp_path, capsys):
+    """--save-every 7 of 3000 steps: summary.json's T is the run's 3.0 s (it was the last
+    row's 2.996 s) and one note says the last row is state 2996, as a beam run says."""
+    from conftest import exit_code
+    from skfem_beam.cases import impacting_bar
+    out = tmp_path / "r"
+    assert exit_code(impacting_bar.main, ["--save-every", "7", "--format", "none",
+                                          "--out", str(out)]) == 0
+    s = json.loads((out / "summary.json").read_text())
+    assert s["T"] == 3.0 and s["steps"] == 3000
+    assert "the last saved row is state 2996 (t=2.996 s)" in capsys.readouterr().err

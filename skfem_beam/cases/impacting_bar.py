@@ -39,7 +39,7 @@ from ..bar import (Bar, BarSeries, bar_run, contact_periods, describe, energy_re
 from ..chart_process import draw
 from ..output.charts import compare_chart
 from ..output.events import bar_impacts
-from ..output.stream import Series, execute, prepare
+from ..output.stream import Series, execute, note_last_row, prepare
 from ..methods import Penalty, PositionLevel
 from ..spec import RunSpec
 from ..reference import BarExact
@@ -112,7 +112,10 @@ def run_bar_case(bar: Bar, spec: RunSpec) -> int:
                     field_until=series.n_steps, keep_all=True,   # errors need every row
                     events=lambda folder, run, last: bar_impacts(folder, run, bar, last))
     summary = bar_summary(bar, run, series, method, spec.config)
-    return execute(run, spec.options, summary, stream, bar_charts(bar, series, exact, s.T))
+    code = execute(run, spec.options, summary, stream, bar_charts(bar, series, exact, s.T))
+    if code == 0:      # the bar's run saves every state: its rows are the series' own
+        note_last_row(series.every, series.n_steps, run.dt)
+    return code
 
 
 def warn_first_step_restitution(bar: Bar, method, dt: float) -> None:
@@ -193,7 +196,7 @@ def bar_charts(bar: Bar, series, exact, T: float):
              {"exact total": data.get("energy_exact")}, title,
              "energy (J/m²)" if bar.A is None else "energy (J)")
         return {
-            "T": float(b.t[-1]), "steps": min(run.n, series.n_steps),
+            "T": min(run.n, series.n_steps) * run.dt, "steps": min(run.n, series.n_steps),
             "max_penetration": b.penetration, "max_nodal_violation": b.penetration,
             "energy_final": float(b.energy[-1] + b.load_potential[-1]),
             "impacts": len(periods), "contact_periods": periods,

@@ -245,11 +245,15 @@ def _note_last_step(run) -> None:
     if s is not None and abs(s.steps * s.dt - s.T) > 1e-9 * s.T:
         print(f"note: T={s.T:g} s is not a whole number of steps dt={s.dt:g} s: the run "
               f"ends at t={s.steps * s.dt:.9g} s ({s.steps} steps)", file=sys.stderr)
-    every, steps = getattr(run, "save_every", 1), getattr(run, "n_steps", 0)
-    if steps % every:       # the rows, and energy_final, stop short of the end
+    note_last_row(getattr(run, "save_every", 1), getattr(run, "n_steps", 0), run.dt)
+
+
+def note_last_row(every: int, steps: int, dt: float) -> None:
+    """One line when the rows, and energy_final, stop short of the run's last state."""
+    if steps % every:
         last = steps // every * every
         print(f"note: a row saved every {every} states does not divide the {steps} steps: "
-              f"the last saved row is state {last} (t={last * run.dt:.9g} s), not the last "
+              f"the last saved row is state {last} (t={last * dt:.9g} s), not the last "
               "state", file=sys.stderr)
 
 

@@ -194,3 +194,27 @@ def test_an_unstable_run_with_a_norm_energy_keeps_its_rows_to_the_last_good_stat
     tip = [float(r.split(",")[1]) for r in rows[1:]]
     assert tip == same.observed["tip_displacement"].tolist()
     assert s["impacts"] == same.impacts > 0
+
+
+def test_springs_below_a_quarter_keep_rows_to_the_chunk_start_only(tmp_path):
+    """Penalty springs at β = 0 with Δt below the structure's limit but above the one the
+    springs impose: ½E_β is no norm there (the kept rows held a runaway at ±270 m/s, 300×
+    the energy); the run keeps its chunk's start and says why; a run whose rows end
+    between saved states (save_every 13) has as many impacts in summary.json as in
+    impacts.csv (137 against 135 rows)."""
+    from conftest import exit_code
+    from skfem_beam.cases import point_stops
+    out = tmp_path / "springs"
+    assert exit_code(point_stops.main, ["--law", "penalty", "--beta", "0", "--stiffness",
+                                        "1e9", "--dt", "1e-5", "--T", "0.5", "--format",
+                                        "none", "--out", str(out)]) == 4
+    s = json.loads((out / "summary.json").read_text())
+    assert s["steps"] == 1 and "penalty springs below β = 1/4" in s["message"]
+    out = tmp_path / "every13"
+    assert exit_code(point_stops.main, ["--law", "penalty", "--stiffness", "1e11", "--dt",
+                                        "2e-4", "--T", "2", "--save-every", "13",
+                                        "--flush-every", "1", "--format", "none",
+                                        "--out", str(out)]) == 4
+    s = json.loads((out / "summary.json").read_text())
+    rows = (out / "impacts.csv").read_text().splitlines()
+    assert s["impacts"] == len(rows) - 1 > 100

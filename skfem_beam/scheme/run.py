@@ -379,8 +379,10 @@ class Run:
                 or self._chunk(n0, good, Ebound, inputs) != 0:
             # the chunk's start: the energy is no norm (Watch.norm), a Python law without a
             # checkpoint, or a code ≠ 0 stepping again to good (not seen: the same states)
+            # the run ends at the chunk's start, whose diagnostics those are (its rows at
+            # the last saved state before it, as any run that save_every does not divide)
             self._back_to(snap)
-            good, cut = min(good, n0 // self.save_every * self.save_every), n0 < good
+            good, cut = n0, n0 < good
         else:
             cut = False
         self.status = "unstable"
@@ -388,8 +390,9 @@ class Run:
             f"dt={self.dt:g} s, {self.label}"
         if cut:
             self.message += (f"; rows kept up to the chunk's start, step {good}: this "
-                             "run's energy is no norm of its state (massless rows, or Δt "
-                             "beyond the linear limit) and can hide the growth before")
+                             "run's energy is no norm of its state (massless rows, Δt beyond "
+                             "the linear limit, or penalty springs below β = 1/4) and can hide "
+                             "the growth before")
         if self.beta is not None:
             limit = linear_limit(kappa_h(self.system), self.beta)
             if math.isfinite(limit):        # β ≥ 1/4 has none

@@ -86,11 +86,16 @@ class Watch:
 
     def norm(self) -> bool:
         """Whether the saved energy is a norm of the state (Moreau–Jean's always; ½E_β
-        with no massless rows and β ≥ ¼ or Δt below the linear limit, r² < 1): then every
+        with no massless rows and β ≥ ¼, or Δt below the linear limit, r² < 1, without
+        penalty springs, whose stiffness that limit does not see): then every
         saved state that passed the loop's bound is a state of bounded energy, and an
         unstable run keeps its rows up to the last one (scheme.Run._unstable); else the
         growth can hide in it (module docstring) and they end at the chunk's start."""
-        return self.run.beta is None or (self.definite and self._r2() < 1.0)
+        if self.run.beta is None:
+            return True
+        # penalty springs stiffen the structure beyond κ_h: below β = ¼ their limit is lower
+        return self.definite and (self.run.beta >= 0.25 or not self.run.springs) \
+            and self._r2() < 1.0
 
     def _r2(self) -> float:
         if self._kappa is None:

@@ -73,13 +73,13 @@ def check_restitution(e, name: str = "restitution=") -> float:
     return e
 
 
-def check_count(name: str, value, least: int = 1, most: int | None = None) -> int:
-    """A whole number ≥ ``least`` (bools refused), ≤ ``most`` when given."""
+def check_count(name: str, value, least: int = 1, most: int | None = None,
+                beyond: str = "more than a machine's memory holds") -> int:
+    """A whole number ≥ ``least`` (bools refused), ≤ ``most`` when given (``beyond``: why)."""
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < least:
         raise InputError(f"{name}={value!r} must be a whole number ≥ {least}")
     if most is not None and value > most:
-        raise InputError(f"{name}={value!r} must be at most {most:,}: more than a machine's "
-                         "memory holds")
+        raise InputError(f"{name}={value!r} must be at most {most:,}: {beyond}")
     return int(value)
 
 

@@ -218,3 +218,32 @@ def test_springs_below_a_quarter_keep_rows_to_the_chunk_start_only(tmp_path):
     s = json.loads((out / "summary.json").read_text())
     rows = (out / "impacts.csv").read_text().splitlines()
     assert s["impacts"] == len(rows) - 1 > 100
+
+
+def test_a_save_every_beyond_64_bits_is_one_line(tmp_path, capsys):
+    """--save-every 2**63 was an OverflowError traceback and a folder left "running"."""
+    from conftest import assert_refused
+    from skfem_beam.cases import point_stops
+    assert_refused(point_stops.main, ["--T", "0.01", "--save-every", str(2**63), "--out",
+                                      str(tmp_path / "a")],
+                   "save_every=9223372036854775808 must be at most 4,611,686,018,427,387,904",
+                   capsys, tmp_path)
+
+
+def test_a_failed_runs_diagnostics_are_those_of_its_last_state(tmp_path):
+    """A contact solver failing at step 80 with --save-every 7: summary.json's steps (79),
+    impacts and impacts.csv are those of the last good state (they were a later state's
+    than the rows' while the run was cut to a saved state)."""
+    from conftest import exit_code
+    from skfem_beam.scenefile import example, run_main
+    out = tmp_path / "failed"
+    code = exit_code(run_main, [str(example("tube_round_holes")), "--set",
+                                "contact.law=penalty", "--set", "contact.stiffness=1e11",
+                                "--set", "time.dt=1e-3", "--T", "5", "--save-every", "7",
+                                "--format", "none", "--out", str(out)])
+    s = json.loads((out / "summary.json").read_text())
+    assert code == 3 and s["status"] == "failed" and s["steps"] == 79
+    rows = (out / "impacts.csv").read_text().splitlines()
+    t = rows[0].split(",").index("t_start")
+    starts = [float(r.split(",")[t]) for r in rows[1:]]
+    assert s["impacts"] == len(starts) > 0 and max(starts) <= 79e-3 + 1e-12

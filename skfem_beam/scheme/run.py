@@ -320,8 +320,9 @@ class Run:
             why = f": {error}" if error is not None else getattr(self.scheme, "failure", str)()
             if error is not None and not isinstance(error, SolverError):
                 raise error               # a bug in a user's law: its own traceback
-            # the last good saved state: its rows can be written before the error is said
-            self.n = max(self.n, ((k - 1) // self.save_every) * self.save_every)
+            # the last good state, whose diagnostics the run's are (its rows end at the last
+            # saved state at or before it): written before the error is said
+            self.n = max(self.n, k - 1)
             raise SolverError(f"the {self.solver} contact solver failed at step {k} "
                               f"(t={k * self.dt:.6g} s){why}")
         if code == UNSTABLE:

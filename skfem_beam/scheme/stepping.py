@@ -40,7 +40,10 @@ class Stepping:
         dt, T = check_positive("dt", self.dt), check_positive("T", self.T)
         object.__setattr__(self, "dt", dt)
         object.__setattr__(self, "T", T)
-        object.__setattr__(self, "save_every", check_count("save_every", self.save_every))
+        object.__setattr__(self, "save_every", check_count(
+            "save_every", self.save_every, most=2**62,
+            beyond="the loop counts in 64 bits (a row every more states than the run has "
+                   "keeps state 0 only)"))
         object.__setattr__(self, "frames", check_count("frames", self.frames))
         object.__setattr__(self, "growth_limit", check_positive("growth_limit",
                                                                  self.growth_limit))

@@ -248,6 +248,7 @@ class SelectorQP:
         self.side0 = None                       # S0 as a state (int8 per row)
         self.Y = None                           # (n, max_columns): G⁻¹ z_j, Fortran order
         self.col = {}                           # row j → its column of Y
+        self.batches = []                       # the rows of each add_columns since S0
         self.y0 = None                          # G⁻¹(F − A u_{S0})|F0 of this step
 
     def guesses_pay(self) -> bool:
@@ -277,6 +278,7 @@ class SelectorQP:
         if self.Y is None:
             self.Y = np.zeros((self.n, self.max_columns), order="F")
         self.col = {}
+        self.batches = []
         self.y0 = None
 
     def gsolve(self, b: np.ndarray) -> np.ndarray:
@@ -309,10 +311,31 @@ class SelectorQP:
             else:
                 R[d, i] = 1.0
         first = len(self.col)
+        self.batches.append(np.array(rows, dtype=np.int64))
         self.Y[:, first:first + rows.size] = self.gsolve(R)
         COUNTS["columns"] += rows.size
         for i, j in enumerate(rows):
             self.col[int(j)] = first + i
+
+    def checkpoint(self) -> dict:
+        """What the next steps' round-off depends on: S0 and the batches of columns
+        cached since (a resume that refactored on its own first set summed otherwise)."""
+        if self.side0 is None:
+            return {}
+        sizes = np.array([b.size for b in self.batches], dtype=np.int64)
+        return {"side0": self.side0.copy(), "batch_sizes": sizes,
+                "batch_rows": np.concatenate(self.batches) if self.batches
+                else np.zeros(0, np.int64)}
+
+    def restore(self, saved: dict) -> None:
+        """S0 factored again and its columns solved again, batch by batch: the same bits."""
+        if "side0" not in saved:
+            return
+        with _one_thread():          # as finish: OpenBLAS's threads sum in another order
+            self.rebase(np.asarray(saved["side0"], dtype=np.int8))
+            rows = np.asarray(saved["batch_rows"], dtype=np.int64)
+            for part in np.split(rows, np.cumsum(saved["batch_sizes"])[:-1]):
+                self.add_columns(part)
 
     def solve_updated(self, F, lo, hi, state, u) -> None:
         """u ← the minimiser with ``state`` pinned, from G = A_{S0}'s factor:
@@ -490,11 +513,13 @@ class XSpaceSolver:
         return mu, its + sweeps
 
     def checkpoint(self) -> dict:
-        return {"active": self.state.copy()}
+        return {"active": self.state.copy(),
+                **{f"qp_{k}": v for k, v in self.qp.checkpoint().items()}}
 
     def restore(self, saved: dict) -> None:
         if "active" in saved:
             self.state[:] = saved["active"]
+        self.qp.restore({k[3:]: v for k, v in saved.items() if k.startswith("qp_")})
 
 
 def jacobi_scaled(A, dof, lo, hi):

@@ -293,3 +293,15 @@ def test_a_pressure_over_a_rectangle_that_cuts_cells_has_its_exact_resultants(el
     got = [b[space.w_dofs].sum()] + [b @ space.basis.project(f) for f in (
         lambda x: x[0], lambda x: x[0] * x[1])]
     assert got == pytest.approx(exact, rel=1e-9)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"points": [], "g1": -1e-3}, "points=\\(\\) names no vertex"),
+    ({}, "needs g1 and/or g2"),
+    ({"g1": -np.inf, "points": [(0.5, 0.5)]}, "needs g1 and/or g2"),
+])
+def test_an_obstacle_that_would_act_nowhere_or_everywhere_is_refused(kwargs, message):
+    """PlateObstacle(points=[]) acted under the whole plate (an empty list read as no
+    points given), and one with neither g1 nor g2 ran with no constraint, silently."""
+    with pytest.raises(InputError, match=message):
+        PlateObstacle(**kwargs)

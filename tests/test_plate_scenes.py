@@ -297,3 +297,17 @@ def test_cells_too_small_for_the_elements_basis_are_one_line(capsys):
             "mesh.ny=600"]
     assert exit_code(modes_main, argv) == 2
     assert "the mesh's cells are too small for the bfs element" in capsys.readouterr().err
+
+
+def test_a_plate_file_without_its_kind_is_told_so(tmp_path, capsys):
+    """A plate's file without kind = "plate" is read as a beam's; its line said only
+    "[geometry] allows: L", and now says which kind its keys fit."""
+    from conftest import assert_refused
+    from skfem_beam.scenefile import example, run_main
+    text = example("plates/plate_rattling").read_text()
+    path, out = tmp_path / "nokind.toml", tmp_path / "out"
+    path.write_text("\n".join(l for l in text.splitlines() if not l.startswith("kind")))
+    out.mkdir()
+    assert_refused(run_main, [str(path), "--out", str(out / "r")],
+                   "no kind is written, so it is read as a beam; a plate's file says "
+                   "kind = \"plate\"", capsys, out)

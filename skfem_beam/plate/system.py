@@ -98,12 +98,20 @@ class PlateObstacle:
     g1: float | Callable = -np.inf
     g2: float | Callable = np.inf
     region: tuple[float, float, float, float] | None = None
-    points: tuple[tuple[float, float], ...] = ()
+    points: tuple[tuple[float, float], ...] | None = None
 
     def __post_init__(self):
         for name in ("g1", "g2"):
             check_bound(f"PlateObstacle {name}", getattr(self, name), "x, y")
-        object.__setattr__(self, "points", _points("PlateObstacle points", self.points))
+        if self.points is not None:
+            object.__setattr__(self, "points", _points("PlateObstacle points", self.points))
+            if not self.points:      # an empty list is no vertex, not the whole plate
+                raise InputError("PlateObstacle points=() names no vertex: give ((x, y), ...) "
+                                 "or leave points out for the whole plate or a region")
+        if not (callable(self.g1) or callable(self.g2) or np.isfinite(self.g1)
+                or np.isfinite(self.g2)):
+            raise InputError("PlateObstacle needs g1 and/or g2 (m): with neither it would "
+                             "never act")
         if self.points and self.region is not None:
             raise InputError("PlateObstacle: give region or points, not both")
 

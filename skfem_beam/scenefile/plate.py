@@ -183,7 +183,10 @@ def obstacles_of(data: dict, space) -> list:
             raise InputError(f"[{where}] points = [] names no vertex")
         g1, g2 = (_g(d[k], f"{where}.{k}") if k in d else default
                   for k, default in (("g1", -np.inf), ("g2", np.inf)))
-        out.append(PlateObstacle(g1, g2, region, points))
+        if not any(callable(g) or np.isfinite(g) for g in (g1, g2)):
+            raise InputError(f"[{where}] g1 = -inf and g2 = inf: it would never act (give a "
+                             "finite g1 and/or g2, m)")
+        out.append(PlateObstacle(g1, g2, region, points if "points" in d else None))
     return out
 
 

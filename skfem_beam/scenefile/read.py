@@ -58,9 +58,25 @@ def read(path, overrides=(), files: dict | None = None, text: str | None = None,
     try:
         check_keys(data, KINDS[kind], sets=sets)
     except InputError as e:
-        raise InputError(f"{path.name}: {e}") from None
+        raise InputError(f"{path.name}: {e}{_kind_hint(data, kind)}") from None
     return Parsed(path, text, data, kind, dict(files or {}),
                   None if meshes is None else dict(meshes))
+
+
+def _kind_hint(data: dict, kind: str) -> str:
+    """Where no ``kind`` is written (a beam) and another kind's keys fit the file: say so
+    (a plate file without it was told "[geometry] allows: L")."""
+    if "kind" in data:
+        return ""
+    for other, schema in KINDS.items():
+        if other != kind:
+            try:
+                check_keys({k: v for k, v in data.items() if k != "kind"}, schema)
+            except InputError:
+                continue
+            return f" (no kind is written, so it is read as a {kind}; a {other}'s file says " \
+                f"kind = \"{other}\")"
+    return ""
 
 
 def scene_path(path) -> Path:

@@ -311,3 +311,15 @@ def test_a_plate_file_without_its_kind_is_told_so(tmp_path, capsys):
     assert_refused(run_main, [str(path), "--out", str(out / "r")],
                    "no kind is written, so it is read as a beam; a plate's file says "
                    "kind = \"plate\"", capsys, out)
+
+
+def test_a_plate_above_its_step_limit_is_warned_of_before_it_runs(tmp_path, capsys):
+    """β = 0 with Δt above the plate's linear limit: a beam warned before the run, a
+    plate did not (it went unstable at step 7 without a word before)."""
+    from conftest import exit_code
+    from skfem_beam.scenefile import example, run_main
+    code = exit_code(run_main, [str(example("plates/plate_rattling")), "--set",
+                                "time.beta=0", "--format", "none",
+                                "--out", str(tmp_path / "r")])
+    err = capsys.readouterr().err
+    assert code == 4 and "is above the linear stability limit 2/√(κ_h(1−4β))" in err

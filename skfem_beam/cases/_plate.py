@@ -14,7 +14,7 @@ from ..output.plate import (UNITS, PlateFieldWriter, plate_cells,
                             plate_columns, plate_impacts, probe_name, vertex_w)
 from ..output.stream import Series, execute, prepare
 from ..spec import RunSpec
-from ._beam import warn_no_contact
+from ._beam import stability_warning, warn_no_contact
 
 
 def smallest_gap(system) -> float | None:
@@ -46,6 +46,8 @@ def run_plate_case(case: str, setup, spec: RunSpec) -> int:
     prepare(spec.options)                         # fail before the run, not after it
     system = setup.system
     run = spec.method.build(system, spec.stepping)
+    if run.beta is not None and run.beta < 0.25:     # β ≥ 1/4: no limit to warn of
+        stability_warning(system, run.dt, run.beta)
     plate = system.meta["plate"]
     summary = {
         "case": case, "kind": "plate", "element": plate.element, **geometry(plate),

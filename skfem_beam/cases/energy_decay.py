@@ -45,9 +45,12 @@ def main(argv=None) -> int:
     other = None if other < 0 else other
 
     def energy_files(folder, data, run):
-        columns = {"t": data["t"], f"energy_{run.label.replace('=', '_')}": data["energy"]}
-        if other is not None and other != run.beta:    # the same β: the same run
-            columns[f"energy_beta_{other:g}"] = compared(pb, args, spec, other, data["t"].size)
+        own = f"energy_{run.label.replace('=', '_')}"
+        columns = {"t": data["t"], own: data["energy"]}
+        if other is not None and other != run.beta:      # the same β: the same run
+            name = f"energy_beta_{other:g}"
+            name = f"energy_beta_{other!r}" if name == own else name   # 0.3000001 vs 0.3
+            columns[name] = compared(pb, args, spec, other, data["t"].size)
         write_timeseries(folder, columns, "energy.csv")
         draw(trajectory_chart, folder / "energy_decay.png", data["t"],
              {k: v for k, v in columns.items() if k != "t"},

@@ -1,8 +1,8 @@
-"""The periodic rod against its exact solution: convergence at a fixed Courant number and
-the energy drift over four periods.
+"""The periodic rod against its exact solution: the accuracy study of issue 40 (the
+default), every class and option, and convergence at a fixed Courant number.
 
-    python -m skfem_beam.bench.rod_study [--N 20,40,80,160] [--courant 0.4,0.04] [--T 12]
-        [--mass consistent,lumped,average] [--beta 0.25,0.5]
+    python -m skfem_beam.bench.rod_study --convergence [--N 20,40,80,160] [--courant 0.4,0.04]
+        [--T 12] [--mass consistent,lumped,average] [--beta 0.25,0.5]
 
 For each (mass, β, Courant number Δt/h, N): the L²(0, T) error of u(0, ·), the
 L²(0, T; L²(0, L)) and max-in-time L²(0, L) errors of u (Gauss points inside every
@@ -19,7 +19,7 @@ contact node's step-to-step oscillation), printed as a table and written
 to ``rod_study.csv`` in --out, then the best setting at each Courant number against the
 issue's targets (:func:`verdict`).  About 20 s once the kernels are compiled.
 
-    python -m skfem_beam.bench.rod_study --accuracy [--N 80] [--out docs]
+    python -m skfem_beam.bench.rod_study [--accuracy] [--N 80] [--out docs]
 
 The accuracy study of issue 40: every named setting of :data:`ACCURACY` (scene-file keys,
 usable as ``--set`` on the bar scene) at Δt/h = 0.4 and 0.04, with ONE error measure,
@@ -345,7 +345,10 @@ def main(argv=None) -> None:
     p.add_argument("--classes", action="store_true",
                    help="every class and option at one N (the first of --N; default 80)")
     p.add_argument("--accuracy", action="store_true",
-                   help="the named settings at Δt/h = 0.4, 0.04 (N default 80): rod_study.json")
+                   help="the named settings at Δt/h = 0.4, 0.04 (N default 80): rod_study.json "
+                        "(the default)")
+    p.add_argument("--convergence", action="store_true",
+                   help="the convergence table over --N, --courant, --mass, --beta (printed)")
     p.add_argument("--out", type=made_folder, default="docs",
                    help="folder for rod_study.csv (--classes) or rod_study.json (--accuracy)")
     p.add_argument("--N", type=counts, default=None,
@@ -356,11 +359,11 @@ def main(argv=None) -> None:
     p.add_argument("--beta", type=lambda s: [float(b) for b in s.split(",")],
                    default="0.25,0.5")
     args = p.parse_args(argv)
-    if args.accuracy:
-        accuracy(args.N[0] if args.N else 80, Path(args.out))
-        return
     if args.classes:
         classes(args.N[0] if args.N else 80, Path(args.out))
+        return
+    if not args.convergence:        # the issue's command: the accuracy study
+        accuracy(args.N[0] if args.N else 80, Path(args.out))
         return
     Ns = args.N or [20, 40, 80, 160]
     rows = []

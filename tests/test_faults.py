@@ -428,6 +428,19 @@ def test_full_disk_keeps_whole_rows_and_resumes_once_there_is_room(small_disk, t
     assert summary(out)["status"] == "success"
 
 
+def test_a_full_disk_before_any_checkpoint_reports_the_steps_of_its_rows(small_disk):
+    """Stopped by a full disk before its first checkpoint, the folder holds its rows only:
+    summary.json's steps are the last row's (it said the run's state, 200001 over rows
+    to step 160000)."""
+    out = small_disk / "run"
+    assert exit_code(point_stops.main, ["--dt", "5e-5", "--T", "2", "--flush-every", "1000",
+                                        "--format", "none", "--checkpoint-every", "1e6",
+                                        "--out", str(out)]) == 3
+    s, kept = summary(out), whole_rows(out)
+    assert s["status"] == "failed" and not (out / "checkpoint.npz").exists()
+    assert s["steps"] * 5e-5 == pytest.approx(float(kept[-1].split(",")[0]), abs=1e-12)
+
+
 def test_a_run_stopped_before_its_first_frame_has_no_field_files_until_resumed(
         small_disk, tmp_path, capsys):
     """The field files are made with the first frames (after the loop, in a run this

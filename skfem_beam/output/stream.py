@@ -238,6 +238,13 @@ def execute(run: Run, options: OutputOptions, summary: dict, series, finish) -> 
             folder.release()
 
 
+def _last_row_t(run, rows) -> float:
+    """The time of the last row kept (a bar's rows are decimated by its writer, not its
+    run: their own time)."""
+    t = getattr(rows, "last_t", None) if rows is not None and rows.rows else 0.0
+    return (rows.rows - 1) * run.save_every * run.dt if t is None else t
+
+
 def _note_last_step(run) -> None:
     """One line when T is not a whole number of steps: the run ends at the first step at
     or after T (Stepping.steps), which a user reading the last row should not wonder at."""
@@ -431,10 +438,7 @@ class _Stream:
 
     def what_is_kept(self) -> str:
         run, rows, kept = self.run, self.rows, self.kept
-        # the last row's own time: a bar's rows are decimated by its writer, not its run
-        t = getattr(rows, "last_t", None) if rows is not None and rows.rows else 0.0
-        if t is None:
-            t = (rows.rows - 1) * run.save_every * run.dt
+        t = _last_row_t(run, rows)
         ck_line = (f"the checkpoint at step {kept} (t={kept * run.dt:.6g} s)"
                    if kept is not None else "no checkpoint")
         frames = f", {self.fields.written} field frames" if self.fields is not None else ""
@@ -464,7 +468,11 @@ class _Stream:
     def failed_write(self, e: OSError) -> int:
         """A write refused (full disk, ...): status "failed", what is kept, exit 3."""
         run, folder = self.run, self.folder
-        folder.fail(e, steps=run.n, kept=self.what_is_kept(), **self.write_events(run.n))
+        # with no checkpoint the folder holds the rows only: its steps are theirs (it said
+        # 200001 over rows to step 160000)
+        steps = run.n if self.kept is not None else int(round(_last_row_t(run, self.rows)
+                                                               / run.dt))
+        folder.fail(e, steps=steps, kept=self.what_is_kept(), **self.write_events(run.n))
         again = _resume_command(folder)
         resume = (f"{_once_fixed(e)}, continue with: {again}" if self.kept is not None else
                   f"{_once_fixed(e)}, with no checkpoint (--checkpoint-every) run it again "

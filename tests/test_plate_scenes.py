@@ -323,3 +323,16 @@ def test_a_plate_above_its_step_limit_is_warned_of_before_it_runs(tmp_path, caps
                                 "--out", str(tmp_path / "r")])
     err = capsys.readouterr().err
     assert code == 4 and "is above the linear stability limit 2/√(κ_h(1−4β))" in err
+
+
+def test_a_plate_too_thick_for_kirchhoff_love_is_warned_of(tmp_path, capsys):
+    """A thickness of half the shorter side ran without a word; the thin-plate model's
+    limit (about 1/10) is now said in one line, and the shipped plates stay quiet."""
+    from conftest import exit_code
+    from skfem_beam.scenefile import example, run_main
+    for thickness, warned in ((0.5, True), (None, False)):
+        sets = ["--set", f"section.thickness={thickness}"] if thickness else []
+        out = tmp_path / str(thickness)
+        assert exit_code(run_main, [str(example("plates/plate_rattling")), *sets, "--T",
+                                    "0.0005", "--format", "none", "--out", str(out)]) == 0
+        assert ("Kirchhoff–Love plates are thin" in capsys.readouterr().err) == warned

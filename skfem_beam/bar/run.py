@@ -33,6 +33,10 @@ from ..checks import check_count
 from .problem import Bar
 from .system import bar_system
 
+# stored values ((steps + 2) × unknowns) up to which a bar run keeps every state as a
+# frame, which the energy split into kinetic and strain needs
+ALL_STATES_LIMIT = 4_000_000
+
 
 @dataclass
 class BarRun:
@@ -109,7 +113,7 @@ def bar_method(bar: Bar, method="contact", solver="auto", restitution: float = 0
 
 
 def bar_run(bar: Bar, dt: float, T: float, beta: float | None = 0.25, method="contact", *,
-            frames: int = 200, all_states_limit: int = 4_000_000, **words):
+            frames: int = 200, all_states_limit: int = ALL_STATES_LIMIT, **words):
     """The bar's :class:`~skfem_beam.scheme.Run` (not yet driven), to T + Δt, with the
     method of :func:`bar_method` (``words``: its ``solver``, ``restitution``,
     ``massless``; ``beta`` the method's β, None: a method object's own).
@@ -230,7 +234,7 @@ class BarSeries:
 
 
 def run_bar(bar: Bar, dt: float, T: float, beta: float = 0.25, method: str = "contact",
-            solver: str = "auto", all_states_limit: int = 4_000_000,
+            solver: str = "auto", all_states_limit: int = ALL_STATES_LIMIT,
             massless: str = "beta") -> BarRun:
     """Integrate the bar with the shared scheme (:func:`bar_run`, driven to its end)."""
     from ..scheme import drive

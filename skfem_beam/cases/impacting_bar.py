@@ -36,6 +36,7 @@ import numpy as np
 from .. import cli
 from ..bar import (Bar, BarSeries, bar_run, contact_periods, describe, energy_report, errors,
                    profile_values, read_profile, spring_step_ratio)
+from ..bar.run import ALL_STATES_LIMIT
 from ..chart_process import draw
 from ..output.charts import compare_chart
 from ..output.events import bar_impacts
@@ -99,7 +100,7 @@ def run_bar_case(bar: Bar, spec: RunSpec) -> int:
     if run.frame_every != 1 and run.beta is not None:
         cli.warn(f"energy_kinetic and energy_strain are NaN in this run: the β split needs "
                  f"every state, and {run.n_steps + 1} states of {run.system.n} unknowns pass "
-                 "the 4,000,000 values kept (energy, the total, is written)")
+                 f"the {ALL_STATES_LIMIT:,} values kept (energy, the total, is written)")
     exact = bar_exact(bar, s.T)
     method = "penalty" if isinstance(spec.method, Penalty) else "contact"
     series = BarSeries(bar, run, s.T, method, every=s.save_every, exact=exact)

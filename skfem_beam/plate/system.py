@@ -108,8 +108,7 @@ class PlateObstacle:
             if not self.points:      # an empty list is no vertex, not the whole plate
                 raise InputError("PlateObstacle points=() names no vertex: give ((x, y), ...) "
                                  "or leave points out for the whole plate or a region")
-        if not (callable(self.g1) or callable(self.g2) or np.isfinite(self.g1)
-                or np.isfinite(self.g2)):
+        if not bounds_act(self.g1, self.g2):
             raise InputError("PlateObstacle needs g1 and/or g2 (m): with neither it would "
                              "never act")
         if self.points and self.region is not None:
@@ -182,6 +181,11 @@ class PlateInitial:
             raise InputError(f"PlateInitial static={self.static!r} must be a Pressure (the "
                              "load whose static deflection starts the run) or None")
         _number_or_function("PlateInitial v0", self.v0, "m/s", "x, y")
+
+
+def bounds_act(g1, g2) -> bool:
+    """Whether an obstacle's g1, g2 (numbers or functions) bound w at all (not −inf, inf)."""
+    return any(callable(g) or np.isfinite(g) for g in (g1, g2))
 
 
 def _points(what: str, points) -> tuple:

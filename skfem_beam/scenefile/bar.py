@@ -3,9 +3,7 @@ area, the one obstacle at an end, the far end, the load and the initial profiles
 from __future__ import annotations
 
 from ..bar import Bar
-from ..checks import check_choice
 from ..errors import InputError
-from ..spaces.lagrange import ELEMENTS, MASSES
 from .parts import material_of, need, section_of
 from .read import Tables
 
@@ -52,9 +50,6 @@ def bar_problem(data: dict, reader: Tables) -> Bar:
     if len(loads) > 1:
         raise InputError("a bar takes one [[loads]] value = f (a uniform body force, N/m³)")
     ini, mesh = data.get("initial", {}), data.get("mesh", {})
-    for key, allowed in (("mass", MASSES), ("element", tuple(ELEMENTS))):
-        if key in mesh:
-            check_choice(f"[mesh] {key}", mesh[key], allowed)
     law = data.get("contact", {}).get("law", "auto")
     try:
         return Bar(a=mat.E, b=data.get("damping", {}).get("viscosity", 0.0), rho=mat.rho, L=L,
@@ -74,6 +69,7 @@ def bar_problem(data: dict, reader: Tables) -> Bar:
 
 
 # Bar's fields whose refusals name them (``N=0 must be …``), as a scene file writes them
-BAR_FIELD_KEYS = {"N": "[mesh] J", "k": "[obstacles.0] stiffness", "b": "[damping] viscosity",
+BAR_FIELD_KEYS = {"N": "[mesh] J", "mass": "[mesh] mass", "element": "[mesh] element",
+                  "k": "[obstacles.0] stiffness", "b": "[damping] viscosity",
                   "a": "[material] E", "rho": "[material] rho", "L": "[geometry] L",
                   "f": "[loads.0] value", "A": "[section] A"}

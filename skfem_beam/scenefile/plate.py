@@ -165,7 +165,7 @@ def _point(value, plate: Plate, where: str) -> tuple[float, float]:
 def obstacles_of(data: dict, space) -> list:
     """[[obstacles]] g1, g2 (m, at least one) over region or at points (a point must be
     a vertex of the mesh)."""
-    from ..plate.system import PlateObstacle, vertex_index
+    from ..plate.system import PlateObstacle, bounds_act, vertex_index
     out = []
     for i, d in enumerate(data.get("obstacles", [])):
         where = f"obstacles.{i}"
@@ -183,7 +183,7 @@ def obstacles_of(data: dict, space) -> list:
             raise InputError(f"[{where}] points = [] names no vertex")
         g1, g2 = (_g(d[k], f"{where}.{k}") if k in d else default
                   for k, default in (("g1", -np.inf), ("g2", np.inf)))
-        if not any(callable(g) or np.isfinite(g) for g in (g1, g2)):
+        if not bounds_act(g1, g2):
             raise InputError(f"[{where}] g1 = -inf and g2 = inf: it would never act (give a "
                              "finite g1 and/or g2, m)")
         out.append(PlateObstacle(g1, g2, region, points if "points" in d else None))

@@ -137,3 +137,15 @@ def random_broached(rng, widths, ridge: float):
     hole = Hole.broached(n, rng.uniform(*widths) * 2 * np.pi / n, 1.0, rng.uniform(-3, 3))
     A = rng.normal(size=(2, 2))
     return hole, A @ A.T + ridge * np.eye(2)
+
+
+@cache
+def compiled(kernel):
+    """A kernel compiled without a Python entry (``no_cpython_wrapper``: called from
+    compiled code only, e.g. contact.round_hole.inner), callable from a test."""
+    from numba import njit
+
+    @njit
+    def call(*args):
+        return kernel(*args)
+    return call

@@ -7,7 +7,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from conftest import assert_refused, exit_code, random_broached
+from conftest import assert_refused, compiled, exit_code, random_broached
 from skfem_beam.contact.round_hole import land_cone_solve, land_project
 from skfem_beam.errors import InputError
 from skfem_beam.holes import Hole, hole_from_table, land_excess
@@ -56,8 +56,8 @@ def test_one_block_is_the_projection_onto_k_in_the_d_metric():
     for _ in range(120):
         hole, D = random_broached(rng, (0.01, 1.0), 0.1)
         z = rng.normal(size=2) * 2.5
-        code = land_project(D[0, 0], D[0, 1], D[1, 1], z[0], z[1], 1.0, *hole.land_row(),
-                            root, mu)
+        code = compiled(land_project)(D[0, 0], D[0, 1], D[1, 1], z[0], z[1], 1.0,
+                                      *hole.land_row(), root, mu)
         if excess(hole, [z])[0] <= 0:
             assert code == 0 and not mu.any()
             continue
@@ -90,8 +90,8 @@ def test_several_blocks_satisfy_the_kkt_conditions_after_the_polish():
         for a in (0, 2):
             b = a + 1
             z = y[[a, b]] - D[[a, b]][:, [a, b]] @ mu[[a, b]]   # without its own μ
-            land_project(D[a, a], D[a, b], D[b, b], z[0], z[1], 1.0, *hole.land_row(),
-                         root, out)
+            compiled(land_project)(D[a, a], D[a, b], D[b, b], z[0], z[1], 1.0,
+                                   *hole.land_row(), root, out)
             assert np.abs(out - mu[[a, b]]).max() <= 1e-12 * max(1.0, np.abs(mu).max())
             assert excess(hole, [y[[a, b]]])[0] <= 1e-13
 

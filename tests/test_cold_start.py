@@ -8,7 +8,6 @@ import sys
 from pathlib import Path
 
 import skfem_beam
-from skfem_beam.scheme.kernels import CALLEES
 
 NOTICE = ("compiling numerical kernels (once per method and scene type; later runs load "
           "them)")
@@ -37,33 +36,6 @@ def test_cold_then_warm_run_same_files_one_notice(tmp_path):
         assert (tmp_path / "cold" / f).read_bytes() == (tmp_path / "warm" / f).read_bytes(), f
 
 
-CALLEES_CHILD = """
-from skfem_beam import aside, beam_system, scenes, solve
-from skfem_beam.methods import PositionLevel
-from skfem_beam.scheme.kernels import CALLEES
-child = aside.start(CALLEES)
-assert child is not None and child.wait() == 0, "the child failed"
-solve(beam_system(scenes.flat_obstacles(J=8)), dt=1e-3, T=0.05, method=PositionLevel("active-set"))
-for f, sig in CALLEES:   # loaded from the child's cache entry, compiled for no other types
-    print(f.py_func.__name__, sum(f.stats.cache_hits.values()),
-          sum(f.stats.cache_misses.values()), len(f.signatures))
-"""
-
-
-def test_the_callees_compiled_aside_are_the_loops(tmp_path):
-    """kernels.CALLEES, which a fresh install compiles in a child (skfem_beam.aside) while
-    run_steps compiles, carry the types run_steps calls them with: the loop's compile then
-    loads each from the child's cache entry instead of compiling it again."""
-    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
-    p = subprocess.run([sys.executable, "-c", CALLEES_CHILD], env=env, capture_output=True,
-                       text=True)
-    assert p.returncode == 0, p.stderr
-    rows = [line.split() for line in p.stdout.splitlines()]
-    assert [r[0] for r in rows] == ["rows_matvec", "csr_product", "rows_dot", "write_event",
-                                    "energy_beta", "add_columns"], p.stdout
-    assert all(r[1:] == ["1", "0", "1"] for r in rows), p.stdout
-
-
 PLATE_CHILD = """
 from skfem_beam import aside
 from skfem_beam.linalg import band_solve
@@ -79,23 +51,21 @@ system = plate_system(plate_space(Plate(nx=4, ny=4)), obstacles=[PlateObstacle(g
                       initial=PlateInitial(static=Pressure(1e4)))
 r = solve(system, 1e-4, 2e-3)
 print(len(band_solve.signatures), sum(band_solve.stats.cache_misses.values()))
-print(" ".join(started[0]))
-print(" ".join(sum(started[1:], [])), r.solver)
+print(" ".join(sum(started, [])), r.solver)
 """
 
 
-def test_a_plate_run_sends_the_callees_and_its_law_aside(tmp_path):
+def test_a_plate_run_sends_its_law_aside(tmp_path):
     """A plate builds W without `band_solve` (operators.multi_rhs_W): BetaScheme compiles
     it once the law is set up, for the one signature the start step and the loop call it
-    with, so that a fresh install sends kernels.CALLEES and the law aside there, before
-    the loop's compile (else all compiled on one core); a beam's run compiles no other."""
+    with, so that a fresh install sends the law aside there, before the loop's compile
+    (else all compiled on one core); a beam's run compiles no other."""
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
     p = subprocess.run([sys.executable, "-c", PLATE_CHILD], env=env, capture_output=True,
                        text=True)
     assert p.returncode == 0, p.stderr
-    compiled, callees, law = p.stdout.splitlines()
+    compiled, law = p.stdout.splitlines()
     assert compiled == "1 1", p.stdout
-    assert callees.split() == [f.py_func.__name__ for f, _ in CALLEES], p.stdout
     assert law == "active_set_kernel active-set", p.stdout
 
 

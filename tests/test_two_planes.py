@@ -8,7 +8,7 @@ import json
 import numpy as np
 import pytest
 
-from conftest import assert_refused, exit_code, resumed
+from conftest import assert_refused, compiled, exit_code, resumed
 from skfem_beam import methods
 from skfem_beam.methods import PositionLevel
 from skfem_beam.contact.round_hole import cone_solve, disk_kinds, disk_root
@@ -200,7 +200,7 @@ def test_one_disk_is_the_secular_equations_root():
     out = np.empty(3)
     for a, b, d in ((2.0, 0.3, 1.5), (1.0, 0.0, 4.0), (3.0, 0.0, 3.0), (1e-3, 2e-4, 5e-4)):
         z = np.array([1.3, -0.7])
-        disk_root(a, b, d, z[0], z[1], 0.4, out)
+        compiled(disk_root)(a, b, d, z[0], z[1], 0.4, out)
         p, t = out[:2], out[2]
         assert np.hypot(*p) == pytest.approx(0.4, rel=1e-15)
         assert np.abs((np.eye(2) + t * np.array([[a, b], [b, d]])) @ p - z).max() <= 1e-15

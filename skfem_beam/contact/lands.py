@@ -26,9 +26,11 @@ import numpy as np
 from numba import njit
 
 PIECE_ARC, PIECE_LINE, PIECE_CORNER = 1, 2, 3
+# called from compiled code only: no Python or C entry (round_hole.inner)
+inner = njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 
 
-@njit(cache=True)
+@inner
 def nearest_land(pa, pb, lands, angle):
     """(k, off): the land nearest p's direction and p's angle from its centre, in
     [−π/lands, π/lands]."""
@@ -47,7 +49,7 @@ def land_excess(pa, pb, r, lands, half, angle):
     return rho * np.cos(max(abs(off) - half, 0.0)) - r
 
 
-@njit(cache=True)
+@inner
 def lobe_geometry(k, lands, half, angle):
     """(φ₁, φ₂, δ) of lobe k: its first and second lines' normal angles, half its angle."""
     step = 2.0 * np.pi / lands
@@ -55,7 +57,7 @@ def lobe_geometry(k, lands, half, angle):
     return theta + half, theta + step - half, 0.5 * step - half
 
 
-@njit(cache=True)
+@inner
 def piece_of(code, r, lands, half, angle):
     """(kind, x, y, t_lo, t_hi) of the piece ``code``: PIECE_ARC; PIECE_LINE with its unit
     normal (x, y) and the segment's tangential coordinates p·(−y, x) ∈ [t_lo, t_hi];
@@ -74,7 +76,7 @@ def piece_of(code, r, lands, half, angle):
     return PIECE_CORNER, reach * np.cos(m), reach * np.sin(m), 0.0, 0.0
 
 
-@njit(cache=True)
+@inner
 def line_candidate(a, b, d, za, zb, r, ex, ey, t_lo, t_hi, out):
     """The projection of z onto the line p·e = r in the metric D⁻¹ (D = [[a, b], [b, d]]):
     p = z − sDe, s = (e·z − r)/eᵀDe, μ = −se.  If p lies on the segment [t_lo, t_hi]
@@ -91,7 +93,7 @@ def line_candidate(a, b, d, za, zb, r, ex, ey, t_lo, t_hi, out):
     return s * s * ede
 
 
-@njit(cache=True)
+@inner
 def corner_candidate(a, b, d, za, zb, qa, qb, out):
     """The corner q as the block's value: μ = D⁻¹(q − z) in out[0:2]; returns its cost
     (q − z)·μ = μᵀDμ (a corner of K is always in K)."""
@@ -102,7 +104,7 @@ def corner_candidate(a, b, d, za, zb, qa, qb, out):
     return ga * ma + gb * mb
 
 
-@njit(cache=True)
+@inner
 def piece_holds(code, pa, pb, mua, mub, r, lands, half, angle, tol):
     """Whether the block's value p with multiplier μ still satisfies the KKT conditions of
     its piece after the polish: μ pushes inwards (an arc: μ·p < 0, p on a land; a line:
@@ -139,19 +141,19 @@ def land_normal(pa, pb, lands, half, angle):
     return np.cos(phi), np.sin(phi)
 
 
-@njit(cache=True)
+@inner
 def on_land(pa, pb, lands, half, angle):
     """Whether p's direction lies on a land (1e-12 rad of slack)."""
     return abs(nearest_land(pa, pb, lands, angle)[1]) <= half + 1e-12
 
 
-@njit(cache=True)
+@inner
 def lobe_slips(phi1, phi2, va, vb):
     """(t₁·v, t₂·v): v along the tangents t_i = (−sin φ_i, cos φ_i) of a lobe's two lines."""
     return (-np.sin(phi1) * va + np.cos(phi1) * vb, -np.sin(phi2) * va + np.cos(phi2) * vb)
 
 
-@njit(cache=True)
+@inner
 def corner_forces(mua, mub, slips, f, phis, tol):
     """A corner's multiplier as two faces' Coulomb forces: −μ = λ₁g₁ + λ₂g₂ with
     g_i = e_i + σ_i f t_i (e_i = e(φ_i), t_i = R e_i; σ_i = sign(s_i), either sign when

@@ -37,6 +37,9 @@ from .lands import (PIECE_CORNER, PIECE_LINE, corner_candidate, land_excess, lin
                     lobe_geometry, piece_holds, piece_of)
 
 internal = njit(cache=True)   # also called from Python: the start step runs the law uncompiled
+# called from compiled code only: no Python or C entry (its compile: 0.5 of a broached
+# law's 4.4 CPU s, bench.cold_compile; the tests call them through tests/conftest.compiled)
+inner = njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 
 MAX_SWEEPS = 20000
 SWEEP_TOL = 1e-14        # a sweep moved no value y by more than this × the data's scale
@@ -51,7 +54,7 @@ def radial(ya, yb, lo_a, hi_a, lo_b, hi_b):
     return pa, pb, np.hypot(pa, pb), 0.5 * (hi_a - lo_a)
 
 
-@njit(cache=True)
+@inner
 def disk_root(a, b, d, z0, z1, r, out):
     """The point p = (I + tD)⁻¹z on the circle |p| = r (D = [[a, b], [b, d]] SPD, |z| > r):
     out[0:2] ← p, out[2] ← t.  Returns the Newton iterations."""
@@ -96,7 +99,7 @@ def disk_root(a, b, d, z0, z1, r, out):
     return its
 
 
-@njit(cache=True)
+@inner
 def land_project(a, b, d, za, zb, r, lands, half, angle, root, out):
     """A broached block (contact.lands): out[0:2] ← μ of z's projection onto K in the
     metric D⁻¹ (D = [[a, b], [b, d]]); returns its piece (0: z in K, μ = 0).  K is convex,
@@ -128,7 +131,7 @@ def land_project(a, b, d, za, zb, r, lands, half, angle, root, out):
     return code
 
 
-@njit(cache=True)
+@inner
 def _piece_rows(D, act, k, i, ab, offset, mu, code, lands, F, J):
     """Rows i, i+1 of the polish for a broached block on a line (e·p = r and μ ∥ e) or a
     corner (p = q): both linear in μ.  ``ab``: the block's rows (a, b); ``offset``: its
@@ -154,7 +157,7 @@ def _piece_rows(D, act, k, i, ab, offset, mu, code, lands, F, J):
     return False
 
 
-@njit(cache=True)
+@inner
 def _active_rows(kind, piece, mu, act):
     """The polish's unknowns: box rows and round blocks with μ ≠ 0 on their first row (as
     before broached holes), broached blocks on a piece (either row may carry μ)."""
@@ -169,10 +172,10 @@ def _active_rows(kind, piece, mu, act):
     return k
 
 
-@njit(cache=True)
+@inner
 def _still_holds(D, yf, lo, hi, kind, lands, piece, mu, mu_new, tol):
     """Whether μ_new keeps the active set's signs and the inactive constraints."""
-    y = yf + matvec(D, mu_new)
+    y = plus_matvec(yf, D, mu_new)
     for j in range(yf.size):
         if kind[j] == 0:
             if (mu[j] > 0.0 and mu_new[j] <= 0.0) or (mu[j] < 0.0 and mu_new[j] >= 0.0):
@@ -246,7 +249,7 @@ def matvec_numpy(D, x):
 if _xxgemv is None:
     matvec = matvec_numpy
 else:
-    @internal
+    @inner
     def matvec(D, x):
         """D @ x for D C-contiguous (m × n) and x contiguous: BLAS dgemv, as numba's D @ x."""
         m, n = D.shape
@@ -263,7 +266,7 @@ else:
 if _xgesv is None:
     gesv = solve_numpy
 else:
-    @internal
+    @inner
     def gesv(J, F):
         """F ← J⁻¹F (J square, k × k, C order); False (F undefined) where np.linalg.solve
         raises: J or F not finite, J singular."""
@@ -281,7 +284,16 @@ else:
         return r == 0 and a.size + ipiv.size > 0
 
 
-@internal
+@inner
+def plus_matvec(yf, D, mu):
+    """yf + D μ (a loop: the array expression compiled a kernel of its own)."""
+    y = matvec(D, mu)
+    for i in range(y.size):
+        y[i] = yf[i] + y[i]
+    return y
+
+
+@inner
 def _polish(D, yf, lo, hi, kind, lands, piece, mu, tol):
     """Newton on the active set's KKT equations (boxes on their bound, disks on their
     circle with μ_p ∥ −(y_p − c), broached blocks on their piece: _piece_rows), from the
@@ -294,7 +306,7 @@ def _polish(D, yf, lo, hi, kind, lands, piece, mu, tol):
         return True
     mu_new = mu.copy()
     for _ in range(3):
-        y = yf + matvec(D, mu_new)
+        y = plus_matvec(yf, D, mu_new)
         F = np.zeros(k)
         J = np.zeros((k, k))
         i = k - k       # 0, typed int64: a literal 0 compiled _piece_rows a second time
@@ -334,7 +346,7 @@ def _polish(D, yf, lo, hi, kind, lands, piece, mu, tol):
     return True
 
 
-@internal
+@inner
 def _block(D, y, lo, hi, kind, lands, piece, mu, a, root, out):
     """The disk block a's new μ in out[0:2] (module docstring; a broached block:
     land_project, its piece kept in piece[a] for the polish)."""
@@ -396,7 +408,7 @@ def land_cone_solve(D, yf, lo, hi, kind, lands, mu, active):
     return sweeps
 
 
-@internal
+@inner
 def sweep_start(yf, lo, hi, kind, mu):
     """A Gauss–Seidel's start: (y = y_f, the data's scale, the number of blocks: box
     rows and disks), μ ← 0."""
@@ -409,7 +421,7 @@ def sweep_start(yf, lo, hi, kind, mu):
     return yf.copy(), data_scale(yf, lo, hi), blocks
 
 
-@internal
+@inner
 def box_row(D, y, lo, hi, mu, j):
     """Box row j's projection (Lemma 4.1) with the others fixed; returns its change."""
     yt = y[j] - D[j, j] * mu[j]
@@ -422,7 +434,7 @@ def box_row(D, y, lo, hi, mu, j):
     return abs(D[j, j] * dj)
 
 
-@internal
+@inner
 def contact_flags(kind, mu, active):
     """The values in contact: a disk's first row when its μ_p ≠ 0, never its second row,
     a box row when its μ ≠ 0."""

@@ -3,6 +3,7 @@ field name), the start step, the loads of a chunk and the compiled loop over a c
 :class:`~skfem_beam.scheme.run.Run` drives it (chunks, saved rows, events, checkpoints)."""
 from __future__ import annotations
 
+import gc
 import math
 import sys
 from contextlib import contextmanager
@@ -14,7 +15,7 @@ from numba import typeof, types
 from numba.core import event
 from numba.core.dispatcher import LiftedCode
 
-from .. import aside
+from .. import _startup
 from ..checks import check_beta
 from ..contact import ContactLaw, StepData, resolve
 from ..contact.base import NoContact, no_explicit
@@ -22,7 +23,7 @@ from ..contact.registry import Auto
 from ..contact.round_hole import disk_kinds
 from ..errors import InputError, SolverError
 from ..linalg import band_solve, row_layout_of, rows_matvec
-from .kernels import (CALLEES, EVENT_COLUMNS, FRICTION_COLUMN, IMPACT_FIELDS, NC_COLUMNS,
+from .kernels import (EVENT_COLUMNS, FRICTION_COLUMN, IMPACT_FIELDS, NC_COLUMNS,
                       SECTORS, TANGENT_COLUMN, Inputs, Ops, PythonLaw, Series, State,
                       csr_product, energy_beta, friction_of_ops, lands_of, move_bounds,
                       record, run_steps, run_steps_python, track_impacts)
@@ -56,16 +57,15 @@ class _CompileNotice(event.Listener):
 event.register("numba:compile", _CompileNotice())
 
 
-class _CalleesAside(event.Listener):
-    """At the first compile it sees, a child compiles the loop's out-of-line callees, and
-    children the ``laws`` (contact.base.Compiled kernels)."""
-    def __init__(self, laws=()):
+class _LawAside(event.Listener):
+    """At the first compile it sees, children compile the ``laws`` (contact.base.Compiled
+    kernels)."""
+    def __init__(self, laws):
         self.started, self.laws = False, laws
 
     def on_start(self, ev):
         if not self.started:
             self.started = True
-            aside.start(CALLEES)
             for kernel in self.laws:
                 kernel.compile_aside()
 
@@ -74,16 +74,15 @@ class _CalleesAside(event.Listener):
 
 
 @contextmanager
-def _callees_aside(laws=()):
-    """While the step operators are built: should they compile `band_solve` (a fresh
-    install), a child compiles the loop's out-of-line callees (kernels.CALLEES) meanwhile,
-    so that `run_steps`' compile, ~1 s later, loads them from the cache (0.8 CPU s of its
-    own compile; the law's child starts only once the law is known, too late for them).
-    A plate builds W without `band_solve` (operators.multi_rhs_W): BetaScheme compiles it
-    once its law is set up, in this context with ``laws`` (the law's kernels), so that
-    the callees and the law go aside at once, 0.5–0.8 s before the loop's compile (else
-    nothing compiled before `start`: neither was sent aside, 21 s on one core → 13 s)."""
-    listener = _CalleesAside(tuple(laws))
+def _law_aside(laws):
+    """A plate builds W without `band_solve` (operators.multi_rhs_W): BetaScheme compiles
+    it once its law is set up, in this context with ``laws`` (the law's kernels), so that
+    a fresh install sends the law aside then, before the loop's compile (else nothing
+    compiled before `start` and the law was not sent aside: 21 s on one core → 13 s).
+    The loop's out-of-line callees (rows_matvec, energy_beta, ...) compile with the loop:
+    a third process for them, on two cores, made every shipped scene's first run slower
+    or no faster (docs/design.md, "The whole command")."""
+    listener = _LawAside(tuple(laws))
     event.register("numba:compile", listener)
     try:
         yield
@@ -255,9 +254,7 @@ class BetaScheme:
         if isinstance(law, Auto) and m > 0:
             law = law.before_operators(system.n, system.C) or law
         x_space = law.x_space and m > 0   # no W, no D
-        with _callees_aside():
-            self.op = op = step_operators(system, s.dt, beta, s.massless,
-                                          delassus=not x_space)
+        self.op = op = step_operators(system, s.dt, beta, s.massless, delassus=not x_space)
         self.step = StepData(op.A, op.C, op.D, np.ascontiguousarray(system.lo, dtype=float),
                              np.ascontiguousarray(system.hi, dtype=float), s.dt, beta,
                              disk_rows(system), land_rows(system), friction_of(system),
@@ -279,10 +276,10 @@ class BetaScheme:
         if op.Z.size and (law.kernel is None or law.explicit is not None):
             raise InputError(f"massless='quasi-static' needs an exact compiled contact law "
                              f"(projection, active-set, restitution), not {law.name!r}")
-        with _callees_aside(k for k in (law.kernel, law.explicit) if k is not None):
+        with _law_aside(k for k in (law.kernel, law.explicit) if k is not None):
             # the start step's and the loop's `band_solve`, should step_operators not have
             # compiled it (a plate's W is one LAPACK solve; an x-space law has no W): a
-            # fresh install then sends the callees and the law aside (a warm one loads it)
+            # fresh install then sends the law aside (a warm one loads it)
             band_solve.compile(BAND_SOLVE)
         self.loads = np.ascontiguousarray(system.loads, dtype=float)
         self.load_norm = load_norms(system, s.dt, beta)
@@ -373,6 +370,11 @@ class BetaScheme:
                 k.compile_aside()
         run_steps.compile(loop)
         _ = self._kernels     # wait for the law: the start step calls what it compiled
+        if _startup.COMMAND:
+            # the millions of objects the compile left out of the collector's sight: its next
+            # full collection walked them all (0.25 s of a broached tube's first run, in
+            # writing its frames); a command ends with the run
+            gc.freeze()
 
     def start(self, out) -> int:
         """u¹: one step of the scheme itself, from u⁰ and the fictitious u⁻¹ = u¹ − 2Δt v⁰

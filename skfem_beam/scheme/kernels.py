@@ -22,7 +22,7 @@ from __future__ import annotations
 from collections import namedtuple
 
 import numpy as np
-from numba import njit, objmode, types
+from numba import njit, objmode
 
 from ..contact.lands import land_excess, land_normal, land_split
 from ..linalg import add_columns, band_solve, csr_product, rows_dot, rows_matvec
@@ -652,18 +652,6 @@ def run_steps(law, explicit, ops, st, out, n0, n1, inputs, Ebound, holes, massle
         if code:
             return code
     return 0
-
-
-# What run_steps calls out of line in a run without holes or massless rows, with the types
-# it calls them with (every array of the tuples is C-contiguous): a fresh install compiles
-# them in a child beside this process's compile (BetaScheme, skfem_beam.aside);
-# tests/test_cold_start.py checks the types against the loop's.
-_v, _M, _i = types.float64[::1], types.float64[:, ::1], types.int64[::1]
-_J = types.int64[:, ::1]
-CALLEES = ((rows_matvec, (_M, _J, _v, _v, types.float64, types.boolean)),
-           (csr_product, (_i, _i, _v, _v, _v)), (rows_dot, (_M, _J, _v, _v)),
-           (write_event, (_M, _i, types.int64, _v)), (energy_beta, (_M, _J, _v, _v, _v, _v)),
-           (add_columns, (_M, _v, _v)))
 
 
 def lands_of(ops):

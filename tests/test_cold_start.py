@@ -5,9 +5,15 @@ import os
 import shutil
 import subprocess
 import sys
+from dataclasses import replace
 from pathlib import Path
 
+import pytest
+
 import skfem_beam
+from skfem_beam import beam_system
+from skfem_beam.contact import resolve
+from skfem_beam.scenefile import example, load
 
 NOTICE = ("compiling numerical kernels (once per method and scene type; later runs load "
           "them)")
@@ -74,3 +80,24 @@ def test_cold_compile_bench_runs_by_its_path():
     path = Path(skfem_beam.__file__).parent / "bench" / "cold_compile.py"
     p = subprocess.run([sys.executable, str(path), "--help"], capture_output=True, text=True)
     assert p.returncode == 0 and "--one-core" in p.stdout, p.stderr
+
+
+@pytest.mark.parametrize("name, early", [
+    ("tube_trefoil_holes.toml", "broached_hole_kernel"),
+    ("tube_round_holes.toml", "round_hole_kernel"),
+    ("tube_round_holes_friction.toml", "round_hole_friction_kernel"),
+    ("flat_obstacles.toml", None)])
+def test_the_law_sent_aside_early_is_the_one_its_setup_picks(name, early):
+    """A law whose kernel the step's rows decide (ContactLaw.kernels_for, read before the
+    step operators exist) goes aside while they are built: it must be the kernel `setup`
+    picks once they are; none where D decides (flat obstacles: projection or active set)."""
+    scene = load(example(name))
+    system = beam_system(scene.problem)
+    scheme = scene.method.build(system, scene.stepping).scheme
+    rows = replace(scheme.step, A=None, D=None)
+    picked = resolve("auto").kernels_for(rows)
+    if early is None:
+        assert picked == () and scheme.law.kernel is not None
+    else:
+        assert [k.func.__name__ for k in picked] == [early]
+        assert picked == (scheme.law.kernel,)

@@ -445,7 +445,9 @@ class ActiveSet(ContactLaw):
     name = "active-set"
     kernel = active_set_kernel
 
+    def kernels_for(self, step):
+        return (active_set_pdas_kernel if step.C.shape[0] >= PDAS_MIN else active_set_kernel,)
+
     def setup(self, step, first=False):
-        self.kernel = active_set_pdas_kernel if step.D.shape[0] >= PDAS_MIN \
-            else active_set_kernel
+        self.kernel, = self.kernels_for(step)
         return np.zeros(0)

@@ -181,6 +181,12 @@ class ContactLaw:
     def setup(self, step: StepData, first: bool = False) -> np.ndarray:
         return np.zeros(0)
 
+    def kernels_for(self, step: StepData) -> tuple:
+        """The compiled kernels `setup` will pick for ``step``, read from its rows alone
+        (its A and D are not built yet: None), so that a fresh install compiles them aside
+        while the step operators are built; () where that needs D (the default)."""
+        return ()
+
     def solver(self, step: StepData):
         raise NotImplementedError(f"the {self.name} law has no Python solver")
 

@@ -175,9 +175,16 @@ class Auto(ContactLaw):
 
     @staticmethod
     def choose(step: StepData) -> ContactLaw:
+        return Auto._holes(step) or (Projection() if step.decoupled else ActiveSet())
+
+    @staticmethod
+    def _holes(step: StepData) -> ContactLaw | None:
+        """The law for round holes or friction, read from the step's rows; None without."""
         fric = np.asarray(step.friction, dtype=float)
         if fric.size and np.any(fric > 0):
             return RoundHoleFriction()
-        if step.disks.size:
-            return RoundHole()
-        return Projection() if step.decoupled else ActiveSet()
+        return RoundHole() if step.disks.size else None
+
+    def kernels_for(self, step):
+        law = self._holes(step)       # else projection or active set: D decides
+        return law.kernels_for(step) if law is not None else ()

@@ -502,6 +502,11 @@ def broached_hole_kernel(D, yf, y_cur, y_prev, lo, hi, params, state, mu, active
                            active)
 
 
+def broached(step) -> bool:
+    """Some hole of the step is broached (StepData.lands: lands > 0)."""
+    return bool(step.lands.size and np.any(step.lands[:, 0] > 0))
+
+
 def disk_params(disks) -> np.ndarray:
     """[q, a0, b0, a1, b1, ...]: the disk pairs as a law's float constants."""
     d = np.asarray(disks, dtype=float).reshape(-1, 2)
@@ -520,10 +525,13 @@ class RoundHole(ContactLaw):
     kernel = round_hole_kernel
     round_holes = True
 
+    def kernels_for(self, step):
+        # round holes only: no lands' code
+        return (broached_hole_kernel if broached(step) else round_hole_kernel,)
+
     def setup(self, step, first=False):
         check_radii(step)
-        if step.lands.size and np.any(step.lands[:, 0] > 0):
-            self.kernel = broached_hole_kernel    # round holes only: no lands' code
+        self.kernel, = self.kernels_for(step)
+        if broached(step):
             return np.concatenate([disk_params(step.disks), land_params(step.lands)])
-        self.kernel = round_hole_kernel
         return disk_params(step.disks)

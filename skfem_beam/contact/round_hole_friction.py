@@ -54,7 +54,7 @@ from ..errors import InputError
 from .base import ContactLaw, compiled_law
 from .lands import (corner_forces, corner_candidate, land_excess, lobe_geometry, lobe_slips,
                     on_land, piece_of)
-from .round_hole import (MAX_SWEEPS, SWEEP_TOL, box_row, check_radii, contact_flags,
+from .round_hole import (MAX_SWEEPS, SWEEP_TOL, box_row, broached, check_radii, contact_flags,
                          disk_params, disk_root, kinds_of, land_cone_solve, land_params,
                          land_project, radial, sweep_start)
 
@@ -422,24 +422,33 @@ class RoundHoleFriction(ContactLaw):
                "couples the holes' normal and tangential forces strongly: check μ, or a "
                "smaller dt)")
 
-    def setup(self, step, first=False):
-        check_radii(step)
+    @staticmethod
+    def _rows(step):
+        """(μ per row, the faces' (row, tangent row) pairs, μ > 0 at some disk or face:
+        friction_rows' fric > 0 at some row, the kernels)."""
         fric = np.asarray(step.friction, dtype=float)
         if fric.size == 0:
             fric = np.zeros(step.lo.size)
         tangents = np.asarray(step.tangents, dtype=np.int64).reshape(-1, 2)
+        frictional = bool(np.any(fric[step.disks[:, 0]] > 0) or np.any(fric[tangents[:, 0]] > 0))
+        return fric, tangents, frictional
+
+    def kernels_for(self, step):
+        frictional = self._rows(step)[2]
+        if broached(step):        # round holes only: no lands' code
+            return (broached_friction_kernel if frictional else broached_frictionless_kernel,)
+        return (round_hole_friction_kernel if frictional else round_hole_frictionless_kernel,)
+
+    def setup(self, step, first=False):
+        check_radii(step)
+        fric, tangents, _ = self._rows(step)
         if np.any(np.delete(fric, np.concatenate([step.disks[:, 0], tangents[:, 0]])) > 0):
             raise InputError("Coulomb friction acts at round holes and at a hole's faces "
                              "(with their tangent rows) only")
         params = np.concatenate([disk_params(step.disks), fric[step.disks[:, 0]],
                                  [float(tangents.shape[0])], tangents.ravel().astype(float),
                                  fric[tangents[:, 0]]])
-        # μ > 0 at some disk or face: friction_rows' fric > 0 at some row (the kernels)
-        frictional = bool(np.any(fric[step.disks[:, 0]] > 0) or np.any(fric[tangents[:, 0]] > 0))
-        if step.lands.size and np.any(step.lands[:, 0] > 0):
-            self.kernel = broached_friction_kernel if frictional \
-                else broached_frictionless_kernel     # round holes only: no lands' code
+        self.kernel, = self.kernels_for(step)
+        if broached(step):
             return np.concatenate([params, land_params(step.lands)])
-        self.kernel = round_hole_friction_kernel if frictional \
-            else round_hole_frictionless_kernel
         return params

@@ -37,8 +37,8 @@ from .lands import (PIECE_CORNER, PIECE_LINE, corner_candidate, land_excess, lin
                     lobe_geometry, piece_holds, piece_of)
 
 internal = njit(cache=True)   # also called from Python: the start step runs the law uncompiled
-# called from compiled code only: no Python or C entry (its compile: 0.5 of a broached
-# law's 4.4 CPU s, bench.cold_compile; the tests call them through tests/conftest.compiled)
+# called from compiled code only: no Python or C entry (the entries were 0.5 of the
+# broached law's 4.4 CPU s of compile; the tests call them through tests/conftest.compiled)
 inner = njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 
 MAX_SWEEPS = 20000

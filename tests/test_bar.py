@@ -77,6 +77,18 @@ def test_p2_matrices_equal_closed_forms():
     assert smp.E2 @ q == pytest.approx(2.0, abs=1e-11)
 
 
+def test_a_profile_not_finite_at_a_p2_midpoint_is_refused_by_name():
+    """A P2 bar's initial profile is evaluated at its midpoints too: NaN there is refused
+    in one line naming the point (it was found by the first step, as a state "too large
+    for floating point"); P1 has no dof there and takes it."""
+    def u0(x):
+        x = np.asarray(x, dtype=float)
+        return np.where(np.isclose((x * 4) % 1.0, 0.5), np.nan, 0.0)
+    Bar(N=4, element="p1", u0=u0)
+    with pytest.raises(InputError, match=r"^u0\(x=0.125\)=nan must be a finite number$"):
+        Bar(N=4, element="p2", u0=u0)
+
+
 @pytest.mark.parametrize("element, order", [("p1", 2), ("p2", 4)])
 def test_clamped_free_frequencies_converge_at_the_element_rate(element, order):
     """u_tt = u_xx, u(1) = 0, u_x(0) = 0: ω_k = (k − ½)π; the consistent mass's first

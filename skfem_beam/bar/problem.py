@@ -162,7 +162,10 @@ class Bar:
         if k == 0 and self.obstacle == "elastic":
             raise InputError("k=0 must be > 0 for an elastic obstacle")
         object.__setattr__(self, "k", k)
-        x = np.linspace(0.0, self.L, self.N + 1)
+        # every node of the element's dofs, the P2 midpoints too (a profile NaN there only
+        # was found by the first step, as "the initial state ... too large")
+        per = 1 + ELEMENTS[self.element]().interior_dofs
+        x = np.linspace(0.0, self.L, per * self.N + 1)
         for name in ("v0", "u0"):
             value = _profile(name, getattr(self, name))
             object.__setattr__(self, name, value)

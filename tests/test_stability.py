@@ -175,22 +175,31 @@ def test_a_load_too_large_for_floats_leaves_an_overwritten_run_as_it_was(tmp_pat
 
 def test_an_unstable_run_with_a_norm_energy_keeps_its_rows_to_the_last_good_state(tmp_path):
     """Springs stiff enough to gain energy at β = 1/4 (½E_β a norm of the state): the run
-    stops unstable within its first 20,000-step chunk and keeps every saved row up to the
-    last state that passed (it kept the first row only), stepped again from the chunk's
-    start: the same bits as the same run to that time, its impacts those of the rows kept."""
+    stops unstable within its first 20,000-step chunk, at the same step whatever the chunks,
+    and keeps every saved row up to the last state that passed (it kept the first row
+    only), stepped again from the chunk's start: the same bits as the same run to that
+    time, its impacts those of the rows kept."""
     from conftest import exit_code
     from skfem_beam.cases import point_stops
     flags = ["--law", "penalty", "--stiffness", "1e11", "--dt", "2e-4", "--format", "none"]
     out = tmp_path / "unstable"
     assert exit_code(point_stops.main, [*flags, "--T", "2", "--out", str(out)]) == 4
     s = json.loads((out / "summary.json").read_text())
-    assert s["status"] == "unstable" and "unstable at step 5134" in s["message"]
+    assert s["status"] == "unstable" and "unstable at step 5063" in s["message"]
     rows = (out / "timeseries.csv").read_text().splitlines()
-    assert len(rows) == 1 + 5134          # states 0 … 5133
+    assert len(rows) == 1 + 5063          # states 0 … 5062
+    # each saved state has its own bound (the load's work up to it): the same step
+    # whatever the chunks (it was 5063, 5083 or 5134 with --flush-every)
+    for every in ("700", "2500"):
+        again = tmp_path / f"every{every}"
+        assert exit_code(point_stops.main, [*flags, "--T", "2", "--out", str(again),
+                                            "--flush-every", every]) == 4
+        message = json.loads((again / "summary.json").read_text())["message"]
+        assert "unstable at step 5063 " in message, message
     # the same states as a run that does not stop there (a looser bound: growth_limit)
-    same = solve(beam_system(scenes.point_stops()), 2e-4, 5133 * 2e-4,
+    same = solve(beam_system(scenes.point_stops()), 2e-4, 5062 * 2e-4,
                  method=Penalty(1e11), growth_limit=1e4, frames=2)
-    assert same.status == "success" and same.steps == 5133
+    assert same.status == "success" and same.steps == 5062
     tip = [float(r.split(",")[1]) for r in rows[1:]]
     assert tip == same.observed["tip_displacement"].tolist()
     assert s["impacts"] == same.impacts > 0

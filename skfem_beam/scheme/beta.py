@@ -348,7 +348,8 @@ class BetaScheme:
                       np.full(rows, np.nan), np.zeros((rows, 4)), np.zeros((rows, m)),
                       np.full((nframes, n), np.nan), np.full((nframes, n), np.nan),
                       np.zeros((nframes, m)),
-                      np.zeros((max(4096, 4 * m), len(EVENT_COLUMNS))), np.zeros(rows))
+                      np.zeros((max(4096, 4 * m), len(EVENT_COLUMNS))), np.zeros(rows),
+                      np.full(rows, np.inf))
 
     @property
     def _kernels(self):
@@ -366,7 +367,7 @@ class BetaScheme:
         # the types of the arguments exactly as _steps passes them: the same compiled loop
         loop = (types.FunctionType(kernel.signature), types.FunctionType(explicit.signature))
         args = (self.ops, self.st, out, 1, 1,
-                Inputs(np.zeros((0, self.loads.shape[1])), np.zeros(0)), 0.0, self.holes,
+                Inputs(np.zeros((0, self.loads.shape[1])), np.zeros(0)), self.holes,
                 self.massless, self.lands)
         loop += tuple(typeof(a) for a in args)
         if loop in run_steps.overloads:
@@ -538,7 +539,7 @@ class BetaScheme:
         why = getattr(self.law, "failure", "")
         return f": {why}" if isinstance(why, str) and why else ""
 
-    def steps(self, out, n0, n1, Ebound, inputs=None):
+    def steps(self, out, n0, n1, inputs=None):
         """The compiled loop over steps n0..n1−1 (see kernels.run_steps)."""
         if inputs is None:
             inputs = Inputs(np.zeros((0, self.loads.shape[1])), np.zeros(0),
@@ -546,7 +547,7 @@ class BetaScheme:
         if self.pysolver is None:
             try:
                 return run_steps(*self._kernels, self.ops, self.st, out, n0, n1, inputs,
-                                 Ebound, self.holes, self.massless, self.lands)
+                                 self.holes, self.massless, self.lands)
             except TypeError as e:
                 # numba 0.68: a Ctrl-C landing while the dispatcher unboxes the law's C
                 # callback surfaces as this TypeError (seen once in CI): it is the interrupt
@@ -555,7 +556,7 @@ class BetaScheme:
                 raise
         PythonLaw.solver, PythonLaw.state, PythonLaw.error = self.pysolver, self.st, None
         try:
-            return run_steps_python(self.ops, self.st, out, n0, n1, inputs, Ebound,
+            return run_steps_python(self.ops, self.st, out, n0, n1, inputs,
                                     bool(getattr(self.law, "free_inside", True)), self.holes,
                                     self.massless, self.lands)
         finally:

@@ -80,7 +80,8 @@ State = namedtuple("State", [
     "ez",                             # the massless rows' explicit force of the step
 ])
 Series = namedtuple("Series", ["obs", "obsv", "energy", "work", "lam", "frames_u", "frames_v",
-                               "frames_f", "events", "resid"])   # resid: friction's residual
+                               "frames_f", "events", "resid", "bound"])
+# resid: friction's residual; bound: the a-priori bound of each saved row's energy (Run)
 # H: the load at the quasi-static massless rows, (1−2β)fⁿ + βfⁿ⁻¹ there (0 rows: none)
 Inputs = namedtuple("Inputs", ["G", "phi", "H"], defaults=(np.zeros((0, 0)),))
 WORK_TERMS = ("damping", "input", "contact")   # the columns of State.work and Series.work
@@ -597,13 +598,13 @@ def track_impacts(ops, st, out, step, lands):
 
 
 @njit(cache=True, inline="always")
-def stop_code(ops, st, out, step, Ebound, full):
+def stop_code(ops, st, out, step, full):
     """After the diagnostics of state step+1: UNSTABLE when its saved energy is non-finite
-    or above Ebound, else ``full`` (EVENTS_FULL when the event buffer must be emptied
-    before the next step, else 0); counters[3] ← step+1 when the loop must stop."""
-    counters, save_every, energy = st.counters, ops.save_every, out.energy
-    if (step + 1) % save_every == 0 \
-            and not abs(energy[(step + 1) // save_every - counters[5]]) <= Ebound:
+    or above its row's bound, else ``full`` (EVENTS_FULL when the event buffer must be
+    emptied before the next step, else 0); counters[3] ← step+1 when the loop must stop."""
+    counters, save_every, energy, bound = st.counters, ops.save_every, out.energy, out.bound
+    k = (step + 1) // save_every - counters[5]
+    if (step + 1) % save_every == 0 and not abs(energy[k]) <= bound[k]:
         counters[3] = step + 1
         return UNSTABLE
     if full:
@@ -616,7 +617,7 @@ def stop_code(ops, st, out, step, Ebound, full):
 # nogil: the output pipeline writes the last chunk's rows while this computes the next.
 # No C entry wrapper: it is never passed as a first-class function.
 @njit(cache=True, _nrt=False, nogil=True, no_cfunc_wrapper=True)
-def run_steps(law, explicit, ops, st, out, n0, n1, inputs, Ebound, holes, massless, lands):
+def run_steps(law, explicit, ops, st, out, n0, n1, inputs, holes, massless, lands):
     """Steps n = n0..n1−1 (computing uⁿ⁺¹) with a compiled law: the bounds at t_{n+1},
     the law's explicit force, the free step, the law, then `finish_step`, the impact
     events, the diagnostics and `stop_code`.  ``inputs`` (Inputs) hold Gⁿ and φ(t_{n+1})
@@ -630,8 +631,8 @@ def run_steps(law, explicit, ops, st, out, n0, n1, inputs, Ebound, holes, massle
     friction, 3 CPU s of a first run).
 
     Returns 0, FAILED (the law failed at step counters[3]), UNSTABLE (the energy saved
-    at state counters[3] is non-finite or above Ebound) or EVENTS_FULL (stopped after
-    state counters[3] for the caller to take the impact events).
+    at state counters[3] is non-finite or above its row's Series.bound) or EVENTS_FULL
+    (stopped after state counters[3] for the caller to take the impact events).
     """
     for step in range(n0, n1):
         Gn = inputs.G[step - n0]
@@ -648,7 +649,7 @@ def run_steps(law, explicit, ops, st, out, n0, n1, inputs, Ebound, holes, massle
         if holes is not None:
             track_holes(ops, st, step, holes[0], lands, holes[1])
         record(step + 1, ops, st, out, lands)
-        code = stop_code(ops, st, out, step, Ebound, full)
+        code = stop_code(ops, st, out, step, full)
         if code:
             return code
     return 0
@@ -703,7 +704,7 @@ def python_law() -> int:
 
 
 @njit(cache=True)
-def run_steps_python(ops, st, out, n0, n1, inputs, Ebound, free_inside, holes,
+def run_steps_python(ops, st, out, n0, n1, inputs, free_inside, holes,
                      massless, lands):
     """The same steps as `run_steps` with the law solved in Python (`PythonLaw.solver`,
     e.g. OSQP or daqp, given the step's bounds): the compiled loop calls it for μ when
@@ -731,7 +732,7 @@ def run_steps_python(ops, st, out, n0, n1, inputs, Ebound, free_inside, holes,
         if holes is not None:
             track_holes(ops, st, step, holes[0], lands, holes[1])
         record(step + 1, ops, st, out, lands)
-        code = stop_code(ops, st, out, step, Ebound, full)
+        code = stop_code(ops, st, out, step, full)
         if code:
             return code
     return 0

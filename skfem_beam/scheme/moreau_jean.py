@@ -162,7 +162,7 @@ def mj_holes(ops, st):
 
 
 @njit(cache=True)
-def mj_steps(ops, st, out, n0, n1, inputs, Ebound):
+def mj_steps(ops, st, out, n0, n1, inputs):
     """Steps n = n0..n1−1 of Moreau–Jean (module docstring); the codes of
     :func:`skfem_beam.scheme.kernels.run_steps`."""
     dt, th = ops.dt, ops.theta
@@ -235,8 +235,8 @@ def mj_steps(ops, st, out, n0, n1, inputs, Ebound):
         if ops.Nc.shape[0]:
             track_holes(ops, st, step, st.hk, None, None)   # (Nc: no μ, friction below)
         mj_record(step + 1, ops, st, out)
-        if (step + 1) % ops.save_every == 0 \
-                and not abs(out.energy[(step + 1) // ops.save_every - st.counters[ROW0]]) <= Ebound:
+        k = (step + 1) // ops.save_every - st.counters[ROW0]
+        if (step + 1) % ops.save_every == 0 and not abs(out.energy[k]) <= out.bound[k]:
             st.counters[STOPPED_AT] = step + 1
             return UNSTABLE
         if full:
@@ -332,7 +332,8 @@ class MoreauJeanScheme:
         return Series(np.full((rows, nobs), np.nan), np.full((rows, nobs), np.nan),
                       np.full(rows, np.nan), z((rows, 4)), z((rows, m)),
                       np.full((nframes, n), np.nan), np.full((nframes, n), np.nan),
-                      z((nframes, m)), z((max(4096, 4 * m), len(EVENT_COLUMNS))), z(rows))
+                      z((nframes, m)), z((max(4096, 4 * m), len(EVENT_COLUMNS))), z(rows),
+                      np.full(rows, np.inf))
 
     def start(self, out) -> int:
         """State 0 is the data themselves: recorded; the driver steps on from there."""
@@ -351,10 +352,10 @@ class MoreauJeanScheme:
                  self.system.load_time]))
         return (n0, n1), Inputs(G, np.zeros(n1 - n0))
 
-    def steps(self, out, n0, n1, Ebound, inputs=None):
+    def steps(self, out, n0, n1, inputs=None):
         if inputs is None:
             inputs = Inputs(np.zeros((0, self.loads.shape[1])), np.zeros(0))
-        return mj_steps(self.ops, self.st, out, n0, n1, inputs, Ebound)
+        return mj_steps(self.ops, self.st, out, n0, n1, inputs)
 
     def restored(self) -> None:
         """Every field it needs is in the checkpoint."""

@@ -17,7 +17,7 @@ from .stepping import Named, Result
 from .watch import Watch
 
 FIRST_ROWS = 1 << 15      # saved rows allocated at first; more as a chunk needs them
-SAVED = ("obs", "obsv", "energy", "work", "lam", "resid")   # the saved series, by row
+SAVED = ("obs", "obsv", "energy", "work", "lam", "resid", "bound")   # the saved series, by row
 
 
 @dataclass(frozen=True)
@@ -128,7 +128,7 @@ class Run:
         self.n = scheme.start(self.out)     # the last computed state
         self.E1 = float(self.out.energy[0])
         self.watch = Watch(self)
-        self._steps(self.n, self.n, 0.0)
+        self._steps(self.n, self.n)         # the compiled loop loaded (or compiled) here
         if self.n == 0:                     # a scheme that starts from the data itself
             self.advance(1)
 
@@ -201,24 +201,24 @@ class Run:
             for name in SAVED:
                 a = getattr(self.out, name)
                 b = np.full((size,) + a.shape[1:], np.nan if name in ("obs", "obsv", "energy")
-                            else 0.0)
+                            else np.inf if name == "bound" else 0.0)
                 b[:have] = a
                 grown[name] = b
             self.out = self.out._replace(**grown)
 
-    def _steps(self, n0, n1, Ebound, inputs=None):
+    def _steps(self, n0, n1, inputs=None):
         """The integrator's loop over steps n0..n1−1, with room for their saved rows."""
         self._hold_rows(n1 // self.save_every)
-        return self.scheme.steps(self.out, n0, n1, Ebound, inputs)
+        return self.scheme.steps(self.out, n0, n1, inputs)
 
-    def _chunk(self, n0, n1, Ebound, inputs) -> int:
+    def _chunk(self, n0, n1, inputs) -> int:
         """Steps n0..n1−1 (``inputs`` from n0), the impact events taken as they fill their
         buffer; the loop's stop code."""
-        code = self._steps(n0, n1, Ebound, inputs)
+        code = self._steps(n0, n1, inputs)
         while code == EVENTS_FULL:       # take the impact events, go on from where it stopped
             self._take_events()
             k = self.stopped_at - n0
-            code = self._steps(self.stopped_at, n1, Ebound,
+            code = self._steps(self.stopped_at, n1,
                                Inputs(inputs.G[k:], inputs.phi[k:],
                                       inputs.H[k:] if inputs.H.shape[0] else inputs.H))
         self._take_events()
@@ -301,11 +301,11 @@ class Run:
             inputs = (self._next if self._next[0] == (n0, n1)
                       else self.scheme.inputs(n0, n1))[1]
         G = inputs.G
-        Ebound = self._energy_bound(G, n1)
+        Ebound = self._energy_bounds(G, n0, n1)
         # the state before the chunk: an unstable chunk is stepped again from it, up to its
         # last good state (_unstable)
-        self._before = self._snapshot(), n0, Ebound, inputs
-        code = self._chunk(n0, n1, Ebound, inputs)
+        self._before = self._snapshot(), n0, inputs
+        code = self._chunk(n0, n1, inputs)
         if code == 0 and n1 < self.n_steps:
             # the next chunk's inputs now, while the writer thread may still be formatting
             # the last chunk's rows but has not got this one's: computed while it formats
@@ -326,11 +326,12 @@ class Run:
             raise SolverError(f"the {self.solver} contact solver failed at step {k} "
                               f"(t={k * self.dt:.6g} s){why}")
         if code == UNSTABLE:
-            early = self.watch.negative(n0, k, Ebound)   # a negative energy, there or before
+            early = self.watch.negative(n0, k)   # a negative energy, there or before
             if early is not None:
                 return self._unstable(*early)
-            return self._unstable(k, f"|energy| {abs(self.energy[k // self.save_every]):.3g} "
-                                  f"exceeds {Ebound:.3g}", (k // self.save_every - 1)
+            row = k // self.save_every
+            return self._unstable(k, f"|energy| {abs(self.energy[row]):.3g} exceeds "
+                                  f"{self.out.bound[row - self.row0]:.3g}", (row - 1)
                                   * self.save_every)
         bad = self.watch.bad(n0, n1, Ebound)
         if bad is not None:
@@ -348,36 +349,54 @@ class Run:
             return
         with np.errstate(over="ignore", invalid="ignore"):
             self._next = self.scheme.inputs(n0, n1)
-        saved = self.load_bound
-        try:
-            self._energy_bound(self._next[1].G, n1)
-        finally:
-            self.load_bound = saved
+        self._load_work(self._next[1].G)
 
-    def _energy_bound(self, G, n1: int) -> float:
-        """The a-priori energy bound at state ``n1`` (docs/design.md), the chunk's loads
-        ``G`` added to the load's work so far; a load too large for floats refused."""
+    def _load_work(self, G) -> np.ndarray:
+        """The load's work bound after each step of a chunk whose loads are ``G`` (its work
+        so far added, docs/design.md); a load too large for floats refused."""
         with np.errstate(over="ignore", invalid="ignore"):
-            self.load_bound += float((np.abs(G) @ self.load_norm).sum()) * self.dt \
-                if G.shape[1] else 0.0
-        # the bound grows with n: its chunk-end value is the loosest for the chunk
-        root = math.sqrt(abs(self.E1)) + self.load_bound
-        Ebound = self.stepping.growth_limit * root * root + 1e-300     # inf, not OverflowError
-        if not math.isfinite(Ebound):
-            raise InputError(f"the load is too large for floating point: its work by step {n1} "
-                             f"is {self.load_bound:g}" if math.isfinite(self.load_bound) else
-                             "the load is too large for floating point: its work overflows")
-        return Ebound
+            steps = (np.abs(G) @ self.load_norm) * self.dt if G.shape[1] \
+                else np.zeros(G.shape[0])
+            work = self.load_bound + np.cumsum(steps)
+            last = float(work[-1]) if work.size else self.load_bound
+            root = math.sqrt(abs(self.E1)) + last
+            if not math.isfinite(self.stepping.growth_limit * root * root):
+                raise InputError("the load is too large for floating point: its work by step "
+                                 f"{self.n + G.shape[0]} is {last:g}" if math.isfinite(last)
+                                 else "the load is too large for floating point: its work "
+                                 "overflows")
+        return work
+
+    def _energy_bounds(self, G, n0: int, n1: int) -> float:
+        """The a-priori energy bound of each saved state n0 < k ≤ n1 (n0 < n1), written
+        beside its energy (Series.bound, which the loop tests), from the load's work up to
+        k: a run is found unstable at the same state however it is cut into chunks
+        (--flush-every moved it by up to 70 steps when the chunk's end value served every
+        state in it).  Returns the bound at n1 (the last state's tests, Watch)."""
+        work = self._load_work(G)
+        self.load_bound = float(work[-1])
+        with np.errstate(over="ignore"):
+            bound = self.stepping.growth_limit * (math.sqrt(abs(self.E1)) + work) ** 2 + 1e-300
+        if self.system.bound_motion is not None:
+            # moving obstacles (a shaken support's, a carried hole) work on the structure
+            # beyond the loads' bound: each state of the chunk keeps its end value, the
+            # loosest (a chunk of 10 steps found a stable carried-hole run unstable)
+            bound[:] = bound[-1]
+        every = self.save_every
+        k = np.arange((n0 // every + 1) * every, n1 + 1, every)
+        self._hold_rows(n1 // every)
+        self.out.bound[k // every - self.row0] = bound[k - n0 - 1]
+        return float(bound[-1])
 
     def _unstable(self, k: int, why: str, good: int) -> None:
         """Stop as unstable at state ``k`` (``why``), keeping the saved states up to
         ``good`` (the last one that passed every test): the chunk is stepped again from
         its start to ``good`` (the same bits), so that the running diagnostics
         (penetration, impacts, contact steps) are those of the states kept."""
-        snap, n0, Ebound, inputs = self._before
+        snap, n0, inputs = self._before
         self._back_to(snap)
         if not (snap["again"] and self.watch.norm()) or good <= n0 \
-                or self._chunk(n0, good, Ebound, inputs) != 0:
+                or self._chunk(n0, good, inputs) != 0:
             # the chunk's start: the energy is no norm (Watch.norm), a Python law without a
             # checkpoint, or a code ≠ 0 stepping again to good (not seen: the same states)
             # the run ends at the chunk's start, whose diagnostics those are (its rows at
@@ -406,6 +425,7 @@ class Run:
     obs = property(lambda self: SavedRows(self, "obs"))
     obsv = property(lambda self: SavedRows(self, "obsv"))
     energy = property(lambda self: SavedRows(self, "energy"))
+    bound = property(lambda self: SavedRows(self, "bound"))     # each row's energy bound
     work = property(lambda self: SavedRows(self, "work"))
     lam = property(lambda self: SavedRows(self, "lam"))
     resid = property(lambda self: SavedRows(self, "resid"))

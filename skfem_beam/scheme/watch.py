@@ -34,8 +34,8 @@ R2_CAP = 0.99          # r² used at or beyond the linear limit (no bound there)
 
 class Watch:
     """The checks above for one run (``run``: scheme.Run); ``bad(n0, n1, Ebound)`` after
-    the chunk n0 → n1: None, or (the state where it failed, why, the last saved state
-    that passed them all)."""
+    the chunk n0 → n1 (Ebound: the bound at n1): None, or (the state where it failed,
+    why, the last saved state that passed them all)."""
 
     def __init__(self, run):
         self.run, self._kappa = run, None
@@ -44,7 +44,7 @@ class Watch:
 
     def bad(self, n0: int, n1: int, Ebound: float):
         floor = -ROUND_OFF * Ebound
-        negative = self.negative(n0, n1, Ebound)
+        negative = self.negative(n0, n1)
         if negative is not None:
             return negative
         why = self._last_state(Ebound, floor)
@@ -52,14 +52,15 @@ class Watch:
         return None if why is None else (n1, why, n0 // self.run.save_every
                                          * self.run.save_every)
 
-    def negative(self, n0: int, n1: int, Ebound: float):
+    def negative(self, n0: int, n1: int):
         """The first saved state of n0 < n ≤ n1 whose energy is negative, as ``bad``."""
         run, every = self.run, self.run.save_every
         if not self.definite:
             return None
         rows = np.arange(n0 // every + 1, n1 // every + 1)
         energy = np.asarray(run.energy[rows], dtype=float) if rows.size else rows
-        below = np.flatnonzero(energy < -ROUND_OFF * Ebound)
+        bound = np.asarray(run.bound[rows], dtype=float) if rows.size else rows
+        below = np.flatnonzero(energy < -ROUND_OFF * bound)     # each row's own bound
         if not below.size:
             return None
         k = int(rows[below[0]]) * every

@@ -371,7 +371,7 @@ class Run:
         """The a-priori energy bound of each saved state n0 < k ≤ n1 (n0 < n1), written
         beside its energy (Series.bound, which the loop tests), from the load's work up to
         k: a run is found unstable at the same state however it is cut into chunks
-        (--flush-every moved it by up to 70 steps when the chunk's end value served every
+        (--flush-every moved it by up to 71 steps when the chunk's end value served every
         state in it).  Returns the bound at n1 (the last state's tests, Watch)."""
         work = self._load_work(G)
         self.load_bound = float(work[-1])

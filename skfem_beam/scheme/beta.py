@@ -24,10 +24,10 @@ from ..contact.registry import Auto
 from ..contact.round_hole import disk_kinds
 from ..errors import InputError, SolverError
 from ..linalg import band_solve, row_layout_of, rows_matvec
-from .kernels import (EVENT_COLUMNS, FRICTION_COLUMN, IMPACT_FIELDS, NC_COLUMNS,
-                      SECTORS, TANGENT_COLUMN, Inputs, Ops, PythonLaw, Series, State,
-                      csr_product, energy_beta, friction_of_ops, lands_of, move_bounds,
-                      record, run_steps, run_steps_python, track_impacts)
+from .kernels import (FRICTION_COLUMN, IMPACT_FIELDS, NC_COLUMNS, SECTORS, TANGENT_COLUMN,
+                      Inputs, Ops, PythonLaw, Series, State, csr_product, energy_beta,
+                      friction_of_ops, lands_of, move_bounds, record, run_steps,
+                      run_steps_python, saved_series, track_impacts)
 from .operators import csr_arrays, load_norms, step_operators
 from .stepping import Stepping
 
@@ -343,13 +343,7 @@ class BetaScheme:
 
     def series(self, rows: int, nframes: int) -> Series:
         """Saved-series buffers of ``rows`` rows and ``nframes`` field frames."""
-        n, m, nobs = self.system.n, self.system.C.shape[0], self.Orows.shape[0]
-        return Series(np.full((rows, nobs), np.nan), np.full((rows, nobs), np.nan),
-                      np.full(rows, np.nan), np.zeros((rows, 4)), np.zeros((rows, m)),
-                      np.full((nframes, n), np.nan), np.full((nframes, n), np.nan),
-                      np.zeros((nframes, m)),
-                      np.zeros((max(4096, 4 * m), len(EVENT_COLUMNS))), np.zeros(rows),
-                      np.full(rows, np.inf))
+        return saved_series(self.system, self.Orows, rows, nframes)
 
     @property
     def _kernels(self):

@@ -82,6 +82,18 @@ State = namedtuple("State", [
 Series = namedtuple("Series", ["obs", "obsv", "energy", "work", "lam", "frames_u", "frames_v",
                                "frames_f", "events", "resid", "bound"])
 # resid: friction's residual; bound: the a-priori bound of each saved row's energy (Run)
+
+
+def saved_series(system, Orows, rows: int, nframes: int) -> Series:
+    """A scheme's saved-series buffers: ``rows`` rows (observed points ``Orows``) and
+    ``nframes`` field frames; values not yet computed are NaN, bounds +inf."""
+    n, m, nobs = system.n, system.C.shape[0], Orows.shape[0]
+    return Series(np.full((rows, nobs), np.nan), np.full((rows, nobs), np.nan),
+                  np.full(rows, np.nan), np.zeros((rows, 4)), np.zeros((rows, m)),
+                  np.full((nframes, n), np.nan), np.full((nframes, n), np.nan),
+                  np.zeros((nframes, m)), np.zeros((max(4096, 4 * m), len(EVENT_COLUMNS))),
+                  np.zeros(rows), np.full(rows, np.inf))
+
 # H: the load at the quasi-static massless rows, (1−2β)fⁿ + βfⁿ⁻¹ there (0 rows: none)
 Inputs = namedtuple("Inputs", ["G", "phi", "H"], defaults=(np.zeros((0, 0)),))
 WORK_TERMS = ("damping", "input", "contact")   # the columns of State.work and Series.work

@@ -50,8 +50,8 @@ from ..linalg import add_columns, band_solve, row_layout, row_layout_of, rows_do
 from .beta import (disk_rows, friction_of, hole_arrays, observers, penetration_samples,
                    refuse_lands, start_positions, tangent_rows, two_plane_state)
 from ..contact.friction import MAX_SWEEPS, nsgs
-from .kernels import (EVENT_COLUMNS, FAILED, FRICTION, IMPACT_FIELDS, ITERATIONS, ROW0,
-                      STOPPED_AT, UNSTABLE, Inputs, Series, csr_product, track_holes,
+from .kernels import (FAILED, FRICTION, IMPACT_FIELDS, ITERATIONS, ROW0, STOPPED_AT,
+                      Inputs, Series, csr_product, saved_series, stop_code, track_holes,
                       track_impacts, violation)
 from .operators import csr_arrays, load_norms, step_operators
 from .stepping import Stepping
@@ -235,13 +235,9 @@ def mj_steps(ops, st, out, n0, n1, inputs):
         if ops.Nc.shape[0]:
             track_holes(ops, st, step, st.hk, None, None)   # (Nc: no μ, friction below)
         mj_record(step + 1, ops, st, out)
-        k = (step + 1) // ops.save_every - st.counters[ROW0]
-        if (step + 1) % ops.save_every == 0 and not abs(out.energy[k]) <= out.bound[k]:
-            st.counters[STOPPED_AT] = step + 1
-            return UNSTABLE
-        if full:
-            st.counters[STOPPED_AT] = step + 1
-            return full
+        code = stop_code(ops, st, out, step, full)     # the β-scheme's test, on its rows
+        if code:
+            return code
     return 0
 
 
@@ -327,13 +323,7 @@ class MoreauJeanScheme:
 
     def series(self, rows: int, nframes: int) -> Series:
         """Saved-series buffers (Moreau–Jean keeps its frames, whatever the run asked)."""
-        n, m, nobs = self.system.n, self.system.C.shape[0], self.Orows.shape[0]
-        z = np.zeros
-        return Series(np.full((rows, nobs), np.nan), np.full((rows, nobs), np.nan),
-                      np.full(rows, np.nan), z((rows, 4)), z((rows, m)),
-                      np.full((nframes, n), np.nan), np.full((nframes, n), np.nan),
-                      z((nframes, m)), z((max(4096, 4 * m), len(EVENT_COLUMNS))), z(rows),
-                      np.full(rows, np.inf))
+        return saved_series(self.system, self.Orows, rows, nframes)
 
     def start(self, out) -> int:
         """State 0 is the data themselves: recorded; the driver steps on from there."""

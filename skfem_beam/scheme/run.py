@@ -359,13 +359,19 @@ class Run:
                 else np.zeros(G.shape[0])
             work = self.load_bound + np.cumsum(steps)
             last = float(work[-1]) if work.size else self.load_bound
-            root = math.sqrt(abs(self.E1)) + last
-            if not math.isfinite(self.stepping.growth_limit * root * root):
+            if not math.isfinite(self._bound(last)):
                 raise InputError("the load is too large for floating point: its work by step "
                                  f"{self.n + G.shape[0]} is {last:g}" if math.isfinite(last)
                                  else "the load is too large for floating point: its work "
                                  "overflows")
         return work
+
+    def _bound(self, work):
+        """The a-priori energy bound after the load's work bound ``work`` (a number or an
+        array): growth_limit (√|E¹| + work)², + 1e-300; a product, not ``**``, so that a
+        float too large gives inf, not an OverflowError."""
+        root = math.sqrt(abs(self.E1)) + work
+        return self.stepping.growth_limit * root * root + 1e-300
 
     def _energy_bounds(self, G, n0: int, n1: int) -> float:
         """The a-priori energy bound of each saved state n0 < k ≤ n1 (n0 < n1), written
@@ -376,7 +382,7 @@ class Run:
         work = self._load_work(G)
         self.load_bound = float(work[-1])
         with np.errstate(over="ignore"):
-            bound = self.stepping.growth_limit * (math.sqrt(abs(self.E1)) + work) ** 2 + 1e-300
+            bound = self._bound(work)
         if self.system.bound_motion is not None:
             # moving obstacles (a shaken support's, a carried hole) work on the structure
             # beyond the loads' bound: each state of the chunk keeps its end value, the

@@ -75,7 +75,10 @@ def check_restitution(e, name: str = "restitution=") -> float:
 
 def check_count(name: str, value, least: int = 1, most: int | None = None,
                 beyond: str = "more than a machine's memory holds") -> int:
-    """A whole number ≥ ``least`` (bools refused), ≤ ``most`` when given (``beyond``: why)."""
+    """A whole number ≥ ``least`` (bools refused; a float of a whole value, TOML's ``1e3``
+    or ``40.0``, taken), ≤ ``most`` when given (``beyond``: why)."""
+    if isinstance(value, (float, np.floating)) and np.isfinite(value) and value == int(value):
+        value = int(value)
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < least:
         raise InputError(f"{name}={value!r} must be a whole number ≥ {least}")
     if most is not None and value > most:

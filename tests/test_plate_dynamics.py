@@ -147,17 +147,18 @@ def test_a_regional_pressure_and_point_stops():
 
 
 @pytest.mark.parametrize("kwargs, message", [
-    ({"obstacles": [PlateObstacle(g1=1e-3, region=(0, 0, 0, 1))]}, "held at w = 0"),
+    ({"obstacles": [PlateObstacle(g1=1e-3, region=(0, 0, 0, 1))]},
+     r"held at w = 0 by its support, outside \[0.001, inf\] \(g1 of obstacles\[0\]\)"),
     # only at held vertices: it ran with solver "none" and no contact (a beam's is refused)
     ({"obstacles": [PlateObstacle(g1=-1e-3, region=(0, 0, 0, 1))]},
-     "obstacle 0 acts only at vertices its plate's supports hold at w = 0"),
+     r"obstacles\[0\] acts only at vertices its plate's supports hold at w = 0"),
     ({"obstacles": [PlateObstacle(g1=-1e-3, points=((0.0, 0.5),))]}, "it would never act"),
     ({"obstacles": [PlateObstacle(points=((0.3, 0.3),), g1=0.0)]}, "not a vertex"),
     ({"obstacles": [PlateObstacle(g1=1e-3, g2=0.0)]}, "need g1 < g2"),
     # two obstacles that cross: the line names which one gave each bound
     ({"obstacles": [PlateObstacle(g1=-1e-3, g2=1e-3),
                     PlateObstacle(g1=2e-3, region=(0.5, 1, 0, 1))]},
-     r"g1=0.002 of obstacle 1, g2=0.001 of obstacle 0\)"),
+     r"g1=0.002 of obstacles\[1\], g2=0.001 of obstacles\[0\]\)"),
     ({"obstacles": [PlateObstacle(g1=1e-6, region=(0.5, 1, 0, 1))],
       "initial": PlateInitial(static=Pressure(-1e3))},
      "violates the obstacles"),

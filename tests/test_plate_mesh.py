@@ -287,6 +287,50 @@ def test_a_binary_mesh_file_is_stored_and_read_back_exactly(tmp_path):
     assert a.source == b.source == "bin.msh"
 
 
+def _disk_with(change: str):
+    """The 6-ring disk with one fault: a triangle listed twice, a triangle on an interior
+    edge (three at that edge), one folded onto a rim edge's inner side, a NaN point."""
+    d = disk(0.5, 6)
+    p, t = d.points, d.triangles
+    rim = d.boundaries["rim"][:, 0]
+    if change == "repeated":
+        t = np.column_stack([t, t[:, 5]])
+    elif change == "three":     # a new point beyond the rim, on the edge (0, one of its own)
+        edge = t[:2, 0]
+        p = np.column_stack([p, 3.0 * p[:, edge].mean(axis=1)])
+        t = np.column_stack([t, [edge[0], edge[1], p.shape[1] - 1]])
+    elif change == "folded":    # a rim edge's second triangle, inside the disk
+        p = np.column_stack([p, 0.9 * p[:, rim].mean(axis=1)])
+        t = np.column_stack([t, [rim[0], rim[1], p.shape[1] - 1]])
+    else:
+        p = p.copy()
+        p[0, t[0, 0]] = np.nan
+    return type(d)(p, t, d.boundaries)
+
+
+@pytest.mark.parametrize("change, word", [
+    ("repeated", "triangle 216 repeats triangle 5 (1 repeated)"),
+    ("three", "share the edge"),
+    ("folded", "overlap (both on one side of their edge"),
+    ("nan", "has a non-finite coordinate (nan, "),
+])
+def test_overlapping_triangles_and_non_finite_points_are_refused(tmp_path, capsys, change,
+                                                                 word):
+    """They were accepted (overlaps assembled twice: another plate, silently) or refused
+    for another reason (a NaN point: "dt ... outside floating-point range")."""
+    d = _disk_with(change)
+    name = "bad.vtu" if change == "nan" else "bad.msh"
+    if change == "nan":     # (write_msh refuses a NaN point)
+        meshio.write(tmp_path / name, meshio.Mesh(
+            np.vstack([d.points, np.zeros(d.points.shape[1])]).T,
+            [("triangle", d.triangles.T)]))
+    else:
+        write_msh(d, tmp_path / name)
+    scene = DISK.replace("plate_disk.msh", name)
+    assert_scene_refused(tmp_path, capsys, {name: (tmp_path / name).read_bytes(),
+                                            "plate.toml": scene}, "plate.toml", word)
+
+
 def _two_disks(degenerate: bool):
     """The 6-ring disk and, beside it, a second disk no edge names (unsupported), or (with
     ``degenerate``) the disk with one more triangle of no area (a repeated point)."""
@@ -313,3 +357,9 @@ def test_a_mesh_of_a_flat_triangle_or_an_unheld_part_is_refused(tmp_path, capsys
     assert "two.msh" in scene
     assert_scene_refused(tmp_path, capsys, {"two.msh": (tmp_path / "two.msh").read_bytes(),
                                             "plate.toml": scene}, "plate.toml", word)
+
+
+def test_a_folder_named_as_the_mesh_file_is_called_a_folder(tmp_path):
+    (tmp_path / "dir.msh").mkdir()
+    with pytest.raises(InputError, match="dir.msh: a folder, not a file"):
+        read_plate_mesh(tmp_path / "dir.msh")

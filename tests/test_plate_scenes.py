@@ -130,6 +130,10 @@ EDGES = 'left = "clamped"\nright = "clamped"\nbottom = "clamped"\ntop = "clamped
     ('law = "position"', 'law = "springs"', "law"),
     ('law = "position"', 'law = "penalty"', "stiffness"),
     ("static_pressure = 1.0e5 ", "static_pressure = -1.0e5 ", "initial deflection"),
+    ("static_pressure = 1.0e5 ", "static_pressure = inf ",
+     "[initial] static_pressure=inf must be a finite number"),
+    ("g1 = -1.75e-4 ", "g1 = 1.0e-4 ",      # at the clamped edges' vertices
+     "is held at w = 0 by its support, outside [0.0001, inf] (g1 of obstacles[0])"),
     # nothing holds the plate: K w = f has no solution (w was −1.9e11 m)
     (EDGES, EDGES.replace('"clamped"', '"free"'), "needs edges that hold the plate"),
     (EDGES, EDGES.replace('"clamped"', '"sliding"'), "rigid body"),

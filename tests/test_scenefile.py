@@ -136,8 +136,8 @@ def test_motion_table_is_relative_to_the_scene_and_stored_for_resume(tmp_path):
 def test_set_overrides_nested_keys_and_array_items(tmp_path):
     f = write(tmp_path, PIPE)
     s = load(f, ["time.dt=1e-5", "obstacles.0.g2=0.05", "mesh.element=bspline",
-                 "ends.right=sliding", "obstacles.1.x=0.7505", "obstacles.1.g1=-0.01",
-                 "mesh.J=20"])
+                 "ends.right=sliding", "obstacles[1].x=0.7505", "obstacles.1.g1=-0.01",
+                 "mesh.J=20"])     # obstacles[1]: as the refusal lines write an item
     assert s.stepping.dt == 1e-5 and s.problem.element == "bspline"
     assert s.problem.ends == ("clamped", "sliding")
     lo, hi = s.problem.obstacles.bounds(np.array([0.7505, 1.501]))
@@ -1017,11 +1017,30 @@ def test_an_output_value_of_the_file_is_named_as_the_file_has_it(tmp_path, capsy
 @pytest.mark.parametrize("scene, setting, word", [
     # numpy's "Maximum allowed size exceeded", skfem's "Newton iteration didn't converge"
     ("flat_obstacles.toml", "mesh.J=99999999999999999999999", "must be at most 10,000,000"),
-    ("plate_rattling.toml", "mesh.nx=100000", "plate nx=100000 must be at most 2,000"),
+    ("plate_rattling.toml", "mesh.nx=100000", "[mesh] nx=100000 must be at most 2,000"),
 ])
 def test_a_mesh_beyond_memory_is_one_line(tmp_path, capsys, scene, setting, word):
     assert_refused(run_main, [str(example(scene)), "--set", setting, "--out",
                               str(tmp_path / "x")], word, capsys, tmp_path)
+
+
+@pytest.mark.parametrize("scene, setting, word", [
+    ("plate_rattling.toml", "loads.0.pressure=inf", "loads.0.pressure=inf must be a finite"),
+    ("plate_rattling.toml", "mesh.nx=2.5", "[mesh] nx=2.5 must be a whole number ≥ 1"),
+    ("flat_obstacles.toml", "mesh.J=40.5", "[mesh] J=40.5 must be a whole number ≥ 1"),
+])
+def test_a_scene_value_refused_names_its_key(tmp_path, capsys, scene, setting, word):
+    assert_refused(run_main, [str(example(scene)), "--set", setting, "--out",
+                              str(tmp_path / "x")], word, capsys, tmp_path)
+
+
+def test_a_whole_number_written_as_a_float_is_taken():
+    """TOML's 1e3 and 40.0 are floats: they were refused as "J=40.0 must be a whole
+    number", which they are."""
+    a, b = (load(example("flat_obstacles"), [f"mesh.J={j}"]) for j in ("40", "40.0"))
+    assert a.problem.J == b.problem.J == 40 and isinstance(b.problem.J, int)
+    plate = load(example("plate_rattling"), ["mesh.nx=2e1", "mesh.ny=2e1"])
+    assert plate.problem.space.plate.nx == 20
 
 
 def test_a_kind_that_is_no_word_is_one_line(tmp_path, capsys):

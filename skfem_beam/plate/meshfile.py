@@ -62,7 +62,8 @@ def _read(path: Path):
 
     import meshio
     if not path.is_file():
-        raise InputError(f"cannot read the mesh file {path}: no such file")
+        raise InputError(f"cannot read the mesh file {path}: "
+                         + ("a folder, not a file" if path.is_dir() else "no such file"))
     chatter = io.StringIO()
     try:
         with contextlib.redirect_stdout(chatter), contextlib.redirect_stderr(chatter):
@@ -92,6 +93,12 @@ def read_plate_mesh(path, source: str | None = None) -> PlateMesh:
     if xyz.shape[1] > 2 and np.any(xyz[:, 2:] != 0):
         raise InputError(f"the mesh file {path} is not flat: its points have z ≠ 0")
     used = np.unique(triangles)
+    bad = used[~np.isfinite(xyz[used, :2]).all(axis=1)]
+    if bad.size:        # else a NaN or inf surfaced as a tiny cell or a singular step
+        k = int(bad[0])
+        raise InputError(f"the mesh file {path}: point {k} has a non-finite coordinate "
+                         f"({', '.join(repr(float(c)) for c in xyz[k, :2])}); a plate's "
+                         "points need finite x, y")
     number = np.full(xyz.shape[0], -1)
     number[used] = np.arange(used.size)     # the order of the file, unused points dropped
     lines: dict[str, list] = {}

@@ -53,6 +53,7 @@ def file_mesh(plate: MeshPlate) -> MeshTri:
     points = np.ascontiguousarray(m.points, dtype=float)
     triangles = np.ascontiguousarray(m.triangles, dtype=np.int64)
     _check_areas(points, triangles, m.source)
+    _check_overlaps(points, triangles, m.source)
     mesh = MeshTri(points, triangles)
     n = mesh.p.shape[1]
     key = mesh.facets[0] * n + mesh.facets[1]          # skfem's facets: sorted pairs
@@ -83,6 +84,49 @@ def _check_areas(points, triangles, source: str) -> None:
                          f"{', '.join(str(int(v)) for v in triangles[:, k])}) has no area (a "
                          f"repeated or collinear point; {flat.size} such triangle(s)): a "
                          "plate's triangles need area")
+
+
+def _check_overlaps(points, triangles, source: str) -> None:
+    """Refuse triangles that overlap across an edge: an edge of three or more triangles
+    (a triangle listed twice, say), or of two on the same side of it.  Their stiffness
+    and mass were assembled twice, silently (a disk's first frequency 102.06 → 102.78 Hz
+    for three repeated triangles).  Overlaps that share no edge are not looked for."""
+    t = triangles.shape[1]
+    _, first, again = np.unique(np.sort(triangles, axis=0), axis=1, return_index=True,
+                                return_inverse=True)
+    repeat = np.flatnonzero(first[again.ravel()] != np.arange(t))
+    if repeat.size:
+        k = int(repeat[0])
+        raise InputError(f"the mesh {source}: triangle {k} repeats triangle "
+                         f"{int(first[again.ravel()[k]])} ({repeat.size} repeated); a plate's "
+                         "triangles are listed once")
+    edges = np.sort(np.hstack([triangles[[0, 1]], triangles[[1, 2]], triangles[[2, 0]]]),
+                    axis=0)
+    owner = np.tile(np.arange(t), 3)
+    opposite = np.hstack([triangles[2], triangles[0], triangles[1]])
+    order = np.lexsort(edges)
+    edges, owner, opposite = edges[:, order], owner[order], opposite[order]
+    same = np.all(edges[:, 1:] == edges[:, :-1], axis=0)
+    third = np.flatnonzero(same[1:] & same[:-1])
+    if third.size:
+        i = int(third[0])
+        three = ", ".join(str(int(k)) for k in owner[i:i + 3])
+        raise InputError(f"the mesh {source}: triangles {three} share the edge ({int(edges[0, i])}, {int(edges[1, i])}): "
+                         "overlapping or repeated triangles; a plate's triangles meet "
+                         "two at an edge")
+    pair = np.flatnonzero(same)
+    a, b = points[:, edges[0, pair]], points[:, edges[1, pair]]
+
+    def side(c):
+        return np.sign((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
+    folded = np.flatnonzero(side(points[:, opposite[pair]])
+                            == side(points[:, opposite[pair + 1]]))
+    if folded.size:
+        i = int(pair[folded[0]])
+        raise InputError(f"the mesh {source}: triangles {int(owner[i])} and "
+                         f"{int(owner[i + 1])} overlap (both on one side of their edge ({int(edges[0, i])}, "
+                         f"{int(edges[1, i])})); a plate's triangles meet two at an edge, "
+                         "one on each side")
 
 
 def plate_mesh(plate):

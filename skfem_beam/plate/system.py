@@ -248,6 +248,11 @@ def full_dofs(system: SemiDiscrete, u: np.ndarray) -> np.ndarray:
     return full
 
 
+def _of(k: int) -> str:
+    """" of obstacles[k]", the obstacle that set a bound (none: an infinite one)."""
+    return f" of obstacles[{k}]" if k >= 0 else ""
+
+
 def _contact_rows(space, obstacles, position):
     """(vertices, lo, hi) of the constrained vertices: the highest g1 and the lowest g2
     of the obstacles at each vertex whose w is free and bounded."""
@@ -260,7 +265,7 @@ def _contact_rows(space, obstacles, position):
         acts = np.isfinite(g1) | np.isfinite(g2)
         # as a beam's: it ran with no contact (one that conflicts with w = 0: below)
         if acts.any() and held[acts].all() and not np.any((g1 > 0) | (g2 < 0)):
-            raise InputError(f"obstacle {k} acts only at vertices its plate's supports "
+            raise InputError(f"obstacles[{k}] acts only at vertices its plate's supports "
                              "hold at w = 0: it would never act")
         lo_of[(g1 > lo) | np.isnan(g1)] = k
         hi_of[(g2 < hi) | np.isnan(g2)] = k
@@ -268,12 +273,14 @@ def _contact_rows(space, obstacles, position):
     if np.isnan(lo).any() or np.isnan(hi).any() or np.any(lo >= hi):
         i = int(np.argmax(np.isnan(lo) | np.isnan(hi) | (lo >= hi)))
         raise InputError(f"obstacles at vertex ({space.vertices[0, i]:g}, "
-                         f"{space.vertices[1, i]:g}) need g1 < g2 (g1={lo[i]:g} of obstacle "
-                         f"{lo_of[i]}, g2={hi[i]:g} of obstacle {hi_of[i]})")
+                         f"{space.vertices[1, i]:g}) need g1 < g2 (g1={lo[i]:g}"
+                         f"{_of(lo_of[i])}, g2={hi[i]:g}{_of(hi_of[i])})")
     if np.any(held & ((lo > 0) | (hi < 0))):
         i = int(np.argmax(held & ((lo > 0) | (hi < 0))))
+        which = _of(lo_of[i]) if lo[i] > 0 else _of(hi_of[i])
         raise InputError(f"vertex ({space.vertices[0, i]:g}, {space.vertices[1, i]:g}) is "
-                         f"held at w = 0 by its support, outside [{lo[i]:g}, {hi[i]:g}]")
+                         f"held at w = 0 by its support, outside [{lo[i]:g}, {hi[i]:g}] "
+                         f"(g{1 if lo[i] > 0 else 2}{which})")
     rows = np.flatnonzero(~held & (np.isfinite(lo) | np.isfinite(hi)))
     return rows, lo[rows], hi[rows]
 

@@ -8,6 +8,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..checks import MAX_ELEMENTS, check_count
 from ..errors import InputError
 from ..problem import Beam, BeamProblem, Damping, InitialState, Plane
 from .forcing import loads_of, support_of
@@ -128,7 +129,7 @@ def beam_problem(data: dict, reader: Tables) -> BeamProblem:
     load, load_w = loads_of(data, reader, beam.L)
     problem = BeamProblem(
         beam, obstacles, support_of(data, beam.L, reader), load,
-        J=mesh.get("J", 19), element=mesh.get("element", "hermite"), nodes=mesh.get("nodes"),
+        J=check_count("[mesh] J", mesh.get("J", 19), most=MAX_ELEMENTS), element=mesh.get("element", "hermite"), nodes=mesh.get("nodes"),
         ends=(ends.get("left", "clamped"), ends.get("right", "free")),
         supports=tuple(s.get("x", math.nan) for s in data.get("supports", [])),
         damping=_damping(data), planes=plane_count(data), holes=holes,

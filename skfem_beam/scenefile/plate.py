@@ -12,10 +12,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import methods
-from ..checks import check_choice, check_count, check_positive
+from ..checks import check_choice, check_count, check_finite, check_positive
 from ..contact import SOLVERS
 from ..errors import InputError
-from ..plate.model import EDGES, ELEMENTS, SUPPORTS, MeshPlate, Plate
+from ..plate.model import EDGES, ELEMENTS, MAX_PLATE_SIDE, SUPPORTS, MeshPlate, Plate
 from ..scheme import Stepping
 from .forcing import _time_function
 from .parts import named_section, need, stepping_of, warn_implausible
@@ -82,7 +82,8 @@ def plate_of(data: dict, base=None):
         check_choice(f"[edges] {edge}", support, SUPPORTS)
     mesh = data.get("mesh", {})
     element = check_choice("[mesh] element", mesh.get("element", "bfs"), ELEMENTS)
-    nx, ny = (check_count(f"[mesh] {k}", mesh.get(k, 8)) for k in ("nx", "ny"))
+    nx, ny = (check_count(f"[mesh] {k}", mesh.get(k, 8), most=MAX_PLATE_SIDE)
+              for k in ("nx", "ny"))
     return Plate(a=g["a"], b=g["b"], h=h, E=m["E"], rho=m["rho"], nu=m["nu"],
                  edges={e: edges.get(e, "free") for e in EDGES}, element=element,
                  nx=nx, ny=ny)
@@ -269,7 +270,8 @@ def loads_of(data: dict, space, tables: Tables) -> list:
         if "omega" in time and "amplitude" not in time:
             time["amplitude"] = 1.0          # the pressure is the amplitude
         a = _time_function(time, where, tables)
-        out.append(Pressure(float(p), one if a is None else a, region))
+        p = check_finite(f"{where}.pressure", p)
+        out.append(Pressure(p, one if a is None else a, region))
     return out
 
 
@@ -278,8 +280,9 @@ def initial_of(data: dict):
     (m/s, uniform)."""
     from ..plate.system import PlateInitial, Pressure
     d = data.get("initial", {})
-    static = Pressure(float(d["static_pressure"])) if "static_pressure" in d else None
-    return PlateInitial(static, float(d.get("velocity", 0.0)))
+    static = Pressure(check_finite("[initial] static_pressure", d["static_pressure"])) \
+        if "static_pressure" in d else None
+    return PlateInitial(static, check_finite("[initial] velocity", d.get("velocity", 0.0)))
 
 
 def probes_of(data: dict, space) -> tuple:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import base64
 import hashlib
+import re
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -98,13 +99,13 @@ def _toml_value(text: str):
 
 
 def apply_set(data: dict, assignment: str) -> tuple[str, str]:
-    """``KEY=VALUE`` (KEY dotted, array items by index: ``obstacles.0.g1``) into
-    ``data``; a key the scene's kind does not allow is refused by name.  Returns (KEY,
-    VALUE) as written."""
+    """``KEY=VALUE`` (KEY dotted, array items by index: ``obstacles.0.g1``, or
+    ``obstacles[0].g1`` as refusal lines write list items) into ``data``; a key the
+    scene's kind does not allow is refused by name.  Returns (KEY, VALUE), KEY dotted."""
     key, eq, text = assignment.partition("=")
     if not eq or not key.strip():
         raise InputError(f"--set {assignment!r}: expected KEY=VALUE, e.g. time.dt=1e-5")
-    parts = key.strip().split(".")
+    parts = re.sub(r"\[(\d+)\]", r".\1", key.strip()).split(".")
     schema = KINDS.get(data.get("kind", "beam"), BEAM_KEYS)
     node, sub = data, schema
     for i, part in enumerate(parts):

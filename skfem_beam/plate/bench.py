@@ -113,9 +113,11 @@ def peak_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e3
 
 
-def law_rows(pressed, laws, solve_ms: float, lapack_ms: float, steps: int = STEPS) -> None:
+def law_rows(pressed, laws, solve_ms: float, lapack_ms: float, steps: int = STEPS,
+             free_ms: float | None = None) -> None:
     """One line per law: its mean step, the fraction in contact, the ratio to a solve
-    (the scheme's banded solve; LAPACK's dpbtrs)."""
+    (the scheme's banded solve; LAPACK's dpbtrs); with ``free_ms`` (the step without
+    obstacles), the contact's own share of a step, what the law adds, in dpbtrs."""
     for law in laws:
         try:
             ms, fraction = step_ms(pressed, law, steps)   # (COUNTS: the timed run's)
@@ -125,6 +127,9 @@ def law_rows(pressed, laws, solve_ms: float, lapack_ms: float, steps: int = STEP
         print(f"  step with {law}: {ms:.2f} ms = {ms / solve_ms:.1f} solves "
               f"({ms / lapack_ms:.0f} dpbtrs; {steps} steps, {100 * fraction:.0f} % in "
               f"contact)", flush=True)
+        if free_ms is not None:
+            print(f"    the contact's share: {ms - free_ms:.2f} ms = "
+                  f"{(ms - free_ms) / lapack_ms:.1f} dpbtrs", flush=True)
         if law in X_SPACE_LAWS and COUNTS["steps"]:
             c = {k: v / COUNTS["steps"] for k, v in COUNTS.items()}
             kind = cholesky_kind(pressed.n)
@@ -159,7 +164,7 @@ def main(argv=None) -> None:
         print(f"  step without obstacles: {ms:.2f} ms = {ms / row['band_solve_ms']:.1f} "
               f"solves", flush=True)
         laws = [law for law in args.laws if row["delassus"] or law not in DELASSUS_LAWS]
-        law_rows(pressed, laws, row["band_solve_ms"], row["lapack_solve_ms"], steps)
+        law_rows(pressed, laws, row["band_solve_ms"], row["lapack_solve_ms"], steps, ms)
         print(f"  peak memory of the process so far: {peak_mb():.0f} MB", flush=True)
 
 

@@ -44,7 +44,7 @@ SECTION_DOCS = {
         ' or `sines = [[A, ω, phase], ...]`, `table = "phi.csv"` (t, φ rows), `random = {rms,'
         ' f_low, f_high, seed, count}` (band-limited, `count` sines), `psd = { table, seed, df }`, `value` '
         '(constant), as for loads; `phase` with `amplitude`, `omega`; `lifting`; two planes: '
-        '`direction = [dy, dz]`'
+        '`direction = [dy, dz]` (a direction: its length is not used)'
     ),
     'obstacles': (
         '`x` (point stops) or `x_from`, `x_to` (a span) or neither (the whole beam); `g1`, '
@@ -81,8 +81,8 @@ SECTION_DOCS = {
         '`psd = { table = "S.csv", seed = 1, df = 0.1 }` (a one-sided PSD, columns f in Hz '
         'and S in N²/m²/Hz for a distributed force, synthesised with the seed: '
         '`timefunctions.from_psd`); a distributed load over part of the beam: `x_from`, '
-        '`x_to` (exact when they are nodes); two planes: `direction = [dy, dz]` (default the '
-        'first plane), or `rotating = {amplitude, omega, phase}` instead of a time function '
+        '`x_to` (exact when they are nodes); two planes: `direction = [dy, dz]` (a direction: '
+        'its length is not used; default the first plane), or `rotating = {amplitude, omega, phase}` instead of a time function '
         '(amplitude·cos(ωt + phase) along y, ·sin along z). Bar: `value` (a body force, N/m³)'
     ),
     'initial': (

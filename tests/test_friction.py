@@ -546,3 +546,18 @@ def test_a_stepped_tube_of_one_outer_diameter_gives_wear_its_radius(tmp_path):
     start, end = text.index("[material]"), text.index("[ends]")
     (tmp_path / "s.toml").write_text(text[:start] + segments + text[end:])
     assert wear(load(tmp_path / "s.toml")).radius == 0.01905 / 2
+
+
+def test_a_support_worn_past_the_tube_wall_is_said_with_when():
+    """The shipped friction scene's deepest sector passes its 1.65 mm wall in 40 years
+    (2.19 mm): the table printed that depth without a word."""
+    from skfem_beam.output.supports import Wear, worn_through
+    wear = Wear(1e-14, 40.0, 0.019, 0.0095, wall=0.00165)
+    sectors = [{"depth": 1e-3}, {"depth": 2.2e-3}]
+    lines = worn_through([{"x": 0.5, "wear": {"sectors": sectors}},
+                          {"x": 1.0, "wear": {"sectors": sectors[:1]}}], wear)
+    assert lines == ["the support at x=0.5 wears 2.2 mm deep in 40 years, more than the "
+                     "tube's wall (1.65 mm): it wears through in about 30 years (the depth "
+                     "past the wall is Archard's law extrapolated)"]
+    assert worn_through([{"x": 0.5, "wear": {"sectors": sectors}}],
+                        Wear(1e-14, 40.0, 0.019, 0.0095)) == []     # not a tube: no wall

@@ -1034,6 +1034,18 @@ def test_a_scene_value_refused_names_its_key(tmp_path, capsys, scene, setting, w
                               str(tmp_path / "x")], word, capsys, tmp_path)
 
 
+@pytest.mark.parametrize("setting, word", [
+    ("obstacles.1.hole.radius=-0.0004", "obstacles.1.hole: radius=-0.0004 must be > 0"),
+    ("obstacles.1.friction=-1", "obstacles.1: friction=-1 must be ≥ 0"),
+    ("obstacles.1.x=2.0", "obstacles.1: hole at x=2 lies outside the beam [0, L=1.5]"),
+    ("obstacles.1.hole.sides=2", "obstacles.1.hole: sides=2 must be a whole number ≥ 3"),
+])
+def test_a_hole_refused_names_its_obstacle(tmp_path, capsys, setting, word):
+    """With two baffles, "radius=-0.0004 must be > 0" did not say which."""
+    assert_refused(run_main, [str(example("tube_round_holes")), "--set", setting, "--out",
+                              str(tmp_path / "x")], word, capsys, tmp_path)
+
+
 def test_a_whole_number_written_as_a_float_is_taken():
     """TOML's 1e3 and 40.0 are floats: they were refused as "J=40.0 must be a whole
     number", which they are."""
@@ -1153,3 +1165,15 @@ def test_errors_about_t_name_the_flag_and_others_the_file(tmp_path, capsys, sets
     assert_refused(run_main, [str(example("plate_on_stops")), "--T", T, "--out",
                               str(out / "run")] + [a for s in sets for a in ("--set", s)],
                    line, capsys, out)
+
+
+def test_a_driver_above_the_nyquist_frequency_warns_and_runs(tmp_path, capsys):
+    """A random band at 6–9 kHz with dt = 1e-4 s (Nyquist 5 kHz) ran without a word, its
+    response 14 times that at dt = 1e-5 s."""
+    sets = ["time.T=0.002", "loads.0.random.f_low=6000", "loads.0.random.f_high=9000"]
+    argv = [str(example("tube_round_holes")), "--format", "none", "--out", str(tmp_path / "r")]
+    assert exit_code(run_main, argv + [a for s in sets for a in ("--set", s)]) == 0
+    err = [e for e in capsys.readouterr().err.splitlines() if "Nyquist" in e]
+    assert err == ["warning: loads.0: its highest frequency, 9000 Hz, lies above the steps' "
+                   "Nyquist frequency 1/(2 dt) = 5000 Hz: the steps alias it to a lower one; "
+                   "dt ≤ 5.56e-05 s resolves it (about 10 steps a period: 1.11e-05 s)"]

@@ -15,7 +15,7 @@ from ..output.fields import physical_at, physical_tip
 from ..output.probes import probe_columns, probe_units
 from ..output.checkpoint import read_summary
 from ..output.stream import Series, execute, prepare
-from ..output.supports import support_table, support_wear
+from ..output.supports import support_table, support_wear, worn_through
 from ..methods import MoreauJean, Penalty, summary_word
 from ..scheme.kernels import WORK_TERMS
 from ..spec import RunSpec
@@ -80,6 +80,8 @@ def print_supports(folder: Path, wear) -> None:
     text = support_table(stats.get("supports") or [], newtons, wear)
     if text:
         print(text)
+    for line in worn_through(stats.get("supports") or [], wear):
+        cli.warn(line)
 
 
 def print_springs(folder: Path) -> None:

@@ -48,17 +48,19 @@ class Wear:
     ``land`` b (m, the support's axial contact width), ``radius`` R (m, the tube's outer
     radius); the module docstring says what each number assumes.  The volumes need only
     K and Y; the depths spread them over the land and the radius, so with ``land`` None
-    there are no depths (and the radius may be None)."""
+    there are no depths (and the radius may be None).  ``wall`` (m, a tube's wall, None:
+    not a tube): a deepest sector deeper than it is said (`worn_through`)."""
     coefficient: float
     service_years: float
     land: float | None = None
     radius: float | None = None
+    wall: float | None = None
 
     def __post_init__(self):
         if self.land is not None and self.radius is None:
             raise InputError("[wear] land: a depth spreads the volume over the land and the "
                              "tube's radius: give radius (m) too")
-        for name in ("coefficient", "service_years", "land", "radius"):
+        for name in ("coefficient", "service_years", "land", "radius", "wall"):
             if getattr(self, name) is None:
                 continue        # land, radius: only the depths need them
             object.__setattr__(self, name, check_positive(f"[wear] {name}",
@@ -89,6 +91,24 @@ class Wear:
 
 
 ANGLE_BINS = SECTORS   # the impact-angle histogram: the wear's 30° sectors, −180° to 180°
+
+
+def worn_through(supports: list[dict], wear: Wear | None) -> list[str]:
+    """One line per support whose deepest sector wears deeper than the tube's wall within
+    the service years: Archard's law is then extrapolated past the wall (the table's
+    depth is not a remaining wall)."""
+    if wear is None or wear.wall is None:
+        return []
+    lines = []
+    for s in supports:
+        depths = [k["depth"] for k in (s.get("wear") or {}).get("sectors", []) if "depth" in k]
+        if depths and max(depths) > wear.wall:
+            years = wear.service_years * wear.wall / max(depths)    # depth ∝ time
+            lines.append(f"the support at x={s['x']:g} wears {max(depths) * 1e3:.4g} mm deep "
+                         f"in {wear.service_years:g} years, more than the tube's wall "
+                         f"({wear.wall * 1e3:g} mm): it wears through in about {years:.3g} "
+                         "years (the depth past the wall is Archard's law extrapolated)")
+    return lines
 
 
 def union_length(start: np.ndarray, end: np.ndarray) -> float:

@@ -125,7 +125,7 @@ def beam_problem(data: dict, reader: Tables) -> BeamProblem:
     beam = _beam(data)
     ends = data.get("ends", {})
     mesh = data.get("mesh", {})
-    obstacles, holes = obstacles_and_holes(data)
+    obstacles, holes = obstacles_and_holes(data, beam.L)
     load, load_w = loads_of(data, reader, beam.L)
     problem = BeamProblem(
         beam, obstacles, support_of(data, beam.L, reader), load,

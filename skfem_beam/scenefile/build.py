@@ -15,6 +15,7 @@ from ..errors import InputError
 from ..scheme import Stepping
 from .bar import bar_problem
 from .beam import beam_problem
+from .forcing import warn_aliased
 from .parts import named_section, need, outer_radius, plane_count, stepping_of
 from .read import Parsed, Tables, read
 from .schema import CONTACT, OUTPUT_DEFAULTS
@@ -175,6 +176,7 @@ def _scene(kind, problem, data, text, files) -> Scene:
     methods.check_massless(rows, mesh.get("mass", "consistent"), "[mesh] massless")
     stepping = stepping_of(t, out, load_window=t.get("load_window", "forward"),
                            massless=rows or "beta")
+    warn_aliased(data, stepping.dt)
     scene = Scene(kind, problem, stepping, law, k, contact.get("restitution", 0.0), out, text,
                   files, data, c)
     try:
@@ -207,7 +209,9 @@ def wear(scene: Scene):
         raise InputError("[wear] radius (m, the tube's outer radius) is needed for the depth "
                          "(land) when the section is not a tube or a rod, or its segments' "
                          "outer diameters differ")
+    walls = {section.get("tube", {}).get("wall") for section in sections}
     given = need(d, ("coefficient", "service_years"), "wear")
-    return Wear(given["coefficient"], given["service_years"], d.get("land"), radius)
+    return Wear(given["coefficient"], given["service_years"], d.get("land"), radius,
+                walls.pop() if len(walls) == 1 else None)
 
 

@@ -65,6 +65,33 @@ def _time_form(d: dict, where: str, reader: Tables):
         k: random[k] for k in ("seed", "count") if k in random})
 
 
+def highest_frequency(d: dict) -> float:
+    """The highest frequency (Hz) a [motion] or [[loads]] table's time function holds: its
+    omega, its sines' omegas, its random band's f_high (0: none, or a table or PSD file,
+    not read here)."""
+    omegas = [d.get("omega", 0.0)] + [r[1] for r in d.get("sines", []) if len(r) > 1]
+    band = d.get("random", {}).get("f_high", 0.0) if isinstance(d.get("random"), dict) \
+        else 0.0
+    return max([abs(w) / (2 * math.pi) for w in omegas] + [band])
+
+
+def warn_aliased(data: dict, dt: float) -> None:
+    """One warning line for each driver whose highest frequency lies above the steps'
+    Nyquist frequency 1/(2 dt): the scheme samples it at the steps, so it acts as another,
+    lower frequency (a band at 6–9 kHz with dt = 1e-4 s moved the tube 14 times more than
+    with dt = 1e-5 s, without a word)."""
+    from ..cli import warn
+    drivers = [("[motion]", data.get("motion"))] + \
+        [(f"loads.{i}", d) for i, d in enumerate(data.get("loads", []))]
+    for where, d in drivers:
+        f = highest_frequency(d) if isinstance(d, dict) else 0.0
+        if f > 0.5 / dt:
+            warn(f"{where}: its highest frequency, {f:g} Hz, lies above the steps' Nyquist "
+                 f"frequency 1/(2 dt) = {0.5 / dt:g} Hz: the steps alias it to a lower one; "
+                 f"dt ≤ {0.5 / f:.3g} s resolves it (about 10 steps a period: "
+                 f"{0.1 / f:.3g} s)")
+
+
 def support_of(data: dict, L: float, reader: Tables) -> Support:
     m = data.get("motion")
     if m is None:

@@ -52,14 +52,28 @@ def _hole(o: dict, i: int, friction: float = 0.0):
     where = f"obstacles.{i}"
     if "g1" in o or "g2" in o:
         raise InputError(f"[{where}] a hole bounds (v, w) itself: leave out g1, g2")
-    hole = hole_from_table(o["hole"], f"{where}.hole")
+    hole = _named(f"{where}.hole", lambda: hole_from_table(o["hole"], f"{where}.hole"))
     mu = o.get("friction", friction)
     if "x" in o:
         if "x_from" in o or "x_to" in o:
             raise InputError(f"[{where}] give x or x_from, x_to, not both")
-        return HoleAt(hole, o["x"], carried=o.get("carried", False), friction=mu)
-    a, b = need(o, ("x_from", "x_to"), where).values()
-    return HoleAt(hole, a, b, carried=o.get("carried", False), friction=mu)
+        at = (o["x"],)
+    else:
+        at = tuple(need(o, ("x_from", "x_to"), where).values())
+    return _named(where, lambda: HoleAt(hole, *at, carried=o.get("carried", False),
+                                        friction=mu))
+
+
+def _named(where: str, make):
+    """make(), its refusal prefixed with the key path ``where`` (a hole's own checks name
+    only the value: with two baffles the user could not tell which was wrong)."""
+    try:
+        return make()
+    except InputError as e:
+        text = str(e)
+        if text.startswith((where, f"[{where}]")):
+            raise
+        raise InputError(f"{where}: {text}") from None
 
 
 def _obstacle(o: dict, i: int) -> Obstacles:
@@ -93,13 +107,19 @@ def _warn_hole_size(items, tube: float | None) -> None:
                  "(0.0004 for 0.4 mm), not the hole's own radius")
 
 
-def obstacles_and_holes(data: dict) -> tuple[Obstacles, tuple]:
-    """The flat obstacles (the first plane's, g1 ≤ v ≤ g2) and the holes."""
+def obstacles_and_holes(data: dict, L: float) -> tuple[Obstacles, tuple]:
+    """The flat obstacles (the first plane's, g1 ≤ v ≤ g2) and the holes, each on the beam
+    [0, L] (BeamProblem checks it too, without the key path)."""
     items = list(enumerate(data.get("obstacles", [])))
     mu = data.get("contact", {}).get("friction", 0.0)
     if check_finite("[contact] friction", mu) < 0:     # also where every hole sets its own
         raise InputError(f"[contact] friction={mu:g} must be ≥ 0 (Coulomb's μ)")
     holes = tuple(_hole(o, i, mu) for i, o in items if "hole" in o)
+    for i, h in zip([i for i, o in items if "hole" in o], holes):
+        for b in h.breakpoints:
+            if not 0.0 <= b <= L:
+                raise InputError(f"obstacles.{i}: hole at x={b:g} lies outside the beam "
+                                 f"[0, L={L:g}]")
     _warn_hole_size(items, outer_radius(data.get("section", {})))
     if (mu or any("friction" in o for _, o in items)) and plane_count(data) != 2:
         raise InputError("friction acts along the wall of a hole, in the cross-section: the "

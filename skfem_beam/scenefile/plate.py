@@ -17,7 +17,7 @@ from ..contact import SOLVERS
 from ..errors import InputError
 from ..plate.model import EDGES, ELEMENTS, MAX_PLATE_SIDE, SUPPORTS, MeshPlate, Plate
 from ..scheme import Stepping
-from .forcing import _time_function
+from .forcing import _time_function, warn_aliased
 from .parts import named_section, need, stepping_of, warn_implausible
 from .read import Parsed, Tables
 from .schema import OUTPUT_DEFAULTS, PLATE_KEYS
@@ -353,5 +353,6 @@ def plate_scene(parsed: Parsed, tables: Tables, dynamic: bool = True) -> PlateSc
                           initial_of(data), probes)
     out = {**OUTPUT_DEFAULTS, **data.get("output", {})}
     stepping = stepping_of(t, out)
+    warn_aliased(parsed.data, stepping.dt)
     return PlateScene("plate", PlateSetup(space, system, probes), stepping, method, out,
                       parsed.text, tables.read, data, tables.meshes)

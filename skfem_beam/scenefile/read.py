@@ -52,7 +52,10 @@ def read(path, overrides=(), files: dict | None = None, text: str | None = None,
     kind = data.get("kind", "beam")
     if not isinstance(kind, str) or kind not in KINDS:     # a list: unhashable, a traceback
         raise InputError(f"{path}: kind={kind!r} must be one of: {', '.join(KINDS)}")
-    sets = dict(apply_set(data, assignment) for assignment in overrides)
+    try:
+        sets = dict(apply_set(data, assignment) for assignment in overrides)
+    except InputError as e:
+        raise InputError(f"{path.name}: {e}") from None
     if data.get("kind", "beam") != kind:
         raise InputError(f"{path}: --set kind={data.get('kind')!r}: a scene's kind is its "
                          f"file's ({kind!r}); write another file for another kind")

@@ -561,3 +561,19 @@ def test_a_support_worn_past_the_tube_wall_is_said_with_when():
                      "past the wall is Archard's law extrapolated)"]
     assert worn_through([{"x": 0.5, "wear": {"sectors": sectors}}],
                         Wear(1e-14, 40.0, 0.019, 0.0095)) == []     # not a tube: no wall
+
+
+@pytest.mark.parametrize("law", ["auto", "moreau-jean"])
+def test_the_wear_work_rate_is_the_friction_work_over_mu(tmp_path, law):
+    """Archard's |F_n||v_t| where friction acts is the friction work over μ (the slip's
+    share of the force), under either scheme.  Moreau–Jean's counted, at an impact that
+    sticks, the velocity before it: at μ = 3 it read 0.0378 W against a friction work
+    rate of 0.016 W (0.0053 W over μ), and it did not fall from μ = 3 to 30."""
+    out = tmp_path / "r"
+    assert exit_code(run_main, [str(example("tube_round_holes_friction")), "--format",
+                                "none", "--out", str(out), "--set", "time.T=0.3", "--set",
+                                f"contact.law={law}", "--set", "contact.friction=3"]) == 0
+    supports = json.loads((out / "summary.json").read_text())["impact_statistics"]["supports"]
+    for s in supports:
+        assert s["friction_work_rate"] > 0
+        assert s["normal_work_rate"] == pytest.approx(s["friction_work_rate"] / 3, rel=1e-9)

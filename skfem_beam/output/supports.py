@@ -12,7 +12,11 @@ length, m³/s³), over the run's time T:
 - ``normal_work_rate``: (1/T)∫|F_n||v_t| dt, |F_n| the contact force's normal part, v_t
   the node's velocity along the wall ((y^{n+1} − y^{n−1})/(2Δt), its component along the
   tangent of the face, or of the circle at the node); the wear work rate of Archard's law
-  per unit wear coefficient;
+  per unit wear coefficient.  Where friction acts (μ > 0) it is the friction work over μ,
+  the share of the force that slid: the same number for the β-scheme, whose friction law
+  slips by y^{n+1} − y^{n−1}; for Moreau–Jean, whose impacts are instantaneous, the
+  central difference counted at an impact that sticks the velocity before it (a rate that
+  did not fall with μ);
 - ``friction_work_rate`` (with friction): −(1/T) × the support's share of the friction
   work (the energy its friction takes per second, ≥ 0).
 

@@ -472,14 +472,14 @@ def _to_friction(mt, s, work, rowwork, ev, row, dt):
 
 
 @njit(cache=True, inline="always")
-def track_holes(ops, st, step, p, lands, friction):
+def track_holes(ops, st, step, p, lands, friction, slid):
     """hole_kinematics of the state after step (its arrays read off the tuples here: the
     out-of-line function takes arrays, not the tuples' structs, which cost its compile
-    ~1 CPU s more)."""
+    ~1 CPU s more); ``slid``: hole_kinematics' ``slid``."""
     hole_kinematics(ops.pair, ops.Nc, (ops.Np, ops.Ni, ops.Nx), (st.u_cur, st.stats[3]),
                     (st.mu, st.dy, st.y_cur, st.lo, st.hi),
-                    (st.work, st.rowwork, st.impact, st.pos, st.sectors), step, ops.dt, p,
-                    lands, friction)
+                    (st.work, st.rowwork, st.impact, st.pos, st.sectors, slid), step, ops.dt,
+                    p, lands, friction)
 
 
 @internal
@@ -489,13 +489,15 @@ def hole_kinematics(pair, Nc, nodes, at, force, tallies, step, dt, p, lands, fri
     sectors: |F_n||v_t|Δt with F_n the force's normal part, in the sector the wall's
     normal points to).  ``nodes``: Ops' (Np, Ni, Nx); ``at``: (uⁿ⁺¹, φ(t_{n+1})); ``force``:
     State's (mu, dy, y_cur, lo, hi); ``tallies``: State's (work, rowwork, impact, pos,
-    sectors).  ``lands``: None (no broached hole: their code is not compiled), or Ops.Nc;
+    sectors) and ``slid``: per row the |F_n||v_t|Δt its scheme found itself (NaN: none),
+    or empty (the β-scheme: none; Moreau–Jean gives its rows with friction theirs,
+    moreau_jean.mj_steps).  ``lands``: None (no broached hole: their code is not compiled), or Ops.Nc;
     ``friction``: None (no row with Coulomb's μ in Nc's FRICTION_COLUMN: the friction
     splits are not compiled, `friction_of_ops`), or Ops.Nc."""
     Np, Ni, Nx = nodes
     u, phi = at
     mu, dy, y_cur, lo, hi = force
-    work, rowwork, impact, pos, sectors = tallies
+    work, rowwork, impact, pos, sectors, slid = tallies
     for j in range(mu.size):
         if pair[j] < 0:
             continue
@@ -524,6 +526,8 @@ def hole_kinematics(pair, Nc, nodes, at, force, tallies, step, dt, p, lands, fri
             vx = (p[0] - pos[j, 0]) / (2.0 * dt)
             vy = (p[1] - pos[j, 1]) / (2.0 * dt)
             w = f / (dt * dt) * abs(-vx * ny + vy * nx) * dt
+            if slid.size and not np.isnan(slid[j]):
+                w = slid[j]
             rowwork[j, 1] += w
             # the sector the wall's outward normal points to: in a round hole the node's
             # angle; on a broached hole's land edge (the node in a lobe's corner) the edge's;
@@ -659,7 +663,7 @@ def run_steps(law, explicit, ops, st, out, n0, n1, inputs, holes, massless, land
         finish_step(ops, st, Gn, massless)
         full = track_impacts(ops, st, out, step, lands)
         if holes is not None:
-            track_holes(ops, st, step, holes[0], lands, holes[1])
+            track_holes(ops, st, step, holes[0], lands, holes[1], holes[0][:0])
         record(step + 1, ops, st, out, lands)
         code = stop_code(ops, st, out, step, full)
         if code:
@@ -742,7 +746,7 @@ def run_steps_python(ops, st, out, n0, n1, inputs, free_inside, holes,
         finish_step(ops, st, Gn, massless)
         full = track_impacts(ops, st, out, step, lands)
         if holes is not None:
-            track_holes(ops, st, step, holes[0], lands, holes[1])
+            track_holes(ops, st, step, holes[0], lands, holes[1], holes[0][:0])
         record(step + 1, ops, st, out, lands)
         code = stop_code(ops, st, out, step, full)
         if code:

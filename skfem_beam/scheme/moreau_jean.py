@@ -72,6 +72,7 @@ MJState = namedtuple("MJState", [
     "law_state", "active", "active_prev", "stats", "counters", "work", "impact",
     "pos", "rowwork", "sectors", "hk", "fc",   # two planes (kernels.State)
     "fres",                                # round holes: [the step's NSGS residual, max]
+    "slid",                                # two planes: a row's |F_n||v_t|Δt (mj_steps)
     "mu",                                  # Δt·p (so that mu/Δt² is the force p/Δt)
     "p", "wf", "x", "dv", "Ku", "Kv",   # scratch
 ])
@@ -219,21 +220,28 @@ def mj_steps(ops, st, out, n0, n1, inputs):
         if st.rowwork.shape[0]:          # two planes: each row's share
             for j in range(m):
                 st.rowwork[j, 0] += st.p[j] * (st.y_cur[j] - st.y_prev[j]) / dt
+        st.slid[:] = np.nan
         for a in ops.disks:              # a round hole's friction part of its work
             b = ops.pair[a]
             st.active[b] = False
             st.active[a] = st.p[a] != 0.0 or st.p[b] != 0.0
+            if st.fc.shape[0] and ops.fric[a] > 0.0:
+                # Archard's |F_n||v_t|Δt: the friction work over μ, the share of the
+                # impulse that slid (the central difference counted, at an impact that
+                # sticks, the velocity before it: a rate that did not fall with μ)
+                st.slid[a] = 0.0
             if st.fc.shape[0] and st.fc[a, 1] != 0.0:
                 f = st.fc[a, 1] * (-st.fc[a, 5] * (st.y_cur[a] - st.y_prev[a])
                                    + st.fc[a, 4] * (st.y_cur[b] - st.y_prev[b])) / dt
                 st.work[2] -= f
                 st.work[FRICTION] += f
+                st.slid[a] = abs(f) / ops.fric[a]
                 if st.rowwork.shape[0]:
                     st.rowwork[a, 0] -= f
                     st.rowwork[a, 2] += f
         full = track_impacts(ops, st, out, step, None)      # no broached hole (refused)
         if ops.Nc.shape[0]:
-            track_holes(ops, st, step, st.hk, None, None)   # (Nc: no μ, friction below)
+            track_holes(ops, st, step, st.hk, None, None, st.slid)   # (Nc: no μ; above)
         mj_record(step + 1, ops, st, out)
         code = stop_code(ops, st, out, step, full)     # the β-scheme's test, on its rows
         if code:
@@ -255,7 +263,7 @@ def check_theta(theta, name: str = "theta=") -> float:
 
 
 # checkpointed: every field of MJState but the step's scratch (p, wf, x, dv, Ku, Kv, hk)
-_MJ_SCRATCH = ("p", "wf", "x", "dv", "Ku", "Kv", "hk")
+_MJ_SCRATCH = ("p", "wf", "x", "dv", "Ku", "Kv", "hk", "slid")
 
 
 class MoreauJeanScheme:
@@ -318,7 +326,7 @@ class MoreauJeanScheme:
                        active_prev=z(m, np.bool_), stats=z(4), counters=z(6, np.int64),
                        work=z(4), impact=np.full((m, IMPACT_FIELDS), -1.0),
                        **two_plane_state(self.ops, bool(disk_rows(system).size)),
-                       fres=z(2), mu=z(m), p=z(m), wf=z(m),
+                       fres=z(2), slid=z(m), mu=z(m), p=z(m), wf=z(m),
                        x=z(n), dv=z(n), Ku=z(n), Kv=z(n))
 
     def series(self, rows: int, nframes: int) -> Series:

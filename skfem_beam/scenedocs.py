@@ -82,8 +82,9 @@ SECTION_DOCS = {
         'and S in N²/m²/Hz for a distributed force, synthesised with the seed: '
         '`timefunctions.from_psd`); a distributed load over part of the beam: `x_from`, '
         '`x_to` (exact when they are nodes); two planes: `direction = [dy, dz]` (a direction: '
-        'its length is not used; default the first plane), or `rotating = {amplitude, omega, phase}` instead of a time function '
-        '(amplitude·cos(ωt + phase) along y, ·sin along z). Bar: `value` (a body force, N/m³)'
+        'its length is not used; default the first plane), or `rotating = {amplitude, '
+        'omega, phase}` instead of a time function (amplitude·cos(ωt + phase) along y, '
+        '·sin along z). Bar: `value` (a body force, N/m³)'
     ),
     'initial': (
         '`mode = k`, `amplitude` (u0 = amplitude × the k-th mode shape, its largest \\|u\\| 1) '

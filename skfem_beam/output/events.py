@@ -234,7 +234,8 @@ def _write_impacts(folder, run, units, scale, sign, obstacles, last, wear) -> tu
         f += RIGID_PEAK + ", or give the supports a stiffness"
     stats["units"] = {"t_start": "s", "t_end": "s", "x": "m", "bound": "1 = g1 (lower), "
                       "2 = g2 (upper); a round or broached hole's contacts: 1 (its wall; "
-                      "where on it: angle)", "velocity": VELOCITY, "peak_force": f, "impulse": i,
+                      "where on it: angle)", "velocity": VELOCITY, "peak_force": f,
+                      "impulse": i,
                       "max_violation": "m", "open": "1 = not over at the last state",
                       "contact_fraction": EPISODES}
     if planes == 2:

@@ -111,9 +111,9 @@ def _check_overlaps(points, triangles, source: str) -> None:
     if third.size:
         i = int(third[0])
         three = ", ".join(str(int(k)) for k in owner[i:i + 3])
-        raise InputError(f"the mesh {source}: triangles {three} share the edge ({int(edges[0, i])}, {int(edges[1, i])}): "
-                         "overlapping or repeated triangles; a plate's triangles meet "
-                         "two at an edge")
+        raise InputError(f"the mesh {source}: triangles {three} share the edge "
+                         f"({int(edges[0, i])}, {int(edges[1, i])}): overlapping or repeated "
+                         "triangles; a plate's triangles meet two at an edge")
     pair = np.flatnonzero(same)
     a, b = points[:, edges[0, pair]], points[:, edges[1, pair]]
 
@@ -124,9 +124,9 @@ def _check_overlaps(points, triangles, source: str) -> None:
     if folded.size:
         i = int(pair[folded[0]])
         raise InputError(f"the mesh {source}: triangles {int(owner[i])} and "
-                         f"{int(owner[i + 1])} overlap (both on one side of their edge ({int(edges[0, i])}, "
-                         f"{int(edges[1, i])})); a plate's triangles meet two at an edge, "
-                         "one on each side")
+                         f"{int(owner[i + 1])} overlap (both on one side of their edge "
+                         f"({int(edges[0, i])}, {int(edges[1, i])})); a plate's triangles "
+                         "meet two at an edge, one on each side")
 
 
 def plate_mesh(plate):

@@ -129,7 +129,8 @@ def beam_problem(data: dict, reader: Tables) -> BeamProblem:
     load, load_w = loads_of(data, reader, beam.L)
     problem = BeamProblem(
         beam, obstacles, support_of(data, beam.L, reader), load,
-        J=check_count("[mesh] J", mesh.get("J", 19), most=MAX_ELEMENTS), element=mesh.get("element", "hermite"), nodes=mesh.get("nodes"),
+        J=check_count("[mesh] J", mesh.get("J", 19), most=MAX_ELEMENTS),
+        element=mesh.get("element", "hermite"), nodes=mesh.get("nodes"),
         ends=(ends.get("left", "clamped"), ends.get("right", "free")),
         supports=tuple(s.get("x", math.nan) for s in data.get("supports", [])),
         damping=_damping(data), planes=plane_count(data), holes=holes,

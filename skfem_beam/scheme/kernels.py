@@ -492,8 +492,8 @@ def hole_kinematics(pair, Nc, nodes, at, force, tallies, step, dt, p, lands, fri
     sectors) and ``slid``: per row the |F_n||v_t|Δt its scheme found itself (NaN: none),
     or empty (the β-scheme: none; Moreau–Jean gives its rows with friction theirs,
     moreau_jean.mj_steps).  ``lands``: None (no broached hole: their code is not
-    compiled), or Ops.Nc; ``friction``: None (no row with Coulomb's μ in Nc's FRICTION_COLUMN: the friction
-    splits are not compiled, `friction_of_ops`), or Ops.Nc."""
+    compiled), or Ops.Nc; ``friction``: None (no row with Coulomb's μ in Nc's
+    FRICTION_COLUMN: the friction splits are not compiled, `friction_of_ops`), or Ops.Nc."""
     Np, Ni, Nx = nodes
     u, phi = at
     mu, dy, y_cur, lo, hi = force

@@ -117,10 +117,14 @@ def parse(p: Parser, argv=None):
     """Parse the flags; with --resume, the flags stored by the run being resumed.  The
     method's words are checked once here, and β takes the method's default."""
     args = stored_args(p.parse_args(argv), p, argv)
+    given = {} if args.resume else given_flags(p, argv)
+    if getattr(args, "mesh", None) is not None and "J" in given:   # J was recorded, not run
+        raise InputError(f"--J {args.J} with --mesh {args.mesh}: the mesh file's nodes are "
+                         "the elements; give one of them")
     if hasattr(args, "law"):
         check_law(args, p)
         if not args.resume:
-            not_its_law(args, _given(p, argv))
+            not_its_law(args, given)
         if args.beta is None:
             args.beta = methods.default_beta(method(args))
     return args
@@ -274,7 +278,7 @@ def warn(message: str) -> None:
 
 # ------------------------------------------------------------ --resume: the stored flags
 
-def _given(parser, argv) -> dict:
+def given_flags(parser, argv) -> dict:
     """The flags written on the command line (not the defaults)."""
     actions = [a for a in parser._actions if a.default is not argparse.SUPPRESS]
     saved = [a.default for a in actions]
@@ -333,7 +337,7 @@ def stored_args(args, parser, argv=None):
     _same_command(out, summary, parser.prog)
     ck = read_checkpoint(out) if has_checkpoint(out) else None
     config = summary["config"]
-    given = _given(parser, argv)
+    given = given_flags(parser, argv)
     T = config.get("T")
     for k, v in given.items():
         if k == "resume" or k == "out" and Path(v).resolve() == out.resolve():

@@ -2,12 +2,23 @@
 and exit code 2 (``errors.EXIT_INPUT``), not a usage block.  ``cli`` builds the scenes'
 flags on it; ``results.export_main`` and the scene file's subcommands use it too."""
 import argparse
+import re
 
 from .errors import EXIT_INPUT
 
 
+# a negative number argparse takes for a value, not a flag: its own "-1", "-.5", and also
+# "-1e-3" ("--dt -1e-3" read "expected one argument", "--v0 -1e-1" was unusable)
+NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
+
+
 class Parser(argparse.ArgumentParser):
-    """argparse, but a bad flag gives one line on stderr, not a usage block."""
+    """argparse, but a bad flag gives one line on stderr, not a usage block, and a negative
+    number in exponent form is a value."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = NEGATIVE_NUMBER
 
     def error(self, message):
         self.exit(EXIT_INPUT, f"{self.prog}: error: {message}\n")

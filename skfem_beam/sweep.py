@@ -54,6 +54,7 @@ from .errors import InputError, SolverError
 from .output.folder import (EXIT_SOLVER, EXIT_UNSTABLE, Folder, atomic_write,
                              check_output_dir, stamp)
 from .output.stream import Signals
+from .chart_process import draw, wanted as charts_wanted
 from .checks import check_beta, check_nonnegative, check_positive
 from .sweep_cluster import dask_client, on_cluster
 
@@ -63,6 +64,7 @@ SCENES = {
 }
 SECTION = "tip_displacement"   # the observed value whose section is kept
 CHUNK = 20000                  # steps per call into the compiled loop
+WORKERS_PER_CORE = 4           # --workers at most this many a core: each is a process
 
 
 # ---------------------------------------------------------------- inputs
@@ -367,10 +369,11 @@ def assemble(out: Path, settings: dict, results: list[dict], extra: dict | None 
         [[r["value"]] + [r[c] for c in cols if c != param]
          + [(r.get("damping") or {}).get(c) for c in damp] + [r["status"]] for r in results]))
     from .output.charts import bifurcation_chart   # charts where one is drawn, not in workers
-    bifurcation_chart(out / "bifurcation.png", settings, results)
+    draw(bifurcation_chart, out / "bifurcation.png", settings, results)  # SKFEM_BEAM_CHARTS
     summary = {"settings": settings, "values": len(results),
                "failed": sum(r["status"] != "success" for r in results),
-               "files": ["poincare.csv", "runs.csv", "bifurcation.png", "runs/"],
+               "files": ["poincare.csv", "runs.csv"]
+               + (["bifurcation.png"] if charts_wanted() else []) + ["runs/"],
                "units": {param: PARAM_UNITS.get(param, "the swept value"),
                          "omega": "rad/s, the support's circular frequency",
                          "dt": "s, the time step (a whole number of steps per period)",
@@ -496,7 +499,8 @@ def parser():
                        help=f"fixed value of {name} when not swept (default {default:g})")
     p.add_argument("--workers", type=int, default=argparse.SUPPRESS,
                    help="local Dask worker processes (default: one per core; without "
-                        "Dask installed, none); 0 = no Dask")
+                        "Dask installed, none; at most 4 a core, and no more than the "
+                        "values); 0 = no Dask")
     p.add_argument("--scheduler", default=argparse.SUPPRESS,
                    help="address of an existing Dask scheduler, e.g. tcp://10.0.0.5:8786")
     p.add_argument("--out", default="out/sweep", help="output folder (resumed if it exists)")
@@ -516,6 +520,7 @@ def main(argv=None) -> int:
                              **{k: getattr(args, k) for k in SETTINGS}, **fixed)
     values = parse_values(args.values)
     check_values(settings, values)
+    charts_wanted()         # a bad SKFEM_BEAM_CHARTS: one line before any folder
     scheduler, workers = getattr(args, "scheduler", None), getattr(args, "workers", None)
     if scheduler and workers is not None:
         raise InputError("give either --workers or --scheduler, not both")
@@ -523,9 +528,14 @@ def main(argv=None) -> int:
         print("note: Dask is not installed (pip install \"skfem_beam[cluster]\" for one "
               "worker per core): the values run one after the other", file=sys.stderr)
         workers = 0
-    workers = (os.cpu_count() or 1) if workers is None else workers
+    cores = os.cpu_count() or 1
+    workers = cores if workers is None else workers
     if workers < 0:
         raise InputError(f"--workers {workers} must be ≥ 0")
+    if workers > WORKERS_PER_CORE * cores:      # each a process: 1000 exhausted the memory
+        raise InputError(f"--workers {workers} on {cores} cores: at most "
+                         f"{WORKERS_PER_CORE * cores} (the default is one a core)")
+    workers = min(workers, len(values))         # one value each at most: no idle process
     out = check_out(args.out, args.overwrite)
     progress = not args.no_progress
     serial = (scheduler is None and workers == 0) or not args.overwrite and all(

@@ -373,8 +373,15 @@ def test_case_end_to_end(tmp_path):
 @pytest.mark.parametrize("args, word", [
     (["--N", "0"], "N=0"), (["--a", "0"], "a=0"), (["--rho", "-1"], "rho=-1"),
     (["--L", "0"], "L=0"), (["--dt", "0"], "dt=0"), (["--T", "-1"], "T=-1"),
-    (["--b", "-1"], "b=-1"), (["--k", "-1"], "k=-1"), (["--u0", "-0.1"], "u0=-0.1"),
-    (["--obstacle", "soft"], "soft"), (["--mass", "x"], "mass='x'"),
+    (["--b", "-1"], "b=-1"), (["--obstacle", "elastic", "--k", "-1"], "k=-1"),
+    (["--u0", "-0.1"], "u0=-0.1"), (["--obstacle", "soft"], "soft"),
+    (["--mass", "x"], "mass='x'"),
+    # a spring of the other obstacle: read and not used
+    (["--k", "50"], "--k 50 is the elastic obstacle's stiffness: with --obstacle rigid it "
+                    "is not used"),
+    (["--obstacle", "elastic", "--law", "penalty", "--stiffness", "5"],
+     "--stiffness 5 is the penalty springs' at a rigid obstacle"),
+    (["--v0", "-1e-1", "--dt", "-1e-3"], "dt=-0.001 must be > 0"),    # -1e-3: a value
 ])
 def test_case_bad_input_one_line_no_output(tmp_path, capsys, args, word):
     """In-process through the same guard as ``python -m`` (a subprocess each is slow)."""

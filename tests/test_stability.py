@@ -105,7 +105,7 @@ def test_penalty_penetrates_less_as_stiffness_grows(pipe_system):
     assert np.abs(exact.observed["tip_displacement"]).max() - 0.1 <= 1e-16
 
 
-def test_stability_map_small_grid(tmp_path):
+def test_stability_map_small_grid(tmp_path, charts):
     out = tmp_path / "map"
     assert exit_code(stability_map.main, ["--betas", "0,0.5", "--ratios", "0.9,1.2",
                                           "--T", "0.05", "--out", str(out)]) == 0

@@ -48,7 +48,7 @@ def results_without_timing(out):
     return runs
 
 
-def test_two_workers_match_serial_exactly(tmp_path):
+def test_two_workers_match_serial_exactly(tmp_path, charts):
     settings = make_settings("point_stops", "omega", **SHORT)
     values = parse_values("linspace(8, 30, 20)")
     # a folder given as a str (bench.sweep_throughput's): TypeError 'str' / 'str' before
@@ -104,7 +104,7 @@ def test_ctrl_c_on_a_sweep_with_workers_prints_one_line(tmp_path):
     assert "run the same command again to resume" in text
 
 
-def test_interrupted_sweep_resumes_without_redoing(tmp_path):
+def test_interrupted_sweep_resumes_without_redoing(tmp_path, charts):
     out = tmp_path / "sweep"
     args = ["--values", "linspace(8, 30, 10)", "--transient", "0.2", "--periods", "3", "--workers", "0",
             "--no-progress", "--out", str(out)]
@@ -141,7 +141,7 @@ def test_interrupted_sweep_resumes_without_redoing(tmp_path):
 
 
 def test_a_signal_after_the_last_value_lets_every_file_be_written(tmp_path, monkeypatch,
-                                                                   capsys):
+                                                                   capsys, charts):
     """SIGINT while the tables and chart are written (every value done): they are written,
     summary.json says success, exit 130 with a line saying so."""
     from skfem_beam import sweep as module
@@ -229,7 +229,7 @@ def test_refuses_a_folder_that_is_not_a_sweep(tmp_path, capsys):
     assert (tmp_path / "mine.txt").read_text() == "keep me"
 
 
-def test_scheduler_address_sends_the_same_work(tmp_path):
+def test_scheduler_address_sends_the_same_work(tmp_path, charts):
     """--scheduler: an existing cluster (here one started on loopback by the test)."""
     distributed = pytest.importorskip("distributed")
     args = ["--values", "9,13,17", "--transient", "0.2", "--periods", "3", "--no-progress"]
@@ -383,3 +383,25 @@ def test_sweep_values_and_params_that_ran_wrong_are_refused_or_reported(tmp_path
     assert exit_code(main, base + ["--values", "10,20", "--beta", "0", "--dt", "1e-4",
                                    "--out", str(out)]) == 4
     assert json.loads((out / "summary.json").read_text())["status"] == "unstable"
+
+
+def test_a_sweep_without_charts_draws_none_and_refuses_a_bad_setting(tmp_path, capsys,
+                                                                     monkeypatch):
+    """SKFEM_BEAM_CHARTS=0 drew bifurcation.png all the same, and =2 ran."""
+    argv = ["--values", "8", "--periods", "2", "--transient", "0.2", "--workers", "0",
+            "--no-progress"]
+    assert exit_code(main, argv + ["--out", str(tmp_path / "a")]) == 0
+    assert (tmp_path / "a" / "runs.csv").is_file()
+    assert not (tmp_path / "a" / "bifurcation.png").exists()
+    monkeypatch.setenv("SKFEM_BEAM_CHARTS", "2")
+    (tmp_path / "b").mkdir()
+    assert_refused(main, argv + ["--out", str(tmp_path / "b" / "sweep")],
+                   "SKFEM_BEAM_CHARTS='2' in the environment", capsys, tmp_path / "b")
+
+
+def test_more_workers_than_a_machine_runs_are_refused(tmp_path, capsys):
+    """--workers 1000 started a thousand processes: the kernel's OOM killer ended it."""
+    (tmp_path / "s").mkdir()
+    assert_refused(main, ["--values", "8,10", "--workers", "1000", "--out",
+                          str(tmp_path / "s" / "sweep")], "--workers 1000 on ", capsys,
+                   tmp_path / "s")

@@ -45,6 +45,7 @@ from ..methods import Penalty, PositionLevel
 from ..spec import RunSpec
 from ..reference import BarExact
 from ..checks import check_choice
+from ..errors import InputError
 from ..spaces.lagrange import ELEMENTS, MASSES
 
 CASE = "impacting_bar"
@@ -79,6 +80,7 @@ def main(argv=None) -> int:
                         "half the wave error at Δt/h = 0.4 with --beta 0.09)")
     args = cli.parse(p, argv)
     check_choice("--element", args.element, tuple(ELEMENTS))
+    _check_springs(args, {} if args.resume else cli.given_flags(p, argv))
 
     u0 = read_profile(args.u0_csv, "--u0-csv") if args.u0_csv else args.u0
     v0 = read_profile(args.v0_csv, "--v0-csv") if args.v0_csv else args.v0
@@ -86,6 +88,18 @@ def main(argv=None) -> int:
               obstacle=args.obstacle, k=args.k, N=args.N, mass=args.mass, element=args.element,
               far_end=args.far_end, obstacle_at=args.obstacle_at, A=args.A)
     return run_bar_case(bar, cli.spec(args))
+
+
+def _check_springs(args, given: dict) -> None:
+    """--k is the elastic obstacle's spring, --stiffness the rigid one's penalty springs:
+    each given where the other obstacle runs was read and not used."""
+    if "k" in given and args.obstacle != "elastic":
+        raise InputError(f"--k {args.k:g} is the elastic obstacle's stiffness: with "
+                         f"--obstacle {args.obstacle} it is not used (--obstacle elastic, or "
+                         "--law penalty --stiffness for springs at a rigid one)")
+    if "stiffness" in given and args.obstacle == "elastic":
+        raise InputError(f"--stiffness {args.stiffness:g} is the penalty springs' at a rigid "
+                         "obstacle: the elastic obstacle's spring is --k")
 
 
 def run_bar_case(bar: Bar, spec: RunSpec) -> int:

@@ -22,6 +22,7 @@ from .. import cli, scenes
 from ..errors import InputError
 from ..scheme import solve
 from ..methods import FLAGS, Penalty, law_of, make
+from ..chart_process import wanted
 from ..output.charts import figure
 from ..output.folder import Folder, check_output_dir
 from ..parser import about
@@ -149,8 +150,10 @@ def main(argv=None) -> int:
             w = csv.DictWriter(fh, fieldnames=list(rows[0]))
             w.writeheader()
             w.writerows(rows)
-        chart(folder / "stability_map.png", rows, kappa, kappa_paper,
-              f"pipe scene J={pb.J}, T={T:g} s: κ_h={kappa:.4g}, paper's κ̄={kappa_paper:.4g} s⁻²")
+        if wanted():        # SKFEM_BEAM_CHARTS=0: no picture, as every command
+            chart(folder / "stability_map.png", rows, kappa, kappa_paper,
+                  f"pipe scene J={pb.J}, T={T:g} s: κ_h={kappa:.4g}, paper's "
+                  f"κ̄={kappa_paper:.4g} s⁻²")
         folder.close(runs=len(rows),
                      bounds={f"beta={b:g}": stability_table(kappa, "hermite", pb.beam.k2, dx, b)
                              for b in betas},

@@ -67,6 +67,8 @@ def _make_locked(out: Path) -> None:
 
 def check_output_dir(out: str | os.PathLike, overwrite: bool = False) -> Path:
     """Refuse an ``--out`` that cannot be written, or holds another run (unless overwrite)."""
+    if not str(out).strip():    # Path("") is ".": the run's files landed in the cwd
+        raise InputError(f"--out {str(out)!r} is empty: name the run's folder")
     out = Path(out)
     longest = max((len(p.encode()) for p in out.parts), default=0)
     if longest > NAME_MAX:      # the checks below raised ENAMETOOLONG: exit 3, not 2

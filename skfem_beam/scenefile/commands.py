@@ -137,7 +137,8 @@ def _grid(scene, flags: dict, resume) -> tuple[OutputOptions, object]:
             flags[key] = value
             from_file.add(key)
     flags["T"] = scene.stepping.T if flags["T"] is None else flags["T"]
-    flags["out"] = flags["out"] or f"out/{Path(flags['scene']).stem}"
+    if flags["out"] is None:
+        flags["out"] = f"out/{Path(flags['scene']).stem}"
     try:
         options = OutputOptions(flags["out"], flags["overwrite"], resume, flags["format"],
                                 flags["frames"], flags["save_every"], flags["flush_every"],

@@ -127,14 +127,32 @@ def read_csv(path: Path) -> dict[str, np.ndarray]:
                              f"{len(header)} column names")
         return {name: values[:, i].copy() for i, name in enumerate(header)}
     rows = list(csv.reader(io.StringIO(body)))   # mixed columns (e.g. a label per impact)
-    out = {}
-    for i, name in enumerate(header):
-        col = [r[i] if i < len(r) else "" for r in rows]
+    return {name: _column(path, name, [r[i] if i < len(r) else "" for r in rows])
+            for i, name in enumerate(header)}
+
+
+def _column(path: Path, name: str, col: list[str]) -> np.ndarray:
+    """Floats, or strings for a column of text; a column of numbers with a word in it is
+    a damaged file (it came back as text, and an export wrote it so)."""
+    numbers = []
+    for row, v in enumerate(col):
         try:
-            out[name] = np.array([float(v) for v in col])
+            numbers.append(float(v))
         except ValueError:
-            out[name] = np.array(col)
-    return out
+            if v.strip() and any(_number(w) for w in col):
+                raise InputError(f"{path}: row {row + 2}, column {name}: {v!r} is not a "
+                                 "number, as the column's other values are (a damaged "
+                                 "file)") from None
+            return np.array(col)
+    return np.array(numbers)
+
+
+def _number(text: str) -> bool:
+    try:
+        float(text)
+        return True
+    except ValueError:
+        return False
 
 
 def _h5_item(folder: Path, item: ET.Element, h5files: dict):
@@ -337,6 +355,9 @@ def export(folder, to: str, out=None) -> Path:
                          "choose another file")
     if not out.parent.is_dir():
         raise InputError(f"--out {out}: folder {out.parent} does not exist")
+    if out.exists() and not _an_export(out, to):     # it replaced a user's thesis.mat
+        raise InputError(f"--out {out} exists and is not an export of a run: choose another "
+                         "file (an earlier export there is replaced)")
     run = read_run(folder)
     data = variables(run, matlab=to == "mat")
     tmp = out.with_name(f".{out.stem}.{os.getpid()}.tmp{out.suffix}")
@@ -351,6 +372,19 @@ def export(folder, to: str, out=None) -> Path:
     finally:
         tmp.unlink(missing_ok=True)
     return out
+
+
+def _an_export(path: Path, to: str) -> bool:
+    """Whether ``path`` is a file ``export`` wrote: its summary is in it (``summary_json``
+    in a .npz, ``summary`` in a .mat)."""
+    try:
+        if to == "npz":
+            with np.load(path) as f:
+                return "summary_json" in f.files
+        from scipy.io import whosmat
+        return any(name == "summary" for name, _, _ in whosmat(path))
+    except Exception:       # noqa: BLE001  (not a file numpy or scipy can read: not ours)
+        return False
 
 
 def export_main(argv=None) -> int:

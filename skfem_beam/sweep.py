@@ -79,6 +79,9 @@ def scene_defaults(scene: str) -> dict:
 
 
 _LINSPACE = re.compile(r"^linspace\(([^,()]+),([^,()]+),([^,()]+)\)$")
+_PLAIN_NUMBER = re.compile(r"^[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^[-+]?(inf|nan)$",
+                           re.IGNORECASE)
+_WHOLE = re.compile(r"^[-+]?\d+$")
 
 
 def parse_values(spec: str) -> list[float]:
@@ -95,21 +98,21 @@ def parse_values(spec: str) -> list[float]:
                          "write linspace(5, 40, 200) for 200 values from 5 to 40, or a "
                          "comma list 5,10,20")
     m = _LINSPACE.match(text)
-    try:
-        if m:
-            a, b, n = float(m[1]), float(m[2]), m[3]
-            if not n.lstrip("+-").isdigit():
-                raise ValueError
-            n = int(n)
-        else:
-            values = [float(v) for v in text.split(",")]
-    except ValueError:
+    words = [m[1], m[2]] if m else text.split(",")
+    # plain numbers only: Python's float() also reads "1_0" and full-width digits
+    if not all(_PLAIN_NUMBER.match(w) for w in words) or m and not _WHOLE.match(m[3]):
         raise InputError(f"--values {spec!r} is not linspace(a, b, n) (n values from a to "
-                         "b) or a comma list of numbers") from None
+                         "b) or a comma list of numbers")
     if m:
+        a, b, n = float(m[1]), float(m[2]), int(m[3])
         if n < 1:
             raise InputError(f"--values {spec!r}: n={n} must be at least 1")
+        if not (math.isfinite(a) and math.isfinite(b)):   # numpy warned, then "nan"
+            raise InputError(f"--values {spec!r}: {a if not math.isfinite(a) else b} is not "
+                             "a finite number")
         values = [a] if n == 1 else np.linspace(a, b, n).tolist()
+    else:
+        values = [float(v) for v in words]
     bad = [v for v in values if not math.isfinite(v)]
     if bad:
         raise InputError(f"--values {spec!r}: {bad[0]} is not a finite number")
@@ -509,19 +512,9 @@ def parser():
     return p
 
 
-def main(argv=None) -> int:
-    args = parser().parse_args(argv)
-    fixed = {n: getattr(args, n) for n in SCENES["point_stops"][1] if hasattr(args, n)}
-    if args.param in fixed:     # it was ignored (and recorded in the summary's config)
-        raise InputError(f"--{args.param} {fixed[args.param]:g} is the swept parameter's "
-                         f"value: --values gives them (--{args.param} fixes it when another "
-                         "is swept)")
-    settings = make_settings(args.scene, args.param,
-                             **{k: getattr(args, k) for k in SETTINGS}, **fixed)
-    values = parse_values(args.values)
-    check_values(settings, values)
-    charts_wanted()         # a bad SKFEM_BEAM_CHARTS: one line before any folder
-    scheduler, workers = getattr(args, "scheduler", None), getattr(args, "workers", None)
+def _workers(workers: int | None, scheduler: str | None, values: int) -> int:
+    """The local Dask workers: --workers (default one a core; none without Dask), at most
+    WORKERS_PER_CORE a core and no more than the values."""
     if scheduler and workers is not None:
         raise InputError("give either --workers or --scheduler, not both")
     if workers is None and not scheduler and importlib.util.find_spec("distributed") is None:
@@ -535,7 +528,23 @@ def main(argv=None) -> int:
     if workers > WORKERS_PER_CORE * cores:      # each a process: 1000 exhausted the memory
         raise InputError(f"--workers {workers} on {cores} cores: at most "
                          f"{WORKERS_PER_CORE * cores} (the default is one a core)")
-    workers = min(workers, len(values))         # one value each at most: no idle process
+    return min(workers, values)                 # one value each at most: no idle process
+
+
+def main(argv=None) -> int:
+    args = parser().parse_args(argv)
+    fixed = {n: getattr(args, n) for n in SCENES["point_stops"][1] if hasattr(args, n)}
+    if args.param in fixed:     # it was ignored (and recorded in the summary's config)
+        raise InputError(f"--{args.param} {fixed[args.param]:g} is the swept parameter's "
+                         f"value: --values gives them (--{args.param} fixes it when another "
+                         "is swept)")
+    settings = make_settings(args.scene, args.param,
+                             **{k: getattr(args, k) for k in SETTINGS}, **fixed)
+    values = parse_values(args.values)
+    check_values(settings, values)
+    charts_wanted()         # a bad SKFEM_BEAM_CHARTS: one line before any folder
+    scheduler = getattr(args, "scheduler", None)
+    workers = _workers(getattr(args, "workers", None), scheduler, len(values))
     out = check_out(args.out, args.overwrite)
     progress = not args.no_progress
     serial = (scheduler is None and workers == 0) or not args.overwrite and all(

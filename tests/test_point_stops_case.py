@@ -4,6 +4,8 @@ import json
 import subprocess
 import sys
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -11,6 +13,7 @@ from conftest import SUMMARY_KEYS, assert_refused, exit_code
 from skfem_beam.cases import point_stops
 from skfem_beam import Beam, BeamProblem, InitialState, InputError, Obstacles, beam_system, solve
 
+MESHES = Path(__file__).parents[1] / "meshes"
 CASE = [sys.executable, "-m", "skfem_beam.cases.point_stops"]
 
 
@@ -48,16 +51,25 @@ def test_case_matches_the_api(tmp_path, pipe):
 
 @pytest.mark.parametrize("args, word", [
     (["--J", "0"], "J=0"), (["--J", "-3"], "J=-3"), (["--J", "x"], "--J"),
-    (["--dt", "0"], "dt=0"), (["--dt=-1e-5"], "dt=-1e-05"), (["--dt", "-1e-5"], "--dt"),
+    (["--dt", "0"], "dt=0"), (["--dt=-1e-5"], "dt=-1e-05"), (["--dt", "-1e-5"], "dt=-1e-05"),
     (["--L", "0"], "L=0"), (["--k2", "-1"], "k2=-1"), (["--beta", "0.6"], "beta=0.6"),
     (["--beta", "-0.1"], "beta=-0.1"), (["--gap", "0"], "gap=0"), (["--dt", "nan"], "dt=nan"),
     (["--k2", "inf"], "k2=inf"), (["--T", "0"], "T=0"), (["--element", "p2"], "element='p2'"),
     (["--solver", "magic"], "solver='magic'"), (["--method", "springs"], "--method"),
+    # J was recorded and the mesh's 19 elements ran
+    (["--mesh", str(MESHES / "point_stops_J19.msh"), "--J", "5"], "--J 5 with --mesh"),
 ])
 def test_bad_input_one_line_no_output(tmp_path, capsys, args, word):
     """In-process through the same guard as ``python -m`` (a subprocess each is slow)."""
     assert_refused(point_stops.main, ["--T", "0.01", "--out", str(tmp_path / "run")] + args,
                    word, capsys, tmp_path)
+
+
+def test_an_empty_out_is_refused(tmp_path, capsys, monkeypatch):
+    """--out '' wrote the run's files into the current folder."""
+    monkeypatch.chdir(tmp_path)
+    assert_refused(point_stops.main, ["--T", "0.01", "--out", ""], "--out '' is empty",
+                   capsys, tmp_path)
 
 
 def test_bad_input_through_python_m(tmp_path):

@@ -255,12 +255,22 @@ def test_a_part_of_a_row_without_its_newline_is_left_out(tmp_path, tail):
     its newline (output.series): read_csv reads the whole rows and leaves that part out,
     numbers and mixed columns alike."""
     whole = "t,u\n0.1,0.5\n0.2,-1.25e-7\n"
-    for text, kind in ((whole, float), (whole.replace("0.5", "a"), str)):
+    text_column = whole.replace("0.5", "a").replace("-1.25e-7", "b")
+    for text, second in ((whole, -1.25e-7), (text_column, "b")):
         path = tmp_path / "timeseries.csv"
         path.write_text(text + tail)
         cols = read_csv(path)
         assert list(cols) == ["t", "u"] and cols["t"].tolist() == [0.1, 0.2]
-        assert cols["u"].tolist()[1] == ("-1.25e-7" if kind is str else -1.25e-7)
+        assert cols["u"].tolist()[1] == second
+
+
+def test_a_word_among_a_columns_numbers_is_a_damaged_file(tmp_path):
+    """It came back as a column of text (dtype <U3), and export wrote it so."""
+    path = tmp_path / "timeseries.csv"
+    path.write_text("t,u\n0.1,0.5\n0.2,abc\n0.3,0.25\n")
+    with pytest.raises(InputError, match=r"timeseries.csv: row 3, column u: 'abc' is not a "
+                                         r"number, as the column's other values are"):
+        read_csv(path)
 
 
 
@@ -375,3 +385,18 @@ def test_fields_read_while_a_run_writes_them_say_so(folder, tmp_path, monkeypatc
     assert read_run(running, fields="none").series        # the rows read
     with pytest.raises(InputError, match="cannot be read"):
         read_run(folder)                                  # a finished run's: as it was
+
+
+def test_export_does_not_replace_a_file_it_did_not_write(tmp_path, capsys):
+    """--out thesis.mat, a file of the user's, was replaced; an earlier export is."""
+    run = tmp_path / "r"
+    assert exit_code(point_stops.main, ["--T", "0.01", "--format", "none", "--out",
+                                        str(run)]) == 0
+    mine = tmp_path / "thesis.mat"
+    mine.write_text("my thesis\n")
+    assert exit_code(export_main, [str(run), "--to", "mat", "--out", str(mine)]) == 2
+    assert "exists and is not an export of a run" in capsys.readouterr().err
+    assert mine.read_text() == "my thesis\n"
+    for _ in range(2):      # the second replaces the first
+        assert exit_code(export_main, [str(run), "--to", "mat", "--out",
+                                       str(tmp_path / "e.mat")]) == 0

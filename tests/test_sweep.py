@@ -4,6 +4,7 @@ import csv
 import json
 import math
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -14,6 +15,7 @@ import numpy as np
 import pytest
 
 from conftest import assert_refused, exit_code
+from skfem_beam.errors import InputError
 from skfem_beam import beam_system, scenes, solve
 from skfem_beam.sweep import (detect_period, main, make_settings, parse_values, run_value,
                               sweep)
@@ -249,6 +251,13 @@ def test_values_syntax():
     assert parse_values(" linspace( 5,40 , 1 ) ") == [5.0]
     assert parse_values("5,40,200") == [5.0, 40.0, 200.0]     # a list: three values
     assert parse_values("7.5") == [7.5]
+    assert parse_values("-1e-3,+2.5E1,.5") == [-1e-3, 25.0, 0.5]
+    # what float() reads but a list of numbers is not: "1_0" ran 10, "８" ran 8; a linspace
+    # to 1e400 warned from numpy, then said "nan is not a finite number"
+    for spec, word in (("1_0,８", "is not linspace(a, b, n)"), ("8,0x10", "is not linspace"),
+                       ("linspace(8, 1e400, 3)", "inf is not a finite number")):
+        with pytest.raises(InputError, match=re.escape(word)):
+            parse_values(spec)
 
 
 def test_killed_worker_is_retried_then_marked_failed(tmp_path):

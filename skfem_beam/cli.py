@@ -105,7 +105,8 @@ def output_flags(p: Parser, prog: str) -> Parser:
     p.add_argument("--flush-every", type=int, default=20000,
                    help="steps between writes of the series to disk")
     p.add_argument("--checkpoint-every", type=float, default=None, metavar="SECONDS",
-                   help="write the full integrator state this often (atomically)")
+                   help="write the full integrator state this often (atomically; default: "
+                        "none while running, one at the end)")
     p.add_argument("--resume", metavar="DIR", default=None,
                    help="continue the killed run in DIR from its last checkpoint (with none: "
                         "run it again from step 0)")

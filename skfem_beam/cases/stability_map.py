@@ -23,6 +23,7 @@ from ..errors import InputError
 from ..scheme import solve
 from ..methods import FLAGS, Penalty, law_of, make
 from ..chart_process import wanted
+from ..parser import Defaults
 from ..output.charts import figure
 from ..output.folder import Folder, check_output_dir
 from ..parser import about
@@ -106,7 +107,8 @@ def chart(path, rows, kappa, kappa_paper, title):
 
 
 def main(argv=None) -> int:
-    p = cli.Parser(prog="skfem_beam.cases.stability_map", description=about(__doc__))
+    p = cli.Parser(prog="skfem_beam.cases.stability_map", description=about(__doc__),
+                   formatter_class=Defaults)
     p.add_argument("--betas", default="0,0.1,0.2,0.25,0.35,0.5",
                    help="comma-separated Newmark β in [0, 1/2]")
     p.add_argument("--ratios", default="0.5,0.9,1.2,2,10,100",
@@ -116,9 +118,10 @@ def main(argv=None) -> int:
                    help="comma-separated: contact (= position), penalty, moreau-jean")
     p.add_argument("--T", type=float, default=0.5, help="final time of each run (s)")
     p.add_argument("--J", type=int, default=19, help="elements of the pipe")
-    p.add_argument("--stiffness", type=float, default=1e8, help="penalty stiffness (N/m)")
+    p.add_argument("--stiffness", type=float, default=1e8,
+                   help="penalty stiffness (N/m), with penalty among --methods")
     p.add_argument("--max-seconds", type=float, default=900.0,
-                   help="refuse a grid whose estimated run time exceeds this")
+                   help="refuse a grid whose estimated run time exceeds this (s)")
     p.add_argument("--out", default="out/stability_map", help="output folder")
     p.add_argument("--overwrite", action="store_true",
                    help="replace the --out folder of an earlier map")

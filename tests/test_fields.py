@@ -355,6 +355,20 @@ def test_a_folder_read_back_is_refused_by_the_renders_in_one_line(tmp_path):
             draw(tmp_path / name, saved)
 
 
+def test_a_two_plane_run_is_refused_by_the_renders_in_one_line():
+    """The trefoil tube's Result: KeyError('displacement') from inside (its fields are
+    displacement_v, _w)."""
+    from skfem_beam import beam_system, solve
+    from skfem_beam.output.render import animate, render_beam
+    from skfem_beam.scenefile import example, load
+    scene = load(example("tube_round_holes"))
+    result = solve(beam_system(scene.problem), 1e-4, 2e-3, progress=False)
+    for draw, name in ((render_beam, "x.png"), (animate, "x.gif")):
+        with pytest.raises(InputError, match="draws a beam in one plane; this one bends in "
+                                             "two"):
+            draw(name, result)
+
+
 # ----------------------------------------------------------------------------- meshes
 MESH_DIR = os.path.join(os.path.dirname(__file__), "..", "meshes")
 

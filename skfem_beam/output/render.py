@@ -158,6 +158,10 @@ def _check_result(result, what: str) -> None:
         raise InputError(f"{what} needs the Result of a beam's solve(...) with its frames "
                          f"in memory, not {type(result).__name__} (a saved folder's fields "
                          "open in ParaView: docs/getting_started.md)")
+    if getattr(result.system.view, "planes", 1) != 1:   # it raised KeyError('displacement')
+        raise InputError(f"{what} draws a beam in one plane; this one bends in two (its "
+                         "fields displacement_v, _w open in ParaView: "
+                         "docs/getting_started.md)")
 
 
 def render_beam(path, result, times=None, scale=None, samples_per_element: int = 8,

@@ -41,7 +41,8 @@ SECTION_DOCS = {
     ),
     'motion': (
         '`end = "left"\\|"right"` or `at = x` (a support); `amplitude`, `omega` (φ = A sin ωt)'
-        ' or `sines = [[A, ω, phase], ...]`, `table = "phi.csv"` (t, φ rows), `random = {rms,'
+        ' or `sines = [[A, ω, phase], ...]`, `table = "phi.csv"` (t, φ rows; held at its '
+        'first and last values outside them), `random = {rms,'
         ' f_low, f_high, seed, count}` (band-limited, `count` sines), `psd = { table, seed, df }`, `value` '
         '(constant), as for loads; `phase` with `amplitude`, `omega`; `lifting`; two planes: '
         '`direction = [dy, dz]` (a direction: its length is not used)'
@@ -77,17 +78,19 @@ SECTION_DOCS = {
         '`x` (a point force, N) or `distributed = true` (N/m) or `per_mass = true` (m/s², the'
         " papers' f̃) or `gravity = 9.81`; the time: `amplitude`, `omega` (rad/s), `phase` "
         '(rad): amplitude·sin(ωt + phase), `value`, `sines`, '
-        '`table = "f.csv"`, `random = {rms, f_low, f_high, seed, count}`, `psd = "S.csv"` or '
+        '`table = "f.csv"` (held at its first and last values outside its times), '
+        '`random = {rms, f_low, f_high, seed, count}`, `psd = "S.csv"` or '
         '`psd = { table = "S.csv", seed = 1, df = 0.1 }` (a one-sided PSD, columns f in Hz '
         'and S in N²/m²/Hz for a distributed force, synthesised with the seed: '
         '`timefunctions.from_psd`); a distributed load over part of the beam: `x_from`, '
         '`x_to` (exact when they are nodes); two planes: `direction = [dy, dz]` (a direction: '
-        'its length is not used; default the first plane), or `rotating = {amplitude, '
+        'its length is not used; default the first plane; gravity pulls along it, and '
+        'without it down in the first plane), or `rotating = {amplitude, '
         'omega, phase}` instead of a time function (amplitude·cos(ωt + phase) along y, '
         '·sin along z). Bar: `value` (a body force, N/m³)'
     ),
     'initial': (
-        '`mode = k`, `amplitude` (u0 = amplitude × the k-th mode shape, its largest \\|u\\| 1) '
+        '`mode = k` with `amplitude` (m; u0 = amplitude × the k-th mode shape, its largest \\|u\\| 1) '
         'or `u0 = {x = [...], u = [...]}` (cubic spline; bar: linear, or a number), `v0 = {x, '
         "v}`; two planes: these are the first plane's, `u0_w = {x, u}`, `v0_w = {x, v}` the "
         "second's (without them w starts at rest); beams read them in the fixed frame (ũ, "

@@ -159,7 +159,7 @@ def band_limited(rms: float, f_low: float, f_high: float, seed: int = 0,
 
 
 def from_psd(f, S, seed: int = 0, df: float | None = None,
-             source: str = "psd") -> SumOfSines:
+             source: str = "psd", rows=None) -> SumOfSines:
     """A random force (or motion) with the one-sided power spectral density S(f): ``f`` in
     Hz (increasing, ≥ 0), ``S`` in unit²/Hz (≥ 0; e.g. N²/m²/Hz for a force per length),
     linear between the table's points and zero outside.  The spectral representation
@@ -167,8 +167,12 @@ def from_psd(f, S, seed: int = 0, df: float | None = None,
     with amplitude √(2 S(f_k) df) and a random phase (``numpy.random.default_rng(seed)``),
     so its mean square is Σ S(f_k) df, the table's ∫S df to the midpoint rule.  The
     record repeats after 1/df s: ``df`` defaults to (f_last − f₀)/512; take df ≤ 1/T for a
-    run of length T that must not see the repetition."""
+    run of length T that must not see the repetition.  ``rows``: each value's row in the
+    file it came from, for the error lines (default: 1, 2, ...)."""
     f, S = np.asarray(f, dtype=float), np.asarray(S, dtype=float)
+
+    def row(i: int) -> int:
+        return rows[i] if rows is not None else i + 1
     if f.ndim != 1 or f.shape != S.shape or f.size < 2:
         raise InputError(f"{source}: needs matching columns f, S of at least 2 rows "
                          f"(got {f.size} and {S.size})")
@@ -176,11 +180,11 @@ def from_psd(f, S, seed: int = 0, df: float | None = None,
         bad = ~np.isfinite(col) | (col < 0)
         if bad.any():
             i = int(np.argmax(bad))
-            raise InputError(f"{source}: {name}={col[i]:g} in row {i + 1} must be a finite "
+            raise InputError(f"{source}: {name}={col[i]:g} in row {row(i)} must be a finite "
                              "number ≥ 0")
     if (np.diff(f) <= 0).any():
         i = int(np.argmax(np.diff(f) <= 0)) + 1
-        raise InputError(f"{source}: f is not increasing at row {i + 1} "
+        raise InputError(f"{source}: f is not increasing at row {row(i)} "
                          f"(f={f[i]:g} Hz after {f[i - 1]:g})")
     width = f[-1] - f[0]
     df = width / 512 if df is None else check_positive("df", df)
@@ -198,36 +202,38 @@ def from_psd(f, S, seed: int = 0, df: float | None = None,
 def psd_from_csv(path, seed: int = 0, df: float | None = None) -> SumOfSines:
     """:func:`from_psd` of a CSV table of two columns f (Hz), S (unit²/Hz); a first line
     that is not numeric is taken as a header."""
-    f, S, _ = _two_columns(Path(path), "f, S")
-    return from_psd(f, S, seed, df, source=str(path))
+    f, S, lines = _two_columns(Path(path), "f, S")
+    return from_psd(f, S, seed, df, source=str(path), rows=lines)
 
 
-def _two_columns(path: Path, names: str) -> tuple[list, list, int]:
-    """The two numeric columns of a CSV file and its header lines (a non-numeric first
-    line is a header, 0 or 1); one error line naming the file and the row otherwise."""
+def _two_columns(path: Path, names: str) -> tuple[list, list, list]:
+    """The two numeric columns of a CSV file (a non-numeric first line is a header; blank
+    lines are skipped) and each value's row, its line in the file; one error line naming
+    the file and the row otherwise."""
     try:    # -sig: a byte-order mark (Excel's "CSV UTF-8") made the first row a header
         with open(path, newline="", encoding="utf-8-sig") as fh:
-            rows = [r for r in csv.reader(fh) if r and any(c.strip() for c in r)]
+            reader = csv.reader(fh)
+            rows = [(reader.line_num, r) for r in reader if r and any(c.strip() for c in r)]
     except OSError as e:
         raise InputError(f"cannot read the table {path}: {e.strerror}") from None
     except UnicodeDecodeError:
         raise InputError(f"{path}: not a UTF-8 text file (a CSV of numbers)") from None
-    header = 0
     if rows:
         try:
-            float(rows[0][0])
+            float(rows[0][1][0])
         except ValueError:
-            header = 1
+            rows = rows[1:]
     first, second = [], []
-    for i, r in enumerate(rows[header:], start=header + 1):
-        if len(r) < 2:
-            raise InputError(f"{path}: row {i} has {len(r)} column(s), needs {names}")
+    for line, r in rows:
+        if len(r) != 2:     # a third value was dropped without a word
+            raise InputError(f"{path}: row {line} has {len(r)} column(s), needs {names}")
         try:
             first.append(float(r[0]))
             second.append(float(r[1]))
         except ValueError:
-            raise InputError(f"{path}: row {i} is not two numbers: {','.join(r)!r}") from None
-    return first, second, header
+            raise InputError(f"{path}: row {line} is not two numbers: "
+                             f"{','.join(r)!r}") from None
+    return first, second, [line for line, _ in rows]
 
 
 @dataclass(frozen=True)
@@ -264,17 +270,17 @@ class Table(_FromEval):
         """Two columns t, phi; a first line that is not numeric is taken as a header.
         Rows are counted as in the file (the header is row 1)."""
         path = Path(path)
-        t, phi, header = _two_columns(path, "t, phi")
+        t, phi, lines = _two_columns(path, "t, phi")
         t_arr = np.asarray(t)
         for name, col in (("the first column", t_arr), ("the second column", np.asarray(phi))):
             nan = np.flatnonzero(~np.isfinite(col))
-            if nan.size:    # named by its row in the file (a header is row 1)
+            if nan.size:    # named by its row in the file
                 raise InputError(f"{path}: {name} is not a finite number in row "
-                                 f"{int(nan[0]) + 1 + header}")
+                                 f"{lines[int(nan[0])]}")
         bad = np.flatnonzero(np.diff(t_arr) <= 0) if t_arr.size > 1 else []
-        if len(bad):   # named by its row in the file (a header is row 1)
+        if len(bad):
             j = int(bad[0]) + 1
-            raise InputError(f"{path}: t is not increasing at row {j + 1 + header} "
+            raise InputError(f"{path}: t is not increasing at row {lines[j]} "
                              f"(t={t_arr[j]:g} after {t_arr[j - 1]:g})")
         return cls(tuple(t), tuple(phi), source=str(path))
 

@@ -86,3 +86,43 @@ def test_logarithmic_decrement_of_the_first_mode():
     delta = np.log(vals[0] / vals[-1]) / n
     measured = delta / np.sqrt(4 * np.pi**2 + delta**2)
     assert n >= 8 and abs(measured / zeta - 1) < 0.01, (measured, n)
+
+
+GRAVITY_TUBE = """kind = "beam"
+planes = 2
+[material]
+E = 2.0e11
+rho = 8000.0
+[section]
+rect = { b = 0.02, h = 0.04 }
+[geometry]
+L = 1.0
+[ends]
+left = "pinned"
+right = "pinned"
+[[loads]]
+LOAD
+direction = [0.0, -1.0]
+[damping]
+modal = 0.9
+[mesh]
+J = 20
+[time]
+dt = 1e-4
+T = 0.5
+"""
+
+
+def test_gravity_pulls_along_its_direction_in_two_planes(tmp_path):
+    """direction = [0, -1] moved a distributed load down in w and the beam's weight up
+    (1.533e-4 m above against below): gravity's direction was read as up."""
+    from skfem_beam.scenefile import load as load_scene
+    w = {}
+    for name, load in (("gravity", "gravity = 9.81"),
+                       ("weight", "distributed = true\nvalue = 62.784")):    # ρAg, N/m
+        path = tmp_path / f"{name}.toml"
+        path.write_text(GRAVITY_TUBE.replace("LOAD", load))
+        scene = load_scene(path)
+        r = solve(beam_system(scene.problem), 1e-4, 0.5, progress=False)
+        w[name] = r.observed["tip_displacement_w"][-1]      # midspan (pinned–pinned)
+    assert w["gravity"] < 0 and w["gravity"] == pytest.approx(w["weight"], rel=1e-6)

@@ -1,4 +1,6 @@
 """A load given by its power spectral density: the realised record has that PSD."""
+import re
+
 import numpy as np
 import pytest
 from scipy import signal, stats
@@ -62,3 +64,21 @@ def test_psd_from_csv_with_a_header(tmp_path):
     path.write_text("f,S\n1,2\nx,3\n")
     with pytest.raises(InputError, match="row 3 is not two numbers"):
         psd_from_csv(path)
+
+
+@pytest.mark.parametrize("text, read, word", [
+    # a blank line shifted the row named by one (row 5 for line 6)
+    ("t,phi\n0,0\n\n0.05,0.001\n0.1,0.002\n0.15,x\n", "table", "row 6 is not two numbers"),
+    # a third value was dropped without a word
+    ("t,phi\n0,0\n0.05,0.001\n0.1,0.001,7\n", "table", "row 4 has 3 column(s), needs t, phi"),
+    ("t,phi\n0,0\n\n0.1,nan\n", "table", "the second column is not a finite number in row 4"),
+    # a PSD's rows were counted without the header (row 2 for line 3)
+    ("f,S\n1,0.5\n5,-1\n10,0.5\n", "psd", "S=-1 in row 3 must be"),
+    ("f,S\n1,0.5\n5,0.5\n5,0.5\n", "psd", "f is not increasing at row 4"),
+])
+def test_a_table_names_the_row_of_its_file(tmp_path, text, read, word):
+    from skfem_beam.timefunctions import Table
+    path = tmp_path / "t.csv"
+    path.write_text(text)
+    with pytest.raises(InputError, match=re.escape(word)):
+        Table.from_csv(path) if read == "table" else psd_from_csv(path)

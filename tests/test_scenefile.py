@@ -235,7 +235,18 @@ BAD = {
     "wall ≥ radius": (PIPE.replace("[mass_normalised]\nk2 = 282.84\nrho_S = 0.1194",
                                    "[material]\nE = 2e11\nrho = 8000.0\n[section]\n"
                                    "tube = { outer_diameter = 0.01, wall = 0.005 }"), "wall=0.005"),
-    "support outside": (PIPE + "[[supports]]\nx = 2.0\n", "support x=2"),
+    "support outside": (PIPE + "[[supports]]\nx = 2.0\n",
+                        "[supports.0] x=2 must lie on the beam"),
+    # the next four named no key
+    "point force outside": (PIPE + "[[loads]]\nx = 2.0\nvalue = 1.0\n",
+                            "[loads.0] x=2 must lie on the beam"),
+    "damping ratio": (PIPE + "[damping]\nmodal = 2.0\n", "[damping] modal=2 must be below 1"),
+    "lifting": (PIPE + '[motion]\nend = "left"\namplitude = 0.1\nomega = 10.0\n'
+                'lifting = "maybe"\n', "[motion] lifting='maybe' is not one of"),
+    "segment length": (PIPE.replace("[mass_normalised]\nk2 = 282.84\nrho_S = 0.1194", "")
+                       .replace("[geometry]\nL = 1.501\n", "") + "[[segments]]\nlength = -0.5"
+                       "\nmaterial = { E = 2e11, rho = 8000.0 }\nsection = { rect = { b = "
+                       "0.01, h = 0.01 } }\n", "[segments.0] length=-0.5 must be > 0"),
     "two supports at one x": (PIPE + "[[supports]]\nx = 0.5\n[[supports]]\nx = 0.5\n",
                               "two supports at x=0.5"),
     "unknown end": (PIPE + '[ends]\nright = "glued"\n', "glued"),
@@ -516,8 +527,8 @@ def test_added_mass_gives_the_textbook_first_frequency(tmp_path):
     (("g1 = -0.0004", 'g1 = "-0.25mm"'), [], "hx.toml: obstacles.0.g1 = '-0.25mm': must be a "
                                              "number"),
     (("E = 2.0e11", 'E = "200GPa"'), [], "hx.toml: material.E = '200GPa': must be a number"),
-    (("zeta = 0.02", "zeta = 2"), [], "hx.toml: zeta=2 must be below 1: it is a ratio of "
-                                      "critical damping (0.02 for 2 %)"),
+    (("zeta = 0.02", "zeta = 2"), [], "hx.toml: [damping] zeta=2 must be below 1: it is a "
+                                      "ratio of critical damping (0.02 for 2 %)"),
     (('left = "pinned"', 'left = "glued"'), [], "hx.toml: ends.left='glued' is not one of: "
                                                 "clamped, pinned, sliding, free"),
     ((), ["obstacles.0.x=0.6m"], "hx.toml: --set obstacles.0.x=0.6m: must be a number, in "
@@ -995,12 +1006,28 @@ def test_modes_over_a_run_folder_replaces_it_whole(tmp_path, capsys):
     assert json.loads((out / "summary.json").read_text())["modes"] == 6
 
 
-def test_an_initial_amplitude_needs_its_mode(tmp_path, capsys):
-    """[initial] amplitude without mode was read and ignored: the beam started at rest."""
-    assert_refused(run_main, [str(example("flat_obstacles.toml")), "--set",
-                              "initial.amplitude=0.001", "--out", str(tmp_path / "x")],
-                   "[initial] amplitude scales a mode shape: it needs mode = k", capsys,
-                   tmp_path)
+@pytest.mark.parametrize("setting, word", [
+    # amplitude without mode was read and ignored: the beam started at rest
+    ("initial.amplitude=0.001", "[initial] amplitude scales a mode shape: it needs mode = k"),
+    # mode without amplitude started the beam 1 m out
+    ("initial.mode=1", "[initial] mode = 1 needs amplitude (m)"),
+])
+def test_an_initial_mode_and_its_amplitude_go_together(tmp_path, capsys, setting, word):
+    assert_refused(run_main, [str(example("flat_obstacles.toml")), "--set", setting,
+                              "--out", str(tmp_path / "x")], word, capsys, tmp_path)
+
+
+@pytest.mark.parametrize("setting, word", [
+    # over half the beam, extrapolated: the tip started at 4.4 times the largest value
+    ("initial.u0={x=[0,2.5,5],u=[0,1e-4,5e-4]}", "[initial.u0] x runs from 0 to 5 m: the "
+                                                 "table must cover the beam, 0 to L = 10 m"),
+    ("initial.v0={x=[-1,0,10],v=[0,0,0]}", "[initial.v0] x runs from -1 to 10 m"),
+    # J was read and ignored: the nodes' 2 elements ran
+    ("mesh.nodes=[0,5,10]", "[mesh] give J (a uniform mesh) or nodes, not both"),
+])
+def test_values_read_and_not_used_are_refused(tmp_path, capsys, setting, word):
+    assert_refused(run_main, [str(example("flat_obstacles.toml")), "--set", setting,
+                              "--out", str(tmp_path / "x")], word, capsys, tmp_path)
 
 
 @pytest.mark.parametrize("setting, word", [

@@ -8,7 +8,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..checks import MAX_ELEMENTS, check_count
+from ..checks import MAX_ELEMENTS, check_count, check_finite, check_positive
 from ..errors import InputError
 from ..problem import Beam, BeamProblem, Damping, InitialState, Plane
 from .forcing import loads_of, support_of
@@ -35,8 +35,8 @@ def _structure(data: dict) -> Beam:
     if segs is not None:
         if "geometry" in data:
             raise InputError("[[segments]] give the length: leave out [geometry]")
-        return Beam.stepped([(s.get("length", math.nan), material_of(s.get("material", {}),
-                                                                    f"segments.{i}.material"),
+        return Beam.stepped([(check_positive(f"[segments.{i}] length", s.get("length", math.nan)),
+                              material_of(s.get("material", {}), f"segments.{i}.material"),
                               section_of(s.get("section", {}), f"segments.{i}.section"))
                              for i, s in enumerate(segs)])
     L = need(data.get("geometry", {}), ("L",), "geometry")["L"]
@@ -47,7 +47,14 @@ def _structure(data: dict) -> Beam:
 
 
 def _damping(data: dict) -> Damping:
-    d = data.get("damping")
+    """[damping]: its refusals name the section ("zeta=2 must be below 1" named none)."""
+    try:
+        return _damping_of(data.get("damping"))
+    except InputError as e:
+        raise e if str(e).startswith("[damping]") else InputError(f"[damping] {e}") from None
+
+
+def _damping_of(d: dict | None) -> Damping:
     if d is None:
         return Damping()
     if "modal" in d:
@@ -62,13 +69,18 @@ def _damping(data: dict) -> Damping:
     return Damping(d.get("alpha", 0.0), d.get("alpha_K", 0.0))
 
 
-def _spline(d: dict, name: str, value: str):
-    """(f, f') of a {x, u} table: a not-a-knot cubic spline."""
+def _spline(d: dict, name: str, value: str, L: float):
+    """(f, f') of a {x, u} table over the beam [0, L]: a not-a-knot cubic spline."""
     pairs = need(d, ("x", value), f"initial.{name}")
+    x = np.asarray(pairs["x"], dtype=float)
+    tol = 1e-9 * L      # a table over half the beam, extrapolated, gave 4.4 mm at its tip
+    if x.size and (abs(x.min()) > tol or abs(x.max() - L) > tol):
+        raise InputError(f"[initial.{name}] x runs from {x.min():g} to {x.max():g} m: the "
+                         f"table must cover the beam, 0 to L = {L:g} m (beyond its ends a "
+                         "spline is extrapolated)")
     try:
         from scipy.interpolate import CubicSpline
-        s = CubicSpline(np.asarray(pairs["x"], dtype=float),
-                        np.asarray(pairs[value], dtype=float), bc_type="not-a-knot")
+        s = CubicSpline(x, np.asarray(pairs[value], dtype=float), bc_type="not-a-knot")
     except ValueError as e:
         raise InputError(f"[initial.{name}] table x = [...], {value} = [...]: {e}") from None
     return s, s.derivative()
@@ -79,20 +91,24 @@ def _initial(data: dict, problem: BeamProblem) -> BeamProblem:
     fixed = ini.get("fixed_frame", True)
     if "amplitude" in ini and "mode" not in ini:     # it was read and ignored
         raise InputError("[initial] amplitude scales a mode shape: it needs mode = k")
+    if "mode" in ini and "amplitude" not in ini:     # it started the beam 1 m out
+        raise InputError(f"[initial] mode = {ini['mode']!r} needs amplitude (m): the mode "
+                         "shape's largest displacement")
     if "mode" in ini:
         if "u0" in ini:
             raise InputError("[initial] give mode or u0, not both")
-        u0, du0 = _mode_shape(problem, ini["mode"], ini.get("amplitude", 1.0))
+        u0, du0 = _mode_shape(problem, ini["mode"], ini["amplitude"])
     elif "u0" in ini:
-        u0, du0 = _spline(ini["u0"], "u0", "u")
+        u0, du0 = _spline(ini["u0"], "u0", "u", problem.beam.L)
     else:
         u0 = du0 = None
-    v0 = _spline(ini["v0"], "v0", "v")[0] if "v0" in ini else None
+    v0 = _spline(ini["v0"], "v0", "v", problem.beam.L)[0] if "v0" in ini else None
     return replace(problem, initial=InitialState(u0, v0, du0, fixed_frame=fixed),
-                   second=replace(problem.second, initial=_initial_w(data, fixed)))
+                   second=replace(problem.second,
+                                  initial=_initial_w(data, fixed, problem.beam.L)))
 
 
-def _initial_w(data: dict, fixed: bool) -> InitialState | None:
+def _initial_w(data: dict, fixed: bool, L: float) -> InitialState | None:
     """The second plane's start: [initial] u0_w = {x, u}, v0_w = {x, v} (None: at rest)."""
     ini = data.get("initial", {})
     given = [k for k in ("u0_w", "v0_w") if k in ini]
@@ -101,8 +117,8 @@ def _initial_w(data: dict, fixed: bool) -> InitialState | None:
     if plane_count(data) != 2:
         raise InputError(f"[initial] {', '.join(given)} start the second plane: they need "
                          "planes = 2")
-    u0, du0 = _spline(ini["u0_w"], "u0_w", "u") if "u0_w" in ini else (None, None)
-    v0 = _spline(ini["v0_w"], "v0_w", "v")[0] if "v0_w" in ini else None
+    u0, du0 = _spline(ini["u0_w"], "u0_w", "u", L) if "u0_w" in ini else (None, None)
+    v0 = _spline(ini["v0_w"], "v0_w", "v", L)[0] if "v0_w" in ini else None
     return InitialState(u0, v0, du0, fixed_frame=fixed)
 
 
@@ -121,10 +137,23 @@ def _mode_shape(problem: BeamProblem, k, amplitude):
     return shape(0), shape(1)
 
 
+def _supports_x(data: dict, L: float) -> tuple:
+    """[[supports]] x, each on the beam (BeamProblem's refusal named no item)."""
+    xs = []
+    for i, s in enumerate(data.get("supports", [])):
+        x = check_finite(f"[supports.{i}] x", s.get("x", math.nan))
+        if not 0.0 <= x <= L:
+            raise InputError(f"[supports.{i}] x={x:g} must lie on the beam [0, L={L:g}]")
+        xs.append(x)
+    return tuple(xs)
+
+
 def beam_problem(data: dict, reader: Tables) -> BeamProblem:
     beam = _beam(data)
     ends = data.get("ends", {})
     mesh = data.get("mesh", {})
+    if "J" in mesh and "nodes" in mesh:     # J was read and the nodes' elements ran
+        raise InputError("[mesh] give J (a uniform mesh) or nodes, not both")
     obstacles, holes = obstacles_and_holes(data, beam.L)
     load, load_w = loads_of(data, reader, beam.L)
     problem = BeamProblem(
@@ -132,7 +161,7 @@ def beam_problem(data: dict, reader: Tables) -> BeamProblem:
         J=check_count("[mesh] J", mesh.get("J", 19), most=MAX_ELEMENTS),
         element=mesh.get("element", "hermite"), nodes=mesh.get("nodes"),
         ends=(ends.get("left", "clamped"), ends.get("right", "free")),
-        supports=tuple(s.get("x", math.nan) for s in data.get("supports", [])),
+        supports=_supports_x(data, beam.L),
         damping=_damping(data), planes=plane_count(data), holes=holes,
         second=Plane(load=load_w))
     if problem.element == "bspline" and beam.steps:

@@ -6,8 +6,9 @@ import math
 
 import numpy as np
 
+from ..checks import check_choice, check_finite
 from ..errors import InputError
-from ..problem import Load, Support
+from ..problem import LIFTINGS, Load, Support
 from ..timefunctions import Constant, Sine, SumOfSines, Table, band_limited, psd_from_csv
 from .parts import need, plane_count
 from .read import Tables
@@ -104,7 +105,7 @@ def support_of(data: dict, L: float, reader: Tables) -> Support:
         if m["end"] not in ends:
             raise InputError(f"[motion] end={m['end']!r} must be one of: left, right")
         at = ends[m["end"]]
-    lifting = m.get("lifting", "auto")
+    lifting = check_choice("[motion] lifting", m.get("lifting", "auto"), LIFTINGS)
     direction = _direction(m, data, "motion")
     time = {k: v for k, v in m.items() if k != "direction"}
     # either alone: _time_function refuses it (it was a support at rest)
@@ -128,12 +129,15 @@ def _direction(d: dict, data: dict, where: str) -> tuple[float, float]:
 
 def loads_of(data: dict, reader: Tables, L: float = math.inf) -> tuple[Load, Load]:
     """The loads of the first and the second plane: a load along ``direction`` = [dy, dz]
-    acts dy× in v and dz× in w; ``rotating`` = {amplitude, omega, phase} is
+    acts dy× in v and dz× in w (gravity pulls along it; without one, down in v);
+    ``rotating`` = {amplitude, omega, phase} is
     amplitude·cos(ωt + phase) in v and amplitude·sin(ωt + phase) in w (two planes)."""
     total_v, total_w = Load(), Load()
     for i, d in enumerate(data.get("loads", [])):
         where = f"loads.{i}"
         dy, dz = _direction(d, data, where)
+        if "gravity" in d and "direction" in d:     # where it pulls: it pulled the other way
+            dy, dz = -dy, -dz                       # (Load.gravity: −gρA on u)
         d = {k: v for k, v in d.items() if k != "direction"}
         if "rotating" in d:
             if plane_count(data) != 2:
@@ -179,7 +183,10 @@ def _load(d: dict, where: str, time, L: float = math.inf) -> Load:
         raise InputError(f"[{where}] needs one of x (a point force, N), distributed = "
                          "true (N/m) or per_mass = true (m/s²)")
     if kinds[0] == "x":
-        return Load(points=((d["x"], time),))
+        x = check_finite(f"[{where}] x", d["x"])
+        if not -1e-12 * L <= x <= L * (1 + 1e-12):
+            raise InputError(f"[{where}] x={x:g} must lie on the beam [0, L={L:g}]")
+        return Load(points=((x, time),))
     if kinds[0] == "distributed" and span:
         a, b = need(d, ("x_from", "x_to"), where).values()
         if not a < b:

@@ -1011,13 +1011,6 @@ def test_modes_over_a_run_folder_replaces_it_whole(tmp_path, capsys):
     ("initial.amplitude=0.001", "[initial] amplitude scales a mode shape: it needs mode = k"),
     # mode without amplitude started the beam 1 m out
     ("initial.mode=1", "[initial] mode = 1 needs amplitude (m)"),
-])
-def test_an_initial_mode_and_its_amplitude_go_together(tmp_path, capsys, setting, word):
-    assert_refused(run_main, [str(example("flat_obstacles.toml")), "--set", setting,
-                              "--out", str(tmp_path / "x")], word, capsys, tmp_path)
-
-
-@pytest.mark.parametrize("setting, word", [
     # over half the beam, extrapolated: the tip started at 4.4 times the largest value
     ("initial.u0={x=[0,2.5,5],u=[0,1e-4,5e-4]}", "[initial.u0] x runs from 0 to 5 m: the "
                                                  "table must cover the beam, 0 to L = 10 m"),

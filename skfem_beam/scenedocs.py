@@ -90,7 +90,8 @@ SECTION_DOCS = {
         '·sin along z). Bar: `value` (a body force, N/m³)'
     ),
     'initial': (
-        '`mode = k` with `amplitude` (m; u0 = amplitude × the k-th mode shape, its largest \\|u\\| 1) '
+        '`mode = k` with `amplitude` (m; u0 = amplitude × the k-th mode shape, its largest '
+        '\\|u\\| 1) '
         'or `u0 = {x = [...], u = [...]}` (cubic spline; bar: linear, or a number), `v0 = {x, '
         "v}`; two planes: these are the first plane's, `u0_w = {x, u}`, `v0_w = {x, v}` the "
         "second's (without them w starts at rest); beams read them in the fixed frame (ũ, "

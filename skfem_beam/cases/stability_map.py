@@ -23,10 +23,9 @@ from ..errors import InputError
 from ..scheme import solve
 from ..methods import FLAGS, Penalty, law_of, make
 from ..chart_process import wanted
-from ..parser import Defaults
 from ..output.charts import figure
 from ..output.folder import Folder, check_output_dir
-from ..parser import about
+from ..parser import Defaults, about
 from ..checks import check_beta, check_positive
 from ..semidiscrete import beam_system
 from ..stability import PAPER_KAPPA_BOUNDS, kappa_h, linear_limit, prop31_limit, stability_table

@@ -243,6 +243,9 @@ BAD = {
     "damping ratio": (PIPE + "[damping]\nmodal = 2.0\n", "[damping] modal=2 must be below 1"),
     "lifting": (PIPE + '[motion]\nend = "left"\namplitude = 0.1\nomega = 10.0\n'
                 'lifting = "maybe"\n', "[motion] lifting='maybe' is not one of"),
+    "carried without motion": (PIPE.replace("g2 = 0.1", "g2 = 0.1\ncarried = true"),
+                               "[obstacles.0] carried = true moves the obstacle with the "
+                               "support's [motion]: this scene has none"),
     "segment length": (PIPE.replace("[mass_normalised]\nk2 = 282.84\nrho_S = 0.1194", "")
                        .replace("[geometry]\nL = 1.501\n", "") + "[[segments]]\nlength = -0.5"
                        "\nmaterial = { E = 2e11, rho = 8000.0 }\nsection = { rect = { b = "

@@ -125,6 +125,9 @@ def obstacles_and_holes(data: dict, L: float) -> tuple[Obstacles, tuple]:
         raise InputError("friction acts along the wall of a hole, in the cross-section: the "
                          "one-plane beam has no tangential direction (planes = 2 and a hole)")
     for i, o in items:
+        if o.get("carried", False) and "motion" not in data:   # it ran as a fixed obstacle
+            raise InputError(f"[obstacles.{i}] carried = true moves the obstacle with the "
+                             "support's [motion]: this scene has none")
         if "friction" in o and "hole" not in o:
             raise InputError(f"[obstacles.{i}] friction acts at a hole's wall: this obstacle "
                              "has no hole")

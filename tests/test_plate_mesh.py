@@ -295,7 +295,7 @@ def _disk_with(change: str):
     rim = d.boundaries["rim"][:, 0]
     if change == "repeated":
         t = np.column_stack([t, t[:, 5]])
-    elif change == "three":     # a new point beyond the rim, on the edge (0, one of its own)
+    elif change == "three":     # one more triangle on triangle 0's first edge, an inner one
         edge = t[:2, 0]
         p = np.column_stack([p, 3.0 * p[:, edge].mean(axis=1)])
         t = np.column_stack([t, [edge[0], edge[1], p.shape[1] - 1]])
@@ -320,7 +320,7 @@ def test_overlapping_triangles_and_non_finite_points_are_refused(tmp_path, capsy
     for another reason (a NaN point: "dt ... outside floating-point range")."""
     d = _disk_with(change)
     name = "bad.vtu" if change == "nan" else "bad.msh"
-    if change == "nan":     # (write_msh refuses a NaN point)
+    if change == "nan":     # written by meshio itself, NaN as it is
         meshio.write(tmp_path / name, meshio.Mesh(
             np.vstack([d.points, np.zeros(d.points.shape[1])]).T,
             [("triangle", d.triangles.T)]))

@@ -243,6 +243,8 @@ BAD = {
     "damping ratio": (PIPE + "[damping]\nmodal = 2.0\n", "[damping] modal=2 must be below 1"),
     "lifting": (PIPE + '[motion]\nend = "left"\namplitude = 0.1\nomega = 10.0\n'
                 'lifting = "maybe"\n', "[motion] lifting='maybe' is not one of"),
+    "mesh nodes": (PIPE + "[mesh]\nnodes = [0.0, 1.0, 0.5, 1.501]\n",
+                   "[mesh] nodes must be strictly increasing"),
     "carried without motion": (PIPE.replace("g2 = 0.1", "g2 = 0.1\ncarried = true"),
                                "[obstacles.0] carried = true moves the obstacle with the "
                                "support's [motion]: this scene has none"),

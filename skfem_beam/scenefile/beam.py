@@ -156,14 +156,19 @@ def beam_problem(data: dict, reader: Tables) -> BeamProblem:
         raise InputError("[mesh] give J (a uniform mesh) or nodes, not both")
     obstacles, holes = obstacles_and_holes(data, beam.L)
     load, load_w = loads_of(data, reader, beam.L)
-    problem = BeamProblem(
-        beam, obstacles, support_of(data, beam.L, reader), load,
-        J=check_count("[mesh] J", mesh.get("J", 19), most=MAX_ELEMENTS),
-        element=mesh.get("element", "hermite"), nodes=mesh.get("nodes"),
-        ends=(ends.get("left", "clamped"), ends.get("right", "free")),
-        supports=_supports_x(data, beam.L),
-        damping=_damping(data), planes=plane_count(data), holes=holes,
-        second=Plane(load=load_w))
+    try:
+        problem = BeamProblem(
+            beam, obstacles, support_of(data, beam.L, reader), load,
+            J=check_count("[mesh] J", mesh.get("J", 19), most=MAX_ELEMENTS),
+            element=mesh.get("element", "hermite"), nodes=mesh.get("nodes"),
+            ends=(ends.get("left", "clamped"), ends.get("right", "free")),
+            supports=_supports_x(data, beam.L),
+            damping=_damping(data), planes=plane_count(data), holes=holes,
+            second=Plane(load=load_w))
+    except InputError as e:     # the mesh's refusals name its keys alone ("nodes must ...")
+        if not str(e).startswith(("nodes ", "element=")):
+            raise
+        raise InputError(f"[mesh] {e}") from None
     if problem.element == "bspline" and beam.steps:
         from ..cli import warn
         warn(f"element = \"bspline\" on a beam whose section steps at x = "

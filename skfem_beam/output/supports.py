@@ -105,14 +105,21 @@ def worn_through(supports: list[dict], wear: Wear | None) -> list[str]:
         return []
     lines = []
     for s in supports:
-        depths = [k["depth"] for k in (s.get("wear") or {}).get("sectors", []) if "depth" in k]
-        if depths and max(depths) > wear.wall:
-            years = wear.service_years * wear.wall / max(depths)    # depth ∝ time
-            lines.append(f"the support at x={s['x']:g} wears {max(depths) * 1e3:.4g} mm deep "
+        depth = deepest(s)
+        if depth is not None and depth > wear.wall:
+            years = wear.service_years * wear.wall / depth      # depth ∝ time
+            lines.append(f"the support at x={s['x']:g} wears {depth * 1e3:.4g} mm deep "
                          f"in {wear.service_years:g} years, more than the tube's wall "
                          f"({wear.wall * 1e3:g} mm): it wears through in about {years:.3g} "
                          "years (the depth past the wall is Archard's law extrapolated)")
     return lines
+
+
+def deepest(support: dict) -> float | None:
+    """A support's deepest sector's depth (m; None without [wear] land)."""
+    depths = [k["depth"] for k in (support.get("wear") or {}).get("sectors", [])
+              if "depth" in k]
+    return max(depths) if depths else None
 
 
 def union_length(start: np.ndarray, end: np.ndarray) -> float:
@@ -219,13 +226,12 @@ def _cell(value: float | None) -> str:
 def _row(s: dict) -> list[str]:
     """One support's cells: x, impacts, contact fraction, the three work rates, the worn
     volume (mm³) and the deepest sector's depth (mm), as summary.json has them."""
-    wear = s.get("wear")
-    depths = [k["depth"] for k in wear["sectors"] if "depth" in k] if wear else []
+    wear, depth = s.get("wear"), deepest(s)
     return [f"{s['x']:g}", str(s["impacts"]), _cell(s["contact_fraction"]),
             _cell(s["impact_work_rate"]), _cell(s["normal_work_rate"]),
             _cell(s.get("friction_work_rate")),
             _cell(wear["volume"] * 1e9 if wear else None),
-            _cell(max(depths) * 1e3 if depths else None)]
+            _cell(depth * 1e3 if depth is not None else None)]
 
 
 def support_table(supports: list[dict], newtons: bool = True,

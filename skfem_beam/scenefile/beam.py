@@ -13,7 +13,7 @@ from ..errors import InputError
 from ..problem import Beam, BeamProblem, Damping, InitialState, Plane
 from .forcing import loads_of, support_of
 from .obstacles import obstacles_and_holes
-from .parts import material_of, need, plane_count, section_of
+from .parts import in_section, material_of, need, plane_count, section_of
 from .read import Tables
 
 
@@ -48,10 +48,7 @@ def _structure(data: dict) -> Beam:
 
 def _damping(data: dict) -> Damping:
     """[damping]: its refusals name the section ("zeta=2 must be below 1" named none)."""
-    try:
-        return _damping_of(data.get("damping"))
-    except InputError as e:
-        raise e if str(e).startswith("[damping]") else InputError(f"[damping] {e}") from None
+    return in_section("damping", _damping_of, d=data.get("damping"))
 
 
 def _damping_of(d: dict | None) -> Damping:

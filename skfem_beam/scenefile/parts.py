@@ -39,10 +39,13 @@ def warn_implausible(d: dict, where: str) -> None:
 
 def in_section(where: str, make, **values):
     """``make(**values)``, its error line naming the section (``[segments.1.material]
-    E=0 must be > 0``: the line named only ``E``, whichever segment it was)."""
+    E=0 must be > 0``: the line named only ``E``, whichever segment it was); a line that
+    names it already is kept."""
     try:
         return make(**values)
     except InputError as e:
+        if str(e).startswith(f"[{where}]"):
+            raise
         raise InputError(f"[{where}] {e}") from None
 
 

@@ -291,6 +291,7 @@ class Obstacles:
     breakpoints: tuple[float, ...] = ()
     carried: bool = False
     parts: tuple["Obstacles", ...] = ()
+    name: str = ""      # its key path in a scene file (obstacles.1), for its refusals
 
     def __post_init__(self):
         if not isinstance(self.carried, (bool, np.bool_)):
@@ -299,21 +300,21 @@ class Obstacles:
             check_bound(name, getattr(self, name), "x")
 
     @classmethod
-    def stops(cls, x, g1, g2, carried: bool = False) -> "Obstacles":
+    def stops(cls, x, g1, g2, carried: bool = False, name: str = "") -> "Obstacles":
         """Point stops g1[i] ≤ u(x[i]) ≤ g2[i] (numbers apply to every x; ±inf: one-sided)."""
         xs = np.atleast_1d(np.asarray(x, dtype=float))
-        for name, g in (("g1", g1), ("g2", g2)):    # complex: a TypeError, or cast silently
+        for key, g in (("g1", g1), ("g2", g2)):    # complex: a TypeError, or cast silently
             for v in np.atleast_1d(np.asarray(g, dtype=object)).ravel():
-                check_bound(name, v, "x")
+                check_bound(key, v, "x")
         lo = np.broadcast_to(np.asarray(g1, dtype=float), xs.shape)
         hi = np.broadcast_to(np.asarray(g2, dtype=float), xs.shape)
-        parts = [cls.point_stops(check_finite(f"x[{i}]", xi), lo[i], hi[i], carried)
+        parts = [cls.point_stops(check_finite(f"x[{i}]", xi), lo[i], hi[i], carried, name)
                  for i, xi in enumerate(xs)]
         return parts[0] if len(parts) == 1 else cls.combine(*parts)
 
     @classmethod
-    def span(cls, a: float, b: float, g1=-np.inf, g2=np.inf, carried: bool = False) \
-            -> "Obstacles":
+    def span(cls, a: float, b: float, g1=-np.inf, g2=np.inf, carried: bool = False,
+             name: str = "") -> "Obstacles":
         """A profile g1(x) ≤ u ≤ g2(x) over [a, b] (numbers or functions of x), none elsewhere."""
         a, b = check_finite("a", a), check_finite("b", b)
         if b <= a:
@@ -321,15 +322,18 @@ class Obstacles:
         check_bound("g1", g1, "x")
         check_bound("g2", g2, "x")
 
+        # its ends as nodes are (mesh check): a node a rounding below a was left out
+        tol = 1e-9 * max(1.0, abs(a), abs(b))
+
         def within(g, outside):         # g is evaluated where the span acts only
             def bound(x):
                 x = np.asarray(x, dtype=float)
                 out = np.full(x.shape, outside)
-                inside = (x >= a) & (x <= b)
+                inside = (x >= a - tol) & (x <= b + tol)
                 out[inside] = g(x[inside]) if callable(g) else float(g)
                 return out
             return bound
-        return cls(within(g1, -np.inf), within(g2, np.inf), (a, b), carried)
+        return cls(within(g1, -np.inf), within(g2, np.inf), (a, b), carried, name=name)
 
     @classmethod
     def combine(cls, *obstacles: "Obstacles") -> "Obstacles":
@@ -363,24 +367,24 @@ class Obstacles:
         return carried
 
     @classmethod
-    def point_stops(cls, x: float, g1: float, g2: float, carried: bool = False) \
-            -> "Obstacles":
+    def point_stops(cls, x: float, g1: float, g2: float, carried: bool = False,
+                    name: str = "") -> "Obstacles":
         """Two stops at one abscissa x (the first paper's scene at x = L)."""
-        for name, g in (("g1", g1), ("g2", g2)):
+        for key, g in (("g1", g1), ("g2", g2)):
             if callable(g):
-                raise InputError(f"point stops: {name} must be a number (m; ±inf: no bound)")
-            check_bound(name, g, "x")
+                raise InputError(f"point stops: {key} must be a number (m; ±inf: no bound)")
+            check_bound(key, g, "x")
         g1, g2 = float(g1), float(g2)
         if not g1 < g2:         # where it is built, not at beam_system
-            raise InputError(f"g1 ≥ g2 at x={x:g} (g1={g1:g}, g2={g2:g}); obstacles need "
-                             "g1 < g2")
+            raise InputError(f"{_named(name)}g1 ≥ g2 at x={x:g} (g1={g1:g}, g2={g2:g}); "
+                             "obstacles need g1 < g2")
 
         def lower(z, x=x, g=g1):
             return np.where(np.isclose(z, x, rtol=0, atol=1e-12 * max(1.0, abs(x))), g, -np.inf)
 
         def upper(z, x=x, g=g2):
             return np.where(np.isclose(z, x, rtol=0, atol=1e-12 * max(1.0, abs(x))), g, np.inf)
-        return cls(lower, upper, (float(x),), carried)
+        return cls(lower, upper, (float(x),), carried, name=name)
 
     def owners(self, x: np.ndarray) -> np.ndarray:
         """(len(x), 2): per x the index in ``parts`` of the obstacle whose g1 is the bound
@@ -405,17 +409,34 @@ class Obstacles:
         hi = self.g2(x) if callable(self.g2) else np.full(x.shape, float(self.g2))
         lo = np.broadcast_to(np.asarray(lo, dtype=float), x.shape).copy()
         hi = np.broadcast_to(np.asarray(hi, dtype=float), x.shape).copy()
-        for name, g in (("g1", lo), ("g2", hi)):
+        for key, g in (("g1", lo), ("g2", hi)):
             if np.isnan(g).any():
-                raise InputError(f"{name}(x) is NaN at x={x[np.isnan(g)][0]:g}")
+                raise InputError(f"{_named(self.name)}{key}(x) is NaN at "
+                                 f"x={x[np.isnan(g)][0]:g}")
         if np.isposinf(lo).any() or np.isneginf(hi).any():
             raise InputError("g1 may not be +inf and g2 may not be -inf")
         bad = lo >= hi
         if bad.any():
             i = int(np.argmax(bad))
-            raise InputError(f"g1 ≥ g2 at x={x[i]:g} (g1={lo[i]:g}, g2={hi[i]:g}); "
-                             "obstacles need g1 < g2")
+            raise InputError(self._crossing(x[i], lo[i], hi[i]))
         return lo, hi
+
+    def _crossing(self, x: float, g1: float, g2: float) -> str:
+        """The refusal of g1 ≥ g2 at x, naming the obstacles whose bounds they are."""
+        names = (self.name, self.name)
+        if self.parts:
+            i, j = self.owners(np.array([x]))[0]
+            names = (self.parts[i].name, self.parts[j].name)
+        if all(names) and names[0] != names[1]:
+            return (f"{names[0]}'s g1={g1:g} ≥ {names[1]}'s g2={g2:g} at x={x:g}; "
+                    "obstacles need g1 < g2")
+        return (f"{_named(names[0] or names[1])}g1 ≥ g2 at x={x:g} (g1={g1:g}, g2={g2:g}); "
+                "obstacles need g1 < g2")
+
+
+def _named(name: str) -> str:
+    """A refusal's prefix naming its obstacle's key path, if it has one."""
+    return f"{name}: " if name else ""
 
 
 @dataclass(frozen=True)
@@ -598,18 +619,7 @@ class BeamProblem:
             object.__setattr__(self, "nodes", x)
             object.__setattr__(self, "J", x.size - 1)
         check_choice("element", self.element, ("hermite", "bspline"))
-        for b in (*self.obstacles.breakpoints, *self.hole_breakpoints):
-            if not 0.0 <= b <= self.beam.L:
-                raise InputError(f"obstacle break point x={b:g} lies outside [0, L={self.beam.L:g}]")
-            d = np.abs(self.nodes - b).min()
-            if d > 1e-9 * self.beam.L:
-                raise InputError(f"the mesh has no node at the obstacle break point x={b:g} "
-                                 f"(nearest node {d:.3g} m away); choose J so that it is a node")
-        for b in self.beam.steps:
-            d = np.abs(self.nodes - b).min()
-            if d > 1e-9 * self.beam.L:
-                raise InputError(f"the mesh has no node at the beam's step x={b:g} (nearest "
-                                 f"node {d:.3g} m away); choose J or nodes so that it is one")
+        self._check_break_nodes()
         self._check_load()
         if self.planes == 2:
             self._check_load(self.second.load)
@@ -636,6 +646,24 @@ class BeamProblem:
         if self.support.moves:
             self._check_moving_support()
         self.obstacles.carried_at(self.nodes[free])   # carried and fixed may not meet
+
+    def _check_break_nodes(self) -> None:
+        """Every obstacle's break point and the beam's steps are nodes of the mesh."""
+        for b in (*self.obstacles.breakpoints, *self.hole_breakpoints):
+            if not 0.0 <= b <= self.beam.L:
+                raise InputError(f"obstacle break point x={b:g} lies outside [0, L={self.beam.L:g}]")
+            d = np.abs(self.nodes - b).min()
+            if d > 1e-9 * self.beam.L:
+                owner = [o.name for o in self.obstacles.parts or (self.obstacles,)
+                         if b in o.breakpoints and o.name]
+                raise InputError(f"{_named(owner[0] if owner else '')}the mesh has no node at "
+                                 f"the obstacle break point x={b:g} (nearest node {d:.3g} m "
+                                 "away); choose J so that it is a node")
+        for b in self.beam.steps:
+            d = np.abs(self.nodes - b).min()
+            if d > 1e-9 * self.beam.L:
+                raise InputError(f"the mesh has no node at the beam's step x={b:g} (nearest "
+                                 f"node {d:.3g} m away); choose J or nodes so that it is one")
 
     def _check_acting(self, held: np.ndarray) -> None:
         """Refuse an obstacle that bounds only nodes an end or a support holds (u = 0

@@ -27,7 +27,9 @@ SECTION_DOCS = {
     ),
     'mass': (
         '`added` (kg/m): mass carried along the whole beam, e.g. the fluid inside and around '
-        'a tube (its hydrodynamic mass); ρA + added is the inertia, and converts forces to N'
+        'a tube (its hydrodynamic mass); ρA + added is the inertia, and converts forces to N; '
+        'gravity and `per_mass` loads act on ρA + added too (a fluid round the tube, which '
+        'its buoyancy holds up, adds no weight: give the weight as a `distributed` load)'
     ),
     'geometry': (
         '`L` (m)'
@@ -42,7 +44,8 @@ SECTION_DOCS = {
     'motion': (
         '`end = "left"\\|"right"` or `at = x` (a support); `amplitude`, `omega` (φ = A sin ωt)'
         ' or `sines = [[A, ω, phase], ...]`, `table = "phi.csv"` (t, φ rows; held at its '
-        'first and last values outside them), `random = {rms,'
+        'first and last values outside them, with a warning when it ends before T), '
+        '`random = {rms,'
         ' f_low, f_high, seed, count}` (band-limited, `count` sines), `psd = { table, seed, df }`, `value` '
         '(constant), as for loads; `phase` with `amplitude`, `omega`; `lifting`; two planes: '
         '`direction = [dy, dz]` (a direction: its length is not used)'
@@ -52,7 +55,9 @@ SECTION_DOCS = {
         '`g2`: numbers, `{ poly = [c0, c1, ...], about = x0 }` (Σ c_k (x − x0)^k) or `{ x = '
         '[...], g = [...] }` (linear between points, covering where it acts); `carried = '
         'true` moves with the support; `stiffness` (N/m) and `damping` (N·s/m, optional): elastic supports, the '
-        "penalty law's springs with Kelvin–Voigt dashpots, each obstacle its own (one plane; "
+        "penalty law's springs with Kelvin–Voigt dashpots (k·δ + c·δ' while the spring is "
+        "compressed: on the rebound the dashpot can pull, as a linear one does), each "
+        "obstacle its own (one plane; "
         'two planes: the same on every obstacle), on every obstacle or none (rigid); '
         "summary.json `spring_supports` gives each one's largest deflection and force. "
         'Two planes: g1, g2 bound v; `hole = {...}` at `x` or over `x_from`, `x_to` bounds '
@@ -78,7 +83,8 @@ SECTION_DOCS = {
         '`x` (a point force, N) or `distributed = true` (N/m) or `per_mass = true` (m/s², the'
         " papers' f̃) or `gravity = 9.81`; the time: `amplitude`, `omega` (rad/s), `phase` "
         '(rad): amplitude·sin(ωt + phase), `value`, `sines`, '
-        '`table = "f.csv"` (held at its first and last values outside its times), '
+        '`table = "f.csv"` (held at its first and last values outside its times, with a '
+        'warning when it ends before T), '
         '`random = {rms, f_low, f_high, seed, count}`, `psd = "S.csv"` or '
         '`psd = { table = "S.csv", seed = 1, df = 0.1 }` (a one-sided PSD, columns f in Hz '
         'and S in N²/m²/Hz for a distributed force, synthesised with the seed: '

@@ -371,7 +371,10 @@ def test_case_end_to_end(tmp_path):
 
 
 @pytest.mark.parametrize("args, word", [
-    (["--N", "0"], "N=0"), (["--a", "0"], "a=0"), (["--rho", "-1"], "rho=-1"),
+    (["--N", "0"], "--N=0"), (["--rho", "-1"], "--rho=-1"),
+    # named by the flag given, not by Bar's field (it said a=0)
+    (["--a", "0"], "--E=0 must be > 0"), (["--E", "-1"], "--E=-1 must be > 0"),
+    (["--far-end", "glued"], "--far-end='glued' is not one of"),
     (["--L", "0"], "L=0"), (["--dt", "0"], "dt=0"), (["--T", "-1"], "T=-1"),
     (["--b", "-1"], "b=-1"), (["--obstacle", "elastic", "--k", "-1"], "k=-1"),
     (["--u0", "-0.1"], "u0=-0.1"), (["--obstacle", "soft"], "soft"),
@@ -394,7 +397,7 @@ def test_case_bad_input_subprocess(tmp_path):
     out = tmp_path / "run"
     p = subprocess.run(CASE + ["--N", "0", "--out", str(out)], capture_output=True, text=True,
                        timeout=120)
-    assert p.returncode == 2 and p.stderr.strip() == "error: N=0 must be a whole number ≥ 1"
+    assert p.returncode == 2 and p.stderr.strip() == "error: --N=0 must be a whole number ≥ 1"
     assert p.stdout == "" and not out.exists()
 
 

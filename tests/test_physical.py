@@ -173,3 +173,14 @@ def test_bad_physical_input_is_refused_with_one_clear_line(make, words):
         make()
     msg = str(err.value)
     assert "\n" not in msg and all(w in msg for w in words), msg
+
+
+def test_a_span_acts_at_its_end_nodes_a_rounding_away():
+    """The nodes at a span's ends lie a rounding off them (linspace: 0.6003999999999999 for
+    0.6004); the mesh check takes them as its nodes, so the span acts there: the first one
+    was left free."""
+    x = np.linspace(0.0, 1.501, 11)
+    lo, hi = Obstacles.span(0.6004, 1.2008, -0.2, 0.1).bounds(x)
+    assert x[4] < 0.6004 and x[8] < 1.2008
+    assert list(np.flatnonzero(np.isfinite(lo))) == [4, 5, 6, 7, 8]
+    assert list(np.flatnonzero(np.isfinite(hi))) == [4, 5, 6, 7, 8]

@@ -252,6 +252,19 @@ BAD = {
                        .replace("[geometry]\nL = 1.501\n", "") + "[[segments]]\nlength = -0.5"
                        "\nmaterial = { E = 2e11, rho = 8000.0 }\nsection = { rect = { b = "
                        "0.01, h = 0.01 } }\n", "[segments.0] length=-0.5 must be > 0"),
+    "support off the nodes": (PIPE + "[mesh]\nJ = 10\n[[supports]]\nx = 0.5\n",
+                              "[supports.0] x=0.5: the mesh has no node there (the nearest, "
+                              "x=0.4503"),
+    "point stop g1 above g2": (PIPE.replace("g2 = 0.1", "g2 = -0.2"),
+                               "obstacles.0: g1 ≥ g2 at x=1.501 (g1=-0.1, g2=-0.2)"),
+    "span g1 above g2": (PIPE + "[[obstacles]]\nx_from = 0.6004\nx_to = 1.2008\ng1 = 0.2\n"
+                         "g2 = 0.1\n[mesh]\nJ = 10\n", "obstacles.1: g1 ≥ g2 at x=0.6004 (g1=0.2, g2=0.1)"),
+    "two obstacles crossing": (PIPE + "[[obstacles]]\nx_from = 0.6004\nx_to = 1.501\n"
+                               "g1 = 0.2\n[mesh]\nJ = 10\n", "obstacles.1's g1=0.2 ≥ "
+                               "obstacles.0's g2=0.1 at x=1.501"),
+    "span off the nodes": (PIPE + "[[obstacles]]\nx_from = 0.5\nx_to = 1.501\ng1 = -0.2\n"
+                           "[mesh]\nJ = 10\n", "obstacles.1: the mesh has no node at the "
+                           "obstacle break point x=0.5"),
     "two supports at one x": (PIPE + "[[supports]]\nx = 0.5\n[[supports]]\nx = 0.5\n",
                               "two supports at x=0.5"),
     "unknown end": (PIPE + '[ends]\nright = "glued"\n', "glued"),
@@ -1196,3 +1209,21 @@ def test_a_driver_above_the_nyquist_frequency_warns_and_runs(tmp_path, capsys):
     assert err == ["warning: loads.0: its highest frequency, 9000 Hz, lies above the steps' "
                    "Nyquist frequency 1/(2 dt) = 5000 Hz: the steps alias it to a lower one; "
                    "dt ≤ 5.56e-05 s resolves it (about 10 steps a period: 1.11e-05 s)"]
+
+
+@pytest.mark.parametrize("T, warned", [(0.5, True), (0.4, False)])
+def test_a_time_table_ending_before_T_warns(tmp_path, capsys, T, warned):
+    """A table is held at its last value past its last row: a support motion cut short by
+    mistake stopped there without a word (a beam's motion and load, a plate's pressure)."""
+    (tmp_path / "phi.csv").write_text("t,phi\n0,0\n0.1,0.001\n0.2,0.002\n0.3,0.001\n0.4,0\n")
+    beam = PIPE.replace("T = 0.01", f"T = {T}") + \
+        '[motion]\nend = "left"\ntable = "phi.csv"\n[[loads]]\ntable = "phi.csv"\nper_mass = true\n'
+    plate = example("plate_rattling").read_text().replace("T = 0.2 ", f"T = {T} ") \
+        .replace("omega = 150.0 ", 'table = "phi.csv"')
+    load(write(tmp_path, beam))
+    load(write(tmp_path, plate, "plate.toml"))
+    err = capsys.readouterr().err.splitlines()
+    held = f"table = 'phi.csv' ends at t=0.4 s, before T={T:g} s: from there on it is held " \
+           "at its last value"
+    assert err == ([f"warning: [loads.0] {held}", f"warning: [motion] {held}",
+                    f"warning: [loads.0] {held}"] if warned else [])

@@ -84,10 +84,23 @@ def main(argv=None) -> int:
 
     u0 = read_profile(args.u0_csv, "--u0-csv") if args.u0_csv else args.u0
     v0 = read_profile(args.v0_csv, "--v0-csv") if args.v0_csv else args.v0
-    bar = Bar(a=args.a, b=args.b, rho=args.rho, L=args.L, f=args.f, v0=v0, u0=u0,
-              obstacle=args.obstacle, k=args.k, N=args.N, mass=args.mass, element=args.element,
-              far_end=args.far_end, obstacle_at=args.obstacle_at, A=args.A)
+    try:
+        bar = Bar(a=args.a, b=args.b, rho=args.rho, L=args.L, f=args.f, v0=v0, u0=u0,
+                  obstacle=args.obstacle, k=args.k, N=args.N, mass=args.mass,
+                  element=args.element, far_end=args.far_end, obstacle_at=args.obstacle_at,
+                  A=args.A)
+    except InputError as e:     # Bar's field names as the flags ("a=-1": --E -1)
+        name, eq, rest = str(e).partition("=")
+        if eq and name in FLAGS:
+            raise InputError(f"{FLAGS[name]}={rest}") from None
+        raise
     return run_bar_case(bar, cli.spec(args))
+
+
+# Bar's fields whose refusals name them (``a=-1 must be > 0``), as the command's flags
+FLAGS = {"a": "--E", "b": "--b", "rho": "--rho", "L": "--L", "f": "--f", "k": "--k",
+         "N": "--N", "A": "--A", "obstacle": "--obstacle", "mass": "--mass",
+         "far_end": "--far-end", "obstacle_at": "--obstacle-at"}
 
 
 def _check_springs(args, given: dict) -> None:

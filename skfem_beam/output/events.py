@@ -164,6 +164,8 @@ EPISODES = ("of the run's time: each episode from its first state in contact to 
 # impacts.csv's velocity, as summary.json's units say it
 VELOCITY = ("m/s: (yⁿ − yⁿ⁻¹)/Δt at the state before the first in contact (a free flight's "
             "approach; after a one-step separation, that separation's, away from the obstacle)")
+# peak_force is unsigned, unlike the impulse and the contact_force column
+MAGNITUDE = " (the largest |force|: the impulse carries the sign)"
 # peak_force's unit under exact contact
 RIGID_PEAK = ("; rigid (exact) contact: the largest one-step force, which grows as dt "
               "shrinks: quote the impulse")
@@ -229,7 +231,7 @@ def _write_impacts(folder, run, units, scale, sign, obstacles, last, wear) -> tu
     # the share of the states 1..n, as the run's own contact_fraction counts it
     duration = max(0, last - 1) * run.dt
     stats = impact_statistics(table, duration, obstacles)
-    f, i = units["force"], units["impulse"]
+    f, i = units["force"] + MAGNITUDE, units["impulse"]
     if not run.springs:     # exact contact: the force of one step, impulse/Δt
         f += RIGID_PEAK + ", or give the supports a stiffness"
     stats["units"] = {"t_start": "s", "t_end": "s", "x": "m", "bound": "1 = g1 (lower), "
@@ -244,7 +246,6 @@ def _write_impacts(folder, run, units, scale, sign, obstacles, last, wear) -> tu
                                                wear)
         stats["units"].update(work_rate_units(units["force"] == "N", wear))
         if disk_rows(s).size:       # a round hole's event is its pair's (Run.impact_events)
-            stats["units"]["peak_force"] += "; a round hole's: the force's magnitude"
             stats["units"]["impulse"] += "; a round hole's: Σ|force|Δt"
     if friction:
         stats["units"].update({"slip": "m, Σ|u_t|Δt over the contact",

@@ -163,7 +163,11 @@ def beam_problem(data: dict, reader: Tables) -> BeamProblem:
             damping=_damping(data), planes=plane_count(data), holes=holes,
             second=Plane(load=load_w))
     except InputError as e:     # the mesh's refusals name its keys alone ("nodes must ...")
-        if not str(e).startswith(("nodes ", "element=")):
+        text = str(e)
+        if text.startswith("supports["):        # supports[1] x=...: the file's [supports.1]
+            k, _, rest = text[len("supports["):].partition("]")
+            raise InputError(f"[supports.{k}]{rest}") from None
+        if not text.startswith(("nodes ", "element=")):
             raise
         raise InputError(f"[mesh] {e}") from None
     if problem.element == "bspline" and beam.steps:

@@ -15,7 +15,7 @@ from ..errors import InputError
 from ..scheme import Stepping
 from .bar import bar_problem
 from .beam import beam_problem
-from .forcing import warn_aliased
+from .forcing import warn_aliased, warn_short_tables
 from .parts import named_section, need, outer_radius, plane_count, stepping_of
 from .read import Parsed, Tables, read
 from .schema import CONTACT, OUTPUT_DEFAULTS
@@ -106,7 +106,7 @@ def build(parsed: Parsed, dynamic: bool = True) -> Scene:
         if not dynamic:
             return Scene(parsed.kind, problem, None, text=parsed.text, files=tables.read,
                          data=parsed.data)
-        return _scene(parsed.kind, problem, parsed.data, parsed.text, tables.read)
+        return _scene(parsed.kind, problem, parsed.data, parsed.text, tables)
     except InputError as e:
         raise InputError(f"{path.name}: {e}") from None
 
@@ -151,7 +151,7 @@ def _supports(data: dict) -> tuple | None:
     return ks, cs
 
 
-def _scene(kind, problem, data, text, files) -> Scene:
+def _scene(kind, problem, data, text, tables: Tables) -> Scene:
     contact = data.get("contact", {})
     law, k, c = contact.get("law", "auto"), contact.get("stiffness"), 0.0
     supports = _supports(data)
@@ -177,8 +177,9 @@ def _scene(kind, problem, data, text, files) -> Scene:
     stepping = stepping_of(t, out, load_window=t.get("load_window", "forward"),
                            massless=rows or "beta")
     warn_aliased(data, stepping.dt)
+    warn_short_tables(tables, stepping.T)
     scene = Scene(kind, problem, stepping, law, k, contact.get("restitution", 0.0), out, text,
-                  files, data, c)
+                  tables.read, data, c)
     try:
         scene.beta      # the method's own checks (law, stiffness, restitution, β)
     except InputError as e:

@@ -52,7 +52,9 @@ def _time_form(d: dict, where: str, reader: Tables):
         return SumOfSines(tuple(r[0] for r in rows), tuple(r[1] for r in rows),
                           tuple(r[2] if len(r) == 3 else 0.0 for r in rows))
     if form == "table":
-        return Table.from_csv(reader.path(d["table"]))
+        table = Table.from_csv(reader.path(d["table"]))
+        reader.time_tables.append((where, d["table"], table.t[-1]))
+        return table
     if form == "psd":   # a one-sided PSD table f (Hz), S (unit²/Hz), synthesised with a seed
         psd = d["psd"] if isinstance(d["psd"], dict) else {"table": d["psd"]}
         if "table" not in psd:
@@ -91,6 +93,17 @@ def warn_aliased(data: dict, dt: float) -> None:
                  f"frequency 1/(2 dt) = {0.5 / dt:g} Hz: the steps alias it to a lower one; "
                  f"dt ≤ {0.5 / f:.3g} s resolves it (about 10 steps a period: "
                  f"{0.1 / f:.3g} s)")
+
+
+def warn_short_tables(tables: Tables, T: float) -> None:
+    """One warning line for each time table that ends before T: past its last row it is
+    held at its last value (the motion stops there, a load stays constant), which a table
+    cut short by mistake would not say."""
+    from ..cli import warn
+    for where, name, last in tables.time_tables:
+        if last < T:
+            warn(f"[{where}] table = {name!r} ends at t={last:g} s, before T={T:g} s: from "
+                 "there on it is held at its last value")
 
 
 def support_of(data: dict, L: float, reader: Tables) -> Support:

@@ -87,11 +87,11 @@ def _obstacle(o: dict, i: int) -> Obstacles:
         if "x_from" in o or "x_to" in o or callable(g1) or callable(g2):
             raise InputError(f"[{where}] a point stop (x) takes numbers g1, g2 and no "
                              "x_from/x_to")
-        return Obstacles.stops([o["x"]], g1, g2, carried=carried)
+        return Obstacles.stops([o["x"]], g1, g2, carried=carried, name=where)
     if "x_from" in o or "x_to" in o:
         a, b = need(o, ("x_from", "x_to"), where).values()
-        return Obstacles.span(a, b, g1, g2, carried=carried)
-    return Obstacles(g1, g2, carried=carried)
+        return Obstacles.span(a, b, g1, g2, carried=carried, name=where)
+    return Obstacles(g1, g2, carried=carried, name=where)
 
 
 def _warn_hole_size(items, tube: float | None) -> None:

@@ -48,14 +48,15 @@ def support_nodes(nodes: np.ndarray, supports) -> np.ndarray:
     nodes = np.asarray(nodes, dtype=float)
     L = nodes[-1] - nodes[0]
     out = []
-    for xs in supports:
+    for k, xs in enumerate(supports):
         i = int(np.abs(nodes - xs).argmin())
         if abs(nodes[i] - xs) > 1e-9 * L:
-            raise InputError(f"the mesh has no node at the support x={xs:g} (nearest node "
-                             f"{abs(nodes[i] - xs):.3g} m away); choose J so that it is a node")
+            raise InputError(f"supports[{k}] x={xs:g}: the mesh has no node there (the "
+                             f"nearest, x={nodes[i]:g}, is {abs(nodes[i] - xs):.3g} m away); "
+                             "choose J, or the nodes, so that it is one")
         if i == 0 or i == nodes.size - 1:
-            raise InputError(f"support x={xs:g} is at an end of the beam: use ends=(...) "
-                             "('pinned' there) instead")
+            raise InputError(f"supports[{k}] x={xs:g} is at an end of the beam: use "
+                             "ends=(...) ('pinned' there) instead")
         out.append(i)
     if len(set(out)) != len(out):
         raise InputError(f"two supports at one node: supports={tuple(supports)!r}")

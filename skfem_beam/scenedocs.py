@@ -43,8 +43,9 @@ SECTION_DOCS = {
     ),
     'motion': (
         '`end = "left"\\|"right"` or `at = x` (a support); `amplitude`, `omega` (φ = A sin ωt)'
-        ' or `sines = [[A, ω, phase], ...]`, `table = "phi.csv"` (t, φ rows; held at its '
-        'first and last values outside them, with a warning when it ends before T), '
+        ' or `sines = [[A, ω, phase], ...]`, `table = "phi.csv"` (t, φ rows: a cubic '
+        'spline through them, held at its first and last values outside them; a warning '
+        'when it ends before T or the spline overshoots its rows), '
         '`random = {rms,'
         ' f_low, f_high, seed, count}` (band-limited, `count` sines), `psd = { table, seed, df }`, `value` '
         '(constant), as for loads; `phase` with `amplitude`, `omega`; `lifting`; two planes: '
@@ -83,8 +84,9 @@ SECTION_DOCS = {
         '`x` (a point force, N) or `distributed = true` (N/m) or `per_mass = true` (m/s², the'
         " papers' f̃) or `gravity = 9.81`; the time: `amplitude`, `omega` (rad/s), `phase` "
         '(rad): amplitude·sin(ωt + phase), `value`, `sines`, '
-        '`table = "f.csv"` (held at its first and last values outside its times, with a '
-        'warning when it ends before T), '
+        '`table = "f.csv"` (a cubic spline through its rows, held at its first and last '
+        'values outside its times; a warning when it ends before T or the spline overshoots '
+        'its rows), '
         '`random = {rms, f_low, f_high, seed, count}`, `psd = "S.csv"` or '
         '`psd = { table = "S.csv", seed = 1, df = 0.1 }` (a one-sided PSD, columns f in Hz '
         'and S in N²/m²/Hz for a distributed force, synthesised with the seed: '

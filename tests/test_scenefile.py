@@ -1227,3 +1227,16 @@ def test_a_time_table_ending_before_T_warns(tmp_path, capsys, T, warned):
            "at its last value"
     assert err == ([f"warning: [loads.0] {held}", f"warning: [motion] {held}",
                     f"warning: [loads.0] {held}"] if warned else [])
+
+
+def test_a_time_table_whose_spline_overshoots_its_rows_warns(tmp_path, capsys):
+    """A ramp then a hold (0, 0, 1, 1, 1): the spline through it went to −0.103 where the
+    rows say 0, and a plate on a stop under that load lifted off it by 0.25 mm without a
+    word; a smooth table (the bump of the test above) says nothing."""
+    (tmp_path / "ramp.csv").write_text("t,f\n0,0\n0.1,0\n0.3,1\n0.4,1\n0.6,1\n")
+    beam = PIPE.replace("T = 0.01", "T = 0.6") + '[[loads]]\ntable = "ramp.csv"\nper_mass = true\n'
+    load(write(tmp_path, beam))
+    assert capsys.readouterr().err.splitlines() == [
+        "warning: [loads.0] table = 'ramp.csv': the cubic spline through its rows reaches "
+        "-0.103 between t=0 and 0.1 s, outside the rows' values there: give rows closer "
+        "together where it bends (a spline gives the acceleration a support's motion needs)"]

@@ -266,3 +266,39 @@ def test_kappa_h_is_the_same_number_every_time():
     assert system.n >= 100                  # the sparse (Lanczos) branch
     first = kappa_h(system)
     assert all(kappa_h(system) == first for _ in range(4))
+
+
+def test_an_unstable_run_names_the_time_of_its_last_row_written(tmp_path, capsys):
+    """With --save-every 100 an explicit run found unstable at its first saved state keeps
+    the row at t = 0 only: its line said "results up to t=0.01 s written"."""
+    from skfem_beam.cases import flat_obstacles
+    out = tmp_path / "run"
+    argv = ["--beta", "0", "--dt", "0.01", "--T", "5", "--save-every", "100", "--format",
+            "none", "--out", str(out)]
+    assert exit_code(flat_obstacles.main, argv) == 4
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert err.endswith(f"; results up to t=0 s written to {out}"), err
+    assert (out / "timeseries.csv").read_text().splitlines()[-1].startswith("0.0,")
+
+
+def test_an_unstable_penalty_run_says_when_its_energy_left_its_bound_and_why(tmp_path,
+                                                                             capsys):
+    """The main job's penalty method at its defaults goes unstable at t = 1.606 s, its energy
+    growing from about 1.1 s: the rows kept were unmarked, and the springs' gain, said for
+    a run that ends, was not said for one that stops unstable."""
+    from skfem_beam.cases import flat_obstacles
+    out = tmp_path / "run"
+    assert exit_code(flat_obstacles.main, ["--method", "penalty", "--T", "2", "--format",
+                                           "none", "--out", str(out)]) == 4
+    import re
+    err = capsys.readouterr().err.splitlines()
+    # an instability's step is a matter of the last bits: times to a few steps (1.606 s
+    # and 1.483 s on the machine of tests/reference/pins)
+    stop = re.match(r"error: unstable at step \d+ \(t=([\d.]+) s\)", err[0])
+    passed = re.search(r"its energy passed the loads' a-priori bound \(√E¹ \+ their "
+                       r"work\)² at t=([\d.]+) s: the rows from there on show", err[0])
+    assert stop and passed, err
+    assert 1.4 < float(passed[1]) < float(stop[1]) < 1.7
+    gain = re.match(r"warning: the penalty springs did ([\d.]+) of work", err[1])
+    assert gain and float(gain[1]) > 10, err        # 66.27 against 0.66 given
+    assert passed[0] in json.loads((out / "summary.json").read_text())["message"]

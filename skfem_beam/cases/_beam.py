@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import cli
+from ..errors import EXIT_UNSTABLE
 from ..chart_process import draw
 from ..output.charts import (energy_chart, orbit_chart, shape_chart, shapes,
                              trajectory_chart, wear_chart)
@@ -66,8 +67,8 @@ def run_beam_case(case: str, problem, spec: RunSpec, stops=(), extra=None) -> in
         print_supports(Path(spec.options.out), spec.wear)
         print_springs(Path(spec.options.out))
         warn_no_contact(run, system)
-        if penalty:
-            warn_spring_gain(run)
+    if penalty and code in (0, EXIT_UNSTABLE):   # unstable: often why
+        warn_spring_gain(run)
     return code
 
 

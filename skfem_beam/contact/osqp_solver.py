@@ -98,11 +98,27 @@ class OSQPSolver:
         return mu, int(info.iter)
 
     def checkpoint(self) -> dict:
-        return {"active": self.state.copy()}
+        return {"active": self.state.copy(), **warm_state(self.engine)}
 
     def restore(self, saved: dict) -> None:
         if "active" in saved:
             self.state[:] = saved["active"]
+        warm_again(self.engine, saved)
+
+
+def warm_state(engine) -> dict:
+    """OSQP's own warm start: its last x, y and its adapted ρ (without them a resumed
+    run's ADMM took other iteration counts: qp_iterations 56,290 against 56,280)."""
+    sol = engine.solution
+    return {"x": np.array(sol.x), "y": np.array(sol.y), "rho": engine.get_settings().rho}
+
+
+def warm_again(engine, saved: dict) -> None:
+    """Restore :func:`warm_state` (a checkpoint written before it was kept has none)."""
+    if "x" in saved:
+        if float(saved["rho"]) != engine.get_settings().rho:
+            engine.update_rho(float(saved["rho"]))      # refactors, as its adaptation did
+        engine.warm_start(x=saved["x"], y=saved["y"])
 
 
 @njit(cache=True)

@@ -72,6 +72,7 @@ import scipy.sparse as sp
 
 from ..errors import InputError, SolverError
 from .base import ContactLaw
+from .osqp_solver import warm_again, warm_state
 
 MAX_SWEEPS = 100   # active-set updates of one step before it gives up (SolverError)
 # the engines' tolerances in scaled units: loose enough to find the set fast, the exact
@@ -550,6 +551,15 @@ class OSQPSparse(XSpaceSolver):
         self.prob.setup(sp.triu(P, format="csc"), np.zeros(n), self.E, *self.scaled_bounds(),
                         verbose=False, eps_abs=OSQP_EPS, eps_rel=OSQP_EPS, polishing=False,
                         warm_starting=True, max_iter=100000)
+
+    def checkpoint(self) -> dict:
+        return {**super().checkpoint(),
+                **{f"osqp_{k}": v for k, v in warm_state(self.prob._solver).items()}}
+
+    def restore(self, saved: dict) -> None:
+        super().restore(saved)
+        warm_again(self.prob._solver, {k[5:]: v for k, v in saved.items()
+                                       if k.startswith("osqp_")})
 
     def scaled_bounds(self):
         js = self.j[self.qp.dof] * self.s

@@ -19,7 +19,7 @@ import numpy as np
 from ..errors import InputError
 from ..results import CHECKPOINT  # noqa: F401 (the name a folder's reader knows too)
 from ..scheme import Run
-from .folder import SUMMARY, _plain
+from .folder import SUMMARY, _plain, check_writable
 from .series import SeriesFile, file_crc
 
 CHECKPOINT_FORMAT = 3       # 3: impact events hold their first step off (State.impact)
@@ -187,12 +187,16 @@ def _resume_folder(out) -> Path:
     """The folder of ``--resume``; refused when it is not a run's (no summary.json: a
     checkpoint alone cannot say how to rebuild the run)."""
     out = Path(out)
+    if not out.is_dir():        # it said "no summary.json there"
+        raise InputError(f"--resume {out}: no such folder")
     if not (out / SUMMARY).is_file():
         why = (f"its {CHECKPOINT} alone cannot say how to rebuild the run"
                if (out / CHECKPOINT).is_file() else "not the folder of a run")
         raise InputError(f"--resume {out}: no {SUMMARY} there: {why}; nothing to resume "
                          "from")
     read_summary(out)       # before its lock: a folder of `modes` is not a run's
+    # a read-only one failed at its lock, exit 3, "could not write the results"
+    check_writable(out, f"--resume {out}: the folder")
     return out
 
 

@@ -35,6 +35,10 @@ SUMMARY = "summary.json"
 NO_MEMORY = "not enough memory for this run"     # a MemoryError's line (cli.main_guard)
 RESERVE = ".reserve"    # a little disk kept back, freed to write the final summary
 OURS = (LOCK, RESERVE)
+# atomic writes' temporaries, .NAME.PID.tmp (atomic_write), .NAME.PID.tmp.npz (numpy's
+# savez adds .npz: the checkpoint's) and an export's .STEM.PID.tmp.npz or .mat: a process
+# killed while writing one leaves it
+TEMPORARIES = (".*.tmp", ".*.tmp.npz", ".*.tmp.mat")
 # what the project's commands write in a folder, by name, which --overwrite may remove:
 # anything else there (a user's notes, a .git, their own CSV, an export's .mat) is named and
 # the run refused, not deleted
@@ -46,7 +50,7 @@ WRITTEN = (
     "beam_shapes.png", "contact_force.png", "deflection.png", "displacement.png",  # charts
     "energy.csv", "energy.png", "energy_decay.png", "probes.png", "tip_displacement.png",
     "orbit_*.png", "wear_*.png",
-    *OURS, ".*.tmp")        # a run's own hidden files (atomic writes' temporaries)
+    *OURS, *TEMPORARIES)
 NAME_MAX = 255          # bytes of one file name (Linux, macOS, Windows' NTFS in characters)
 OPENED: list[Path] = []         # the folders this process opened (for the interrupt line)
 
@@ -82,19 +86,24 @@ def check_output_dir(out: str | os.PathLike, overwrite: bool = False) -> Path:
         _check_replaceable(out, overwrite)
     # missing parents are made when the run starts (after every check); probe the folder
     # itself when it exists (a writable one in a read-only parent is fine, a read-only one
-    # failed later with exit 3), else the nearest parent that exists: permission bits say
-    # little (root, read-only mounts, /proc)
+    # failed later with exit 3), else the nearest parent that exists
     parent = out.resolve() if out.is_dir() else out.resolve().parent
     while not parent.exists():
         parent = parent.parent
     if not parent.is_dir():
         raise InputError(f"--out {out}: {parent} is not a folder")
+    check_writable(parent, f"--out {out}: folder {parent}")
+    return out
+
+
+def check_writable(folder: Path, what: str) -> None:
+    """Refuse, in one line ("``what`` is not writable"), a folder nothing can be written
+    in: tried, since permission bits say little (root, read-only mounts, /proc)."""
     try:
-        os.rmdir(tempfile.mkdtemp(prefix=".probe.", dir=parent))   # not out's name: a long
+        os.rmdir(tempfile.mkdtemp(prefix=".probe.", dir=folder))   # not out's name: a long
         # name of 250 bytes, legal, passed 255 with the probe's prefix and was refused
     except OSError as e:
-        raise InputError(f"--out {out}: folder {parent} is not writable ({e.strerror})") from None
-    return out
+        raise InputError(f"{what} is not writable ({e.strerror})") from None
 
 
 def _holds_files(out: Path) -> bool:
@@ -141,6 +150,14 @@ def _shown(out: Path, ours=None) -> str:
             not any(fnmatch.fnmatch(name, w) for w in WRITTEN)
     names = sorted(p.name for p in out.iterdir() if theirs(p.name))
     return ", ".join(names[:3]) + (", …" if len(names) > 3 else "")
+
+
+def _remove_temporaries(out: Path) -> None:
+    """Remove the temporaries a killed process left in ``out`` (TEMPORARIES): a resumed
+    run then ends with the files of a run never stopped."""
+    for p in out.iterdir():
+        if p.is_file() and any(fnmatch.fnmatch(p.name, t) for t in TEMPORARIES):
+            p.unlink(missing_ok=True)
 
 
 def _empty(out: Path, keep: tuple[str, ...]) -> None:
@@ -246,6 +263,7 @@ class Folder:
             if not resume and _holds_files(out):   # filled since the checks: a race lost
                 _check_replaceable(out, overwrite)
                 _empty(out, keep=(LOCK,))   # the lock file: it is what others lock
+            _remove_temporaries(out)        # a killed run's: locked, no writer is left
             folder = cls(out, summary)
             OPENED.append(out)
             folder.reserve()
@@ -322,12 +340,13 @@ class Folder:
         return False
 
 
-def report(summary: dict, out) -> int:
-    """One line for a finished run (stdout, or stderr when it went unstable); the exit code."""
+def report(summary: dict, out, last_t: float) -> int:
+    """One line for a finished run (stdout, or stderr when it went unstable, with
+    ``last_t`` the time of its last row: with save_every, before the stop); the exit code."""
     steps, wall = summary["steps"], summary["wall_time_s"]
     if summary["status"] != "success":
-        print(f"error: {summary['message']}; results up to t={steps * summary['dt']:.6g} s "
-              f"written to {out}", file=sys.stderr)
+        print(f"error: {summary['message']}; results up to t={last_t:.6g} s written to "
+              f"{out}", file=sys.stderr)
         return EXIT_UNSTABLE
     print(f"{steps} steps in {wall:.3g} s ({1e6 * wall / max(1, steps):.3g} µs/step), "
           f"{summary['impacts']} impacts, max nodal violation "

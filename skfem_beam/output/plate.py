@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from .events import COLUMNS, EPISODES, IMPACTS, MAGNITUDE, RIGID_PEAK, impact_table
+from .events import COLUMNS, EPISODES, IMPACTS, MAGNITUDE, RIGID_PEAK, VELOCITY, impact_table
 from .fields import FieldWriter, check_format
 from .folder import atomic_write, csv_rows
 from .supports import union_length
@@ -184,7 +184,7 @@ class PlateFieldWriter(FieldWriter):
 
 PLATE_COLUMNS = COLUMNS[:3] + ("y",) + COLUMNS[3:]      # the beam's, and the vertex's y
 IMPACT_UNITS = {"t_start": "s", "t_end": "s", "x": "m", "y": "m",
-                "bound": "1 = g1 (lower), 2 = g2 (upper)", "velocity": "m/s",
+                "bound": "1 = g1 (lower), 2 = g2 (upper)", "velocity": VELOCITY,
                 "peak_force": "N" + MAGNITUDE, "impulse": "N·s", "max_violation": "m",
                 "open": "1 = not over at the last state",
                 "contact_fraction": EPISODES}

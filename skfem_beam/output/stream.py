@@ -213,9 +213,6 @@ def execute(run: Run, options: OutputOptions, summary: dict, series, finish) -> 
     if resume and not restart:
         ck = read_checkpoint(out)       # checked again: the lock is held since the parse
         used = restore(run, ck)
-        # the checkpoint is the one truth: a resume that stops before its first new
-        # checkpoint leaves a summary that still names it
-        summary = {**summary, "checkpoint_step": int(ck["n"])}
     _note_last_step(run)
     if restart:
         check_clearable(out)            # before anything is written
@@ -223,6 +220,11 @@ def execute(run: Run, options: OutputOptions, summary: dict, series, finish) -> 
     with Signals() as stop:
         folder = Folder.open(out, summary, overwrite=options.overwrite, resume=resume)
         try:
+            if ck is not None:
+                # the checkpoint is the one truth: a resume that stops before its first new
+                # checkpoint leaves a summary that still names it (written after the
+                # status, where a run never stopped has it)
+                folder.write(checkpoint_step=int(ck["n"]))
             if restart:
                 # nothing computed is kept without a checkpoint, and the configuration
                 # is in hand (rebuilt from summary.json): the run starts again from step 0
@@ -302,7 +304,7 @@ def _stream(s: _Stream, finish) -> int:
         raise
     phase("summary")
     final = folder.close(**entries)
-    code = report(final, folder.path)
+    code = report(final, folder.path, _last_row_t(run, s.rows))
     if stop.signum is not None:     # during the charts or the summary: nothing is missing
         name = signal.Signals(stop.signum).name
         print(f"interrupted by {name} after the run's last step: its results are complete "

@@ -15,7 +15,7 @@ from ..errors import InputError
 from ..scheme import Stepping
 from .bar import bar_problem
 from .beam import beam_problem
-from .forcing import warn_aliased, warn_short_tables
+from .forcing import warn_aliased, warn_tables
 from .parts import named_section, need, outer_radius, plane_count, stepping_of
 from .read import Parsed, Tables, read
 from .schema import CONTACT, OUTPUT_DEFAULTS
@@ -177,7 +177,7 @@ def _scene(kind, problem, data, text, tables: Tables) -> Scene:
     stepping = stepping_of(t, out, load_window=t.get("load_window", "forward"),
                            massless=rows or "beta")
     warn_aliased(data, stepping.dt)
-    warn_short_tables(tables, stepping.T)
+    warn_tables(tables, stepping.T)
     scene = Scene(kind, problem, stepping, law, k, contact.get("restitution", 0.0), out, text,
                   tables.read, data, c)
     try:

@@ -53,7 +53,7 @@ def _time_form(d: dict, where: str, reader: Tables):
                           tuple(r[2] if len(r) == 3 else 0.0 for r in rows))
     if form == "table":
         table = Table.from_csv(reader.path(d["table"]))
-        reader.time_tables.append((where, d["table"], table.t[-1]))
+        reader.time_tables.append((where, d["table"], table))
         return table
     if form == "psd":   # a one-sided PSD table f (Hz), S (unit²/Hz), synthesised with a seed
         psd = d["psd"] if isinstance(d["psd"], dict) else {"table": d["psd"]}
@@ -95,15 +95,41 @@ def warn_aliased(data: dict, dt: float) -> None:
                  f"{0.1 / f:.3g} s)")
 
 
-def warn_short_tables(tables: Tables, T: float) -> None:
-    """One warning line for each time table that ends before T: past its last row it is
-    held at its last value (the motion stops there, a load stays constant), which a table
-    cut short by mistake would not say."""
+def warn_tables(tables: Tables, T: float) -> None:
+    """One warning line for each time table that ends before T (past its last row it is
+    held at its last value: the motion stops there, a load stays constant), and for each
+    whose spline leaves its rows (a ramp then a hold: the spline overshoots where a
+    measured history would not)."""
     from ..cli import warn
-    for where, name, last in tables.time_tables:
-        if last < T:
-            warn(f"[{where}] table = {name!r} ends at t={last:g} s, before T={T:g} s: from "
-                 "there on it is held at its last value")
+    for where, name, table in tables.time_tables:
+        if table.t[-1] < T:
+            warn(f"[{where}] table = {name!r} ends at t={table.t[-1]:g} s, before T={T:g} s: "
+                 "from there on it is held at its last value")
+        over = overshoot(table)
+        if over is not None:
+            t0, t1, value = over
+            warn(f"[{where}] table = {name!r}: the cubic spline through its rows reaches "
+                 f"{value:.3g} between t={t0:g} and {t1:g} s, outside the rows' values "
+                 "there: give rows closer together where it bends (a spline gives the "
+                 "acceleration a support's motion needs)")
+
+
+def overshoot(table: Table, share: float = 0.05):
+    """(t_i, t_i+1, the spline's farthest value) of the first interval where the spline
+    leaves [min, max] of its two rows by more than ``share`` of the table's range, or
+    None."""
+    t, phi = np.array(table.t), np.array(table.phi)
+    span = float(phi.max() - phi.min())
+    s = np.linspace(0.0, 1.0, 17)[1:-1]
+    tt = t[:-1, None] + s * np.diff(t)[:, None]
+    v = table(tt.ravel()).reshape(tt.shape)
+    lo, hi = np.minimum(phi[:-1], phi[1:])[:, None], np.maximum(phi[:-1], phi[1:])[:, None]
+    out = np.maximum(lo - v, v - hi)
+    bad = np.flatnonzero(out.max(axis=1) > share * span) if span > 0 else []
+    if not len(bad):
+        return None
+    i = int(bad[0])
+    return float(t[i]), float(t[i + 1]), float(v[i, np.argmax(out[i])])
 
 
 def support_of(data: dict, L: float, reader: Tables) -> Support:

@@ -17,7 +17,7 @@ from ..contact import SOLVERS
 from ..errors import InputError
 from ..plate.model import EDGES, ELEMENTS, MAX_PLATE_SIDE, SUPPORTS, MeshPlate, Plate
 from ..scheme import Stepping
-from .forcing import _time_function, warn_aliased, warn_short_tables
+from .forcing import _time_function, warn_aliased, warn_tables
 from .parts import named_section, need, stepping_of, warn_implausible
 from .read import Parsed, Tables
 from .schema import OUTPUT_DEFAULTS, PLATE_KEYS
@@ -354,6 +354,6 @@ def plate_scene(parsed: Parsed, tables: Tables, dynamic: bool = True) -> PlateSc
     out = {**OUTPUT_DEFAULTS, **data.get("output", {})}
     stepping = stepping_of(t, out)
     warn_aliased(parsed.data, stepping.dt)
-    warn_short_tables(tables, stepping.T)
+    warn_tables(tables, stepping.T)
     return PlateScene("plate", PlateSetup(space, system, probes), stepping, method, out,
                       parsed.text, tables.read, data, tables.meshes)

@@ -128,6 +128,7 @@ class Run:
         self.n = scheme.start(self.out)     # the last computed state
         self.E1 = float(self.out.energy[0])
         self.watch = Watch(self)
+        self.over_budget = -1       # the first saved state above the a-priori bound itself
         self._steps(self.n, self.n)         # the compiled loop loaded (or compiled) here
         if self.n == 0:                     # a scheme that starts from the data itself
             self.advance(1)
@@ -306,6 +307,7 @@ class Run:
         # last good state (_unstable)
         self._before = self._snapshot(), n0, inputs
         code = self._chunk(n0, n1, inputs)
+        self._note_over_budget(n0, self.stopped_at if code == UNSTABLE else n1)
         if code == 0 and n1 < self.n_steps:
             # the next chunk's inputs now, while the writer thread may still be formatting
             # the last chunk's rows but has not got this one's: computed while it formats
@@ -394,6 +396,19 @@ class Run:
         self.out.bound[k // every - self.row0] = bound[k - n0 - 1]
         return float(bound[-1])
 
+    def _note_over_budget(self, n0: int, n1: int) -> None:
+        """The first saved state in (n0, n1] whose energy passes the a-priori bound itself
+        (Series.bound / growth_limit: the energy the loads can have given), if none did
+        before: an unstable run's rows from there on show the growth, which its line
+        names (an unstable penalty run kept 500 rows of it, unmarked)."""
+        if self.over_budget >= 0 or self.out.bound.size == 0:
+            return
+        every, limit = self.save_every, self.stepping.growth_limit
+        rows = np.arange(n0 // every + 1, n1 // every + 1) - self.row0
+        over = np.flatnonzero(~(np.abs(self.out.energy[rows]) * limit <= self.out.bound[rows]))
+        if over.size:
+            self.over_budget = int(rows[over[0]] + self.row0) * every
+
     def _unstable(self, k: int, why: str, good: int) -> None:
         """Stop as unstable at state ``k`` (``why``), keeping the saved states up to
         ``good`` (the last one that passed every test): the chunk is stepped again from
@@ -419,6 +434,10 @@ class Run:
                              "run's energy is no norm of its state (massless rows, Δt beyond "
                              "the linear limit, or penalty springs below β = 1/4) and can hide "
                              "the growth before")
+        if 0 <= self.over_budget < k:
+            self.message += (f"; its energy passed the loads' a-priori bound (√E¹ + their "
+                             f"work)² at t={self.over_budget * self.dt:.6g} s: the rows from "
+                             "there on show the instability's growth")
         if self.beta is not None:
             limit = linear_limit(kappa_h(self.system), self.beta)
             if math.isfinite(limit):        # β ≥ 1/4 has none
@@ -458,7 +477,8 @@ class Run:
             saved.update({f"solver_{k}": np.array(v) for k, v in solver.checkpoint().items()})
         return {**saved, **{k: getattr(self.out, v).copy() for k, v in self._FRAMES.items()},
                 "events": self._all_events(), "n": self.n, "load_bound": self.load_bound,
-                "wall": self.wall, "E1": self.E1, "frame_every": self.frame_every}
+                "wall": self.wall, "E1": self.E1, "frame_every": self.frame_every,
+                "over_budget": self.over_budget}
 
     def restore(self, ck: dict) -> None:
         """Continue from ``checkpoint()``: of this run, or of the same run with a shorter
@@ -483,6 +503,7 @@ class Run:
         self.events = [np.asarray(ck["events"], dtype=float).reshape(-1, len(EVENT_COLUMNS))]
         self.n, self.load_bound, self.wall, self.E1 = int(ck["n"]), float(ck["load_bound"]), \
             float(ck["wall"]), float(ck["E1"])
+        self.over_budget = int(ck.get("over_budget", -1))
         if self.n >= self.n_steps:       # a checkpoint at the last step: nothing to compute
             self.status, self.message = "success", "the run reached T"
 

@@ -4,14 +4,14 @@ from scipy.linalg import eigh
 from scipy.sparse.linalg import eigsh
 
 from ..errors import InputError
-from .space import PlateSpace, check_space
+from .space import PlateSpace, check_space, to_skfem
 
 DENSE_UP_TO = 200   # free dofs below which a dense eigh is quicker than shift-invert
 
 
 def natural_frequencies(space: PlateSpace, n: int = 6) -> tuple[np.ndarray, np.ndarray]:
     """The n lowest circular frequencies ω (rad/s), ascending, and their mode shapes
-    (all dofs, one column each, M-normalised)."""
+    (all of skfem's dofs, one column each, M-normalised)."""
     check_space(space, "natural_frequencies")
     free = space.free_dofs
     if not len(free):
@@ -31,4 +31,4 @@ def natural_frequencies(space: PlateSpace, n: int = 6) -> tuple[np.ndarray, np.n
     order = np.argsort(np.abs(omega2))      # rigid modes' ω² ≈ ±1e-9: by the ω printed
     shapes = np.zeros((space.basis.N, n))
     shapes[free] = phi[:, order]
-    return np.sqrt(np.abs(omega2[order])), shapes
+    return np.sqrt(np.abs(omega2[order])), to_skfem(space, shapes.T).T

@@ -12,6 +12,7 @@ from skfem.helpers import dd, ddot, trace
 
 from ..checks import check_finite
 from ..errors import InputError
+from .frames import oblique_frames
 from .model import MeshPlate, Plate
 
 # the coordinate normal to each edge of the rectangle (0: x, 1: y)
@@ -21,7 +22,13 @@ NORMAL_AXIS = {"left": 0, "right": 0, "bottom": 1, "top": 1}
 @dataclass
 class PlateSpace:
     """What a solver needs: the matrices, which dofs are free, and at each mesh vertex its
-    coordinates and the index of its deflection dof w (where contact will act)."""
+    coordinates and the index of its deflection dof w (where contact will act).
+
+    The dofs are ũ, skfem's u = Q ũ: Q turns the gradient and Hessian dofs of the
+    vertices of oblique supported edges (Argyris) to frames where each edge condition is
+    one dof (plate.frames); Q is None elsewhere (ũ = u).  K, M, fixed_dofs and free_dofs
+    are ũ's; w is never turned (w_dofs are skfem's and ũ's); to_skfem and from_skfem
+    convert vectors."""
     plate: Plate
     basis: Basis
     K: sparse.csr_matrix
@@ -30,6 +37,25 @@ class PlateSpace:
     w_dofs: np.ndarray         # the dof of w at each vertex
     fixed_dofs: np.ndarray
     free_dofs: np.ndarray
+    Q: sparse.csr_matrix | None = None     # u = Q ũ (orthogonal); None: the identity
+
+
+def _apply(A, u: np.ndarray) -> np.ndarray:
+    """A (sparse) times each vector along u's last axis."""
+    u = np.asarray(u, dtype=float)
+    flat = u.reshape(-1, u.shape[-1]).T
+    return np.asarray(A @ flat).T.reshape(u.shape[:-1] + (A.shape[0],))
+
+
+def to_skfem(space: PlateSpace, u: np.ndarray) -> np.ndarray:
+    """skfem's dofs Q ũ of the space's dofs ũ (the last axis)."""
+    return u if space.Q is None else _apply(space.Q, u)
+
+
+def from_skfem(space: PlateSpace, f: np.ndarray) -> np.ndarray:
+    """The space's Qᵀ f of skfem's f (the last axis): a load vector, or dofs (Q is
+    orthogonal: Q⁻¹ = Qᵀ)."""
+    return f if space.Q is None else _apply(space.Q.T, f)
 
 
 def rectangle_mesh(plate: Plate):
@@ -196,8 +222,10 @@ def is_fixed(dofname: str, support: str, normal_axis: int | None) -> bool:
     (∂w/∂n = 0, w free: a line of symmetry) fixes those with exactly one.
 
     On an oblique edge the tangential and normal derivatives mix x and y, so only what
-    is a dof there is fixed: w (simply supported, clamped), w_x and w_y (clamped: the
-    whole gradient is 0) and u_n (clamped, sliding); the second derivatives stay free."""
+    is a dof there is fixed here: w (simply supported, clamped), w_x and w_y (clamped:
+    the whole gradient is 0) and u_n (clamped, sliding); Argyris's vertex gradient and
+    Hessian there then get the edge's full conditions in frames of their own
+    (plate.frames.oblique_frames, which replaces this choice of w_x, w_y)."""
     letters = dofname.partition("_")[2]
     if normal_axis is None:
         return {"clamped": letters in ("", "x", "y", "n"), "simply_supported": letters == "",
@@ -316,12 +344,14 @@ def plate_space(plate) -> PlateSpace:
         raise InputError(f"the mesh's cells are too small for the {plate.element} element "
                          f"(smallest {size:.3g} m: its matrices in global monomials are "
                          "singular there): use a coarser mesh") from None
-    fixed = fixed_dofs(basis, plate)
+    fixed, Q = oblique_frames(basis, support_groups(basis, plate), fixed_dofs(basis, plate))
+    K = stiffness_matrix(basis, plate.D, plate.nu)
+    M = mass_matrix(basis, plate.rho * plate.h)
+    if Q is not None:                   # (only then: the others' K and M keep their bits)
+        K, M = (Q.T @ K @ Q).tocsr(), (Q.T @ M @ Q).tocsr()
     return PlateSpace(
-        plate=plate, basis=basis,
-        K=stiffness_matrix(basis, plate.D, plate.nu),
-        M=mass_matrix(basis, plate.rho * plate.h),
+        plate=plate, basis=basis, K=K, M=M,
         vertices=mesh.p.copy(),
         w_dofs=basis.nodal_dofs[0].copy(),      # every element's first nodal dof is u = w
         fixed_dofs=fixed,
-        free_dofs=np.setdiff1d(np.arange(basis.N), fixed))
+        free_dofs=np.setdiff1d(np.arange(basis.N), fixed), Q=Q)

@@ -4,7 +4,7 @@ from scipy.sparse.linalg import spsolve
 
 from ..checks import check_finite
 from ..errors import InputError
-from .space import PlateSpace, check_space
+from .space import PlateSpace, check_space, from_skfem, to_skfem
 
 
 def static_deflection(space: PlateSpace, f: np.ndarray) -> np.ndarray:
@@ -26,16 +26,17 @@ def static_deflection(space: PlateSpace, f: np.ndarray) -> np.ndarray:
                          "bx + cy), so K w = f has no solution; clamp or simply support an "
                          "edge, or start from rest")
     u = np.zeros(space.basis.N)
-    u[free] = spsolve(space.K[free][:, free].tocsc(), f[free])
-    return u
+    u[free] = spsolve(space.K[free][:, free].tocsc(), from_skfem(space, f)[free])
+    return to_skfem(space, u)
 
 
 def rigid_motions(space: PlateSpace) -> int:
     """How many independent rigid motions w = a + bx + cy the supports leave the plate
     (0: K is positive definite on the free dofs): for each part of the mesh (cells joined
     by a vertex; a mesh file may hold two plates, one of them unsupported), the rank that
-    its fixed dofs' values of 1, x/L and y/L (:func:`rigid_dofs`) leave out of 3."""
-    R, part = rigid_dofs(space), dof_parts(space)
+    its fixed dofs' values of 1, x/L and y/L (:func:`rigid_dofs`, in the space's dofs)
+    leave out of 3."""
+    R, part = from_skfem(space, rigid_dofs(space).T).T, dof_parts(space)
     fixed = np.zeros(space.basis.N, dtype=bool)
     fixed[space.fixed_dofs] = True
     free = 0

@@ -7,8 +7,9 @@ in physical units (SI): M = ρh(w, v) in kg, K the bending form in N/m, b_k = �
 dofs are kept, ordered by their location along the plate's longer side, then its shorter
 side (``grid_order``): the banded Cholesky of the scheme then has half bandwidth about
 4(n_short + 2) for BFS (87 at 20 × 20, 167 at 40 × 40; docs/plate.md, Dynamics).
-``system.meta["dofs"]`` maps the system's unknowns back to skfem's dof numbers
-(:func:`full_dofs`).  A row of C is the deflection dof w at one vertex: contact is exact
+``system.meta["dofs"]`` maps the system's unknowns back to the space's dof numbers, and
+:func:`full_dofs` to skfem's dofs (through the space's Q where an oblique edge turns a
+vertex's dofs: plate.frames).  A row of C is the deflection dof w at one vertex: contact is exact
 there, as at the beam's nodes.
 """
 from __future__ import annotations
@@ -23,7 +24,7 @@ from scipy.sparse.linalg import spsolve
 from ..checks import check_bound, check_finite
 from ..errors import InputError
 from ..system import SemiDiscrete
-from .space import PlateSpace, check_space, load_vector, values_at
+from .space import PlateSpace, check_space, from_skfem, load_vector, to_skfem, values_at
 from .region import cells_in, region_load
 from .static import static_deflection
 
@@ -234,8 +235,9 @@ def half_bandwidth(A) -> int:
 
 
 def full_dofs(system: SemiDiscrete, u: np.ndarray) -> np.ndarray:
-    """The system's coefficients (last axis) as all of skfem's dofs (fixed ones 0):
-    for :func:`~skfem_beam.plate.deflection_at_vertex`, plotting, skfem's tools."""
+    """The system's coefficients (last axis) as all of skfem's dofs (fixed ones 0; the
+    space's Q applied, plate.frames): for :func:`~skfem_beam.plate.deflection_at_vertex`,
+    plotting, skfem's tools."""
     if not isinstance(system, SemiDiscrete) or system.meta.get("kind") != "plate":
         raise InputError(f"full_dofs needs a plate's system, plate_system(...), not "
                          f"{type(system).__name__}")
@@ -245,7 +247,7 @@ def full_dofs(system: SemiDiscrete, u: np.ndarray) -> np.ndarray:
                          f"{system.meta['dofs'].size} unknowns")
     full = np.zeros(u.shape[:-1] + (system.meta["space"].basis.N,))
     full[..., system.meta["dofs"]] = u
-    return full
+    return to_skfem(system.meta["space"], full)
 
 
 def _of(k: int) -> str:
@@ -289,12 +291,12 @@ def _initial(space, initial: PlateInitial, dofs: np.ndarray, M: sp.csr_matrix):
     """(u0, v0) on the system's unknowns."""
     u0 = np.zeros(dofs.size)
     if initial.static is not None:
-        u0 = static_deflection(space, initial.static.vector(space))[dofs]
+        u0 = from_skfem(space, static_deflection(space, initial.static.vector(space)))[dofs]
     v0 = np.zeros(dofs.size)
     if not (np.isscalar(initial.v0) and initial.v0 == 0.0):
         rho_h = space.plate.rho * space.plate.h      # M carries ρh: (ρh v0, φ) on the right
-        b = load_vector(space, lambda x, y: rho_h * values_at(initial.v0, x, y,
-                                                            "PlateInitial v0"))[dofs]
+        b = from_skfem(space, load_vector(space, lambda x, y: rho_h * values_at(
+            initial.v0, x, y, "PlateInitial v0")))[dofs]
         v0 = spsolve(M.tocsc(), b)
     return u0, v0
 
@@ -339,7 +341,7 @@ def plate_system(space: PlateSpace, obstacles=(), loads=(), initial: PlateInitia
     module docstring): ``obstacles`` a sequence of :class:`PlateObstacle`, ``loads`` of
     :class:`Pressure`, ``initial`` a :class:`PlateInitial` (None: at rest, flat),
     ``observe`` the vertices (x, y) whose w is observed (None: the one nearest the
-    centre).  ``meta``: "dofs" (skfem's dof of each unknown), "contact_vertices",
+    centre).  ``meta``: "dofs" (the space's dof of each unknown), "contact_vertices",
     "y_contact" (x_contact holds the x of each constrained vertex)."""
     _check_parts(space, obstacles, loads, initial)
     if observe is not None:
@@ -353,7 +355,7 @@ def plate_system(space: PlateSpace, obstacles=(), loads=(), initial: PlateInitia
     cols = position[space.w_dofs[vertices]]
     C = sp.csr_matrix((np.ones(cols.size), (np.arange(cols.size), cols)),
                       shape=(cols.size, dofs.size))
-    b = [load.vector(space)[dofs] for load in loads]
+    b = [from_skfem(space, load.vector(space))[dofs] for load in loads]
     u0, v0 = _initial(space, initial or PlateInitial(), dofs, M)
     y0 = C @ u0
     tol = 1e-12 * max(1.0, np.abs(u0).max(initial=0.0))

@@ -322,7 +322,8 @@ class Obstacles:
         check_bound("g1", g1, "x")
         check_bound("g2", g2, "x")
 
-        # its ends as nodes are (mesh check): a node a rounding below a was left out
+        # a node within the mesh check's tolerance of an end is that end (one a rounding
+        # below a was left free)
         tol = 1e-9 * max(1.0, abs(a), abs(b))
 
         def within(g, outside):         # g is evaluated where the span acts only

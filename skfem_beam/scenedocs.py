@@ -48,7 +48,12 @@ SECTION_DOCS = {
         'when it ends before T or the spline overshoots its rows), '
         '`random = {rms,'
         ' f_low, f_high, seed, count}` (band-limited, `count` sines), `psd = { table, seed, df }`, `value` '
-        '(constant), as for loads; `phase` with `amplitude`, `omega`; `lifting`; two planes: '
+        '(constant), as for loads; `phase` with `amplitude`, `omega`; `lifting = "auto"` '
+        '(default), `"paper"` (the first paper\'s h(x): a clamped end at x = 0, the other '
+        'free or pinned, a uniform beam without supports) or `"static"` (h the discrete '
+        'static shape with u = 1 at the moving support): how u is split into h(x)φ(t) and '
+        'the rest, which changes no result beyond round-off and the time discretisation; '
+        'two planes: '
         '`direction = [dy, dz]` (a direction: its length is not used)'
     ),
     'obstacles': (

@@ -47,6 +47,21 @@ def test_energy_identity_to_round_off(theta, e):
         assert w["damping"][-1] > 1e-4         # the θ-scheme's numerical dissipation
 
 
+@pytest.mark.parametrize("e", [0.0, 1.0])
+def test_the_contact_work_is_the_impulses_on_the_mean_velocity_for_any_theta(e):
+    """A rigid mass bouncing at θ = 1: the impulse p works on (v⁻ + v⁺)/2, −½(1 − e²)v²
+    per impact (0 for e = 1); the θ-scheme's share, p(θ − ½)Δv, is numerical dissipation
+    (work_damping).  Counted as pᵀv^θ it was +1 for e = 1 (energy put in by an elastic
+    stop) and 0 for e = 0."""
+    r = moreau_jean(rigid_mass(), 0.01, 0.2, theta=1.0, restitution=e)
+    w = r.work
+    assert r.impacts == 1
+    assert w["contact"][-1] == pytest.approx(-0.5 * (1 - e * e), abs=1e-14)
+    assert w["damping"][-1] >= 0.0
+    gap = r.energy - r.energy[0] + w["damping"] - w["input"] - w["contact"]
+    assert np.abs(gap).max() < 1e-14
+
+
 def test_elastic_impacts_conserve_energy():
     bar = scenes.periodic_rod(40)
     r = moreau_jean(bar_system(bar), 0.01, 12.0, restitution=1.0, frames=5)

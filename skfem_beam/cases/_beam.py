@@ -7,8 +7,8 @@ from pathlib import Path
 import numpy as np
 
 from .. import cli
-from ..errors import EXIT_UNSTABLE
 from ..chart_process import draw
+from ..errors import EXIT_UNSTABLE
 from ..output.charts import (energy_chart, orbit_chart, shape_chart, shapes,
                              trajectory_chart, wear_chart)
 from ..output.events import beam_impacts

@@ -162,8 +162,9 @@ EPISODES = ("of the run's time: each episode from its first state in contact to 
             "state off, one still open at the end to its last state (so one step less than "
             "the run's contact_fraction, which counts every step that ends in contact)")
 # impacts.csv's velocity, as summary.json's units say it
-VELOCITY = ("m/s: (yⁿ − yⁿ⁻¹)/Δt at the state before the first in contact (a free flight's "
-            "approach; after a one-step separation, that separation's, away from the obstacle)")
+VELOCITY = ("m/s: (yⁿ − yⁿ⁻¹)/Δt at the state before the first in contact, relative to the "
+            "obstacle where a support moves it (a free flight's approach; after a one-step "
+            "separation, that separation's, away from the obstacle)")
 # peak_force is unsigned, unlike the impulse and the contact_force column
 MAGNITUDE = " (the largest |force|: the impulse carries the sign)"
 # peak_force's unit under exact contact
@@ -247,6 +248,8 @@ def _write_impacts(folder, run, units, scale, sign, obstacles, last, wear) -> tu
         stats["units"].update(work_rate_units(units["force"] == "N", wear))
         if disk_rows(s).size:       # a round hole's event is its pair's (Run.impact_events)
             stats["units"]["impulse"] += "; a round hole's: Σ|force|Δt"
+            stats["units"]["velocity"] += ("; a round or broached hole's: its node's v only "
+                                           "(the approach is normal_velocity)")
     if friction:
         stats["units"].update({"slip": "m, Σ|u_t|Δt over the contact",
                                "friction_impulse": i + ", Σ|p_t| over the contact"})

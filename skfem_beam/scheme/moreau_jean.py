@@ -26,8 +26,10 @@ What it records, in the units of the other methods: ``energy`` ½vᵀMv + ½uᵀ
 velocity observers and frames use v itself; contact forces are p/Δt; penetration is
 measured on the positions as for every method (it penetrates O(Δt): the index set only
 switches the law on once the predicted gap closes); ``work``: with v^θ = (u^{n+1}−uⁿ)/Δt,
-input Δt f·v^θ, contact pᵀCv^θ, and "damping" Δt v^θᵀBv^θ plus the θ-scheme's numerical
-dissipation (θ − ½)(ΔvᵀMΔv + Δt² v^θᵀKv^θ), so energy − energy[0] + damping = input +
+input Δt f·v^θ, contact pᵀC(vⁿ + v^{n+1})/2 (the impulse's work on the mean velocity: 0 for
+e = 1, ≤ 0 below; pᵀCv^θ had put the scheme's dissipation there, +2.49 for θ = 1, e = 1
+on point_stops), and "damping" Δt v^θᵀBv^θ plus the θ-scheme's numerical dissipation
+(θ − ½)(ΔvᵀMΔv + Δt² v^θᵀKv^θ − pᵀCΔv), so energy − energy[0] + damping = input +
 contact holds to round-off.  θ = ½, e = 1 conserves the energy at impacts; e = 0 loses
 the constrained node's normal kinetic energy at each impact (O(h) on a mesh).
 Obstacles that move with a support are refused; runs checkpoint and resume bit for bit
@@ -212,6 +214,14 @@ def mj_steps(ops, st, out, n0, n1, inputs):
             st.y_prev[j] = st.y_cur[j]
         csr_product(ops.Cp, ops.Ci, ops.Cx, st.u_cur, st.y_cur)
         csr_product(ops.Cp, ops.Ci, ops.Cx, st.v, st.yv)
+        if th != 0.5:   # μ holds CΔv here: the impulse's θ share is numerical dissipation
+            csr_product(ops.Cp, ops.Ci, ops.Cx, st.dv, st.mu)
+            for j in range(m):
+                d = (th - 0.5) * st.p[j] * st.mu[j]
+                st.work[2] -= d
+                st.work[0] -= d
+                if st.rowwork.shape[0]:
+                    st.rowwork[j, 0] -= d
         for j in range(m):
             st.dy[j] += st.y_cur[j]
             st.work[2] += st.p[j] * (st.y_cur[j] - st.y_prev[j]) / dt

@@ -125,12 +125,14 @@ class HermiteSpace:
         return (self._Pall.T @ self._Am @ self._Pall).tocsr(), \
             (self._Pall.T @ self._As @ self._Pall).tocsr()
 
-    def point_rows(self, x, derivative: int = 0, full: bool = False) -> sp.csr_matrix:
+    def point_rows(self, x, derivative: int = 0, full: bool = False,
+                   side: str = "right") -> sp.csr_matrix:
         """Rows evaluating d^k u/dx^k (k = 0, 1, 2, 3) at abscissae x, from the closed-form
-        cubic Hermite shape functions on the element holding each x (the one to the right
-        of a node, the last one at x = L; the third derivative is constant on an element)."""
+        cubic Hermite shape functions on the element holding each x (the one to the
+        ``side`` of a node, right by default; the last one at x = L, the first at 0; the
+        third derivative is constant on an element, the second jumps at a node)."""
         x = np.atleast_1d(np.asarray(x, dtype=float))
-        e = np.clip(np.searchsorted(self.nodes, x, side="right") - 1, 0, self.J - 1)
+        e = np.clip(np.searchsorted(self.nodes, x, side=side) - 1, 0, self.J - 1)
         h = self.h[e]
         s = (x - self.nodes[e]) / h
         one = np.ones_like(s)

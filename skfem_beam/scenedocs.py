@@ -82,7 +82,9 @@ SECTION_DOCS = {
     ),
     'damping': (
         '`zeta`, `f1`, `f2` (Hz) or `alpha`, `alpha_K` (Rayleigh), or `modal = ζ` (every mode'
-        ' at ζ: a dense damping matrix); ζ is a ratio below 1 (0.02 for 2 %); bar: '
+        ' at ζ: a dense damping matrix); ζ is a ratio below 1 (0.02 for 2 %); under a '
+        '[motion] it damps the motion relative to the support\'s quasi-static one, whatever '
+        'the lifting; bar: '
         '`viscosity` (Kelvin–Voigt b)'
     ),
     'loads': (

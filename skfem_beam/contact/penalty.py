@@ -281,6 +281,13 @@ class Penalty(ContactLaw):
             raise InputError("round holes take one stiffness for all the obstacles")
         return np.concatenate([params, disk_params(step.disks), *rows])
 
+    def stored(self, step, y, lo, hi) -> float:
+        """The springs' energy at the values y of the rows (bounds lo, hi): ½κ(pen)² summed
+        (a run that starts on compressed springs gives it to the structure)."""
+        k_lo, k_hi, _, _ = self.row_params(step)
+        below, above = np.maximum(lo - y, 0.0), np.maximum(y - hi, 0.0)
+        return 0.5 * float(np.sum(k_lo * below * below) + np.sum(k_hi * above * above))
+
     def row_params(self, step):
         """(κ_lo, κ_hi, c_lo, c_hi) per constrained row: the stiffness and damping of the
         obstacle giving its g1 and its g2 (StepData.obstacle; one number: every row)."""

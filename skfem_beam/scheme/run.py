@@ -126,7 +126,8 @@ class Run:
         self.wall = 0.0
         self.status, self.message = "running", ""
         self.n = scheme.start(self.out)     # the last computed state
-        self.E1 = float(self.out.energy[0])
+        # the a-priori bound's start: the first state's energy, and a spring's compression
+        self.E1 = float(self.out.energy[0]) + getattr(scheme, "stored_energy", float)()
         self.watch = Watch(self)
         self.over_budget = -1       # the first saved state above the a-priori bound itself
         self._steps(self.n, self.n)         # the compiled loop loaded (or compiled) here

@@ -15,7 +15,7 @@ from ..output.plate import (UNITS, PlateFieldWriter, plate_cells,
                             plate_columns, plate_impacts, probe_name, vertex_w)
 from ..output.stream import Series, execute, prepare
 from ..spec import RunSpec
-from ._beam import stability_warning, warn_no_contact
+from ._beam import stability_warning, warn_no_contact, warn_rough_start
 
 
 def smallest_gap(system) -> float | None:
@@ -69,6 +69,7 @@ def run_plate_case(case: str, setup, spec: RunSpec) -> int:
     code = execute(run, spec.options, summary, series, plate_charts(case, system, setup))
     if code == 0:
         warn_no_contact(run, system)
+        warn_rough_start(run)
     return code
 
 

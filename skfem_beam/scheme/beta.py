@@ -383,9 +383,11 @@ class BetaScheme:
 
             A u¹ = M(u⁰ + Δt v⁰) − Δt²/2 (1−2β) K u⁰ + βΔt³ K v⁰ − Δt²/2 B v⁰ + Δt²/2 f(0),
 
-        second order and implicit in K: rough data (u0'' ≠ 0 at a free end) pump no
+        second order and implicit in K: a rough u⁰ (u0'' ≠ 0 at a free end) pumps no
         energy into the top modes (an explicit Taylor start gave ½E_β¹ = 855 instead of
-        166.8 for the energy-decay scene at J = 80, Δt = 1e-3).  Its contact is the
+        166.8 for the energy-decay scene at J = 80, Δt = 1e-3); a rough v⁰ does: a mode
+        with ωΔt ≫ 1 gets Δt·v⁰, not v⁰/ω, (ωΔt)² times its energy (the commands warn:
+        cases._beam.warn_rough_start).  Its contact is the
         chosen law's (a spring's force at u⁰ weighted ½(1−2β), see contact.penalty).
 
         It runs the loop's helpers and the law as the Python functions they are compiled
@@ -491,6 +493,12 @@ class BetaScheme:
             raise InputError("the initial state and load are too large for floating point: "
                              f"the first step's energy is {self.E1:g}")
         out.energy[0] = self.E1
+
+    def data_energy(self) -> float:
+        """½v⁰ᵀMv⁰ + ½u⁰ᵀKu⁰: the initial data's energy, which the start's ½E_β¹ should not
+        pass (cases._beam.warn_rough_start)."""
+        u0, v0 = self.system.u0.astype(float), self.system.v0.astype(float)
+        return 0.5 * float(v0 @ (self.system.M @ v0) + u0 @ (self.system.K @ u0))
 
     def stored_energy(self) -> float:
         """The penalty springs' energy at the start (0 for other laws): the a-priori energy

@@ -9,8 +9,8 @@ from .model import MeshPlate, Plate
 from .modes import natural_frequencies
 from .space import PlateSpace, load_vector, plate_space
 from .static import deflection_at_vertex, static_deflection
-from .system import PlateInitial, PlateObstacle, Pressure, full_dofs, plate_system
+from .system import PlateInitial, PlateObstacle, PointForce, Pressure, full_dofs, plate_system
 
 __all__ = ["Plate", "MeshPlate", "PlateSpace", "plate_space", "load_vector", "static_deflection",
            "deflection_at_vertex", "natural_frequencies", "plate_system", "PlateObstacle",
-           "Pressure", "PlateInitial", "full_dofs"]
+           "Pressure", "PointForce", "PlateInitial", "full_dofs"]

@@ -26,8 +26,10 @@ def natural_frequencies(space: PlateSpace, n: int = 6) -> tuple[np.ndarray, np.n
     if len(free) <= DENSE_UP_TO:
         omega2, phi = eigh(K.toarray(), M.toarray(), subset_by_index=[0, n - 1])
     else:
-        # shift-invert about 0 finds the eigenvalues nearest 0: the lowest ones
-        omega2, phi = eigsh(K.tocsc(), k=n, M=M.tocsc(), sigma=0.0, which="LM")
+        # shift-invert about 0 finds the eigenvalues nearest 0: the lowest ones; a fixed
+        # Lanczos start, so that a run started from a mode shape has the same bits each time
+        omega2, phi = eigsh(K.tocsc(), k=n, M=M.tocsc(), sigma=0.0, which="LM",
+                            v0=np.ones(len(free)))
     order = np.argsort(np.abs(omega2))      # rigid modes' ω² ≈ ±1e-9: by the ω printed
     shapes = np.zeros((space.basis.N, n))
     shapes[free] = phi[:, order]

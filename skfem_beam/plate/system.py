@@ -142,20 +142,7 @@ class Pressure:
 
     def __post_init__(self):
         _number_or_function("Pressure p", self.p, "Pa", "x, y")
-        if not callable(self.time):
-            raise InputError(f"Pressure time={self.time!r} must be a function of t")
-        t = np.array([0.0, 1e-3])       # the scheme calls a(t) on arrays of times
-        try:
-            a = np.asarray(self.time(t), dtype=float)
-        except Exception as e:          # noqa: BLE001  (the user's function)
-            a = e
-        if not isinstance(a, np.ndarray) or a.shape != t.shape:
-            got = f"shape {a.shape}" if isinstance(a, np.ndarray) else repr(a)
-            raise InputError(f"Pressure time must be vectorised: a(t) of an array of times "
-                             f"returns one number per time (e.g. lambda t: np.sin(50 * t)); "
-                             f"for t = [0, 0.001] it gave {got}")
-        if not np.isfinite(a).all():
-            raise InputError(f"Pressure time gives {a} at t = [0, 0.001]: a(t) must be finite")
+        _check_time("Pressure", self.time)
 
     def vector(self, space: PlateSpace) -> np.ndarray:
         """b = ∫ p·1_region φ (N), all dofs."""
@@ -170,18 +157,67 @@ class Pressure:
 
 
 @dataclass(frozen=True)
+class PointForce:
+    """A force P·a(t) (N, positive along w) at the mesh vertex (x, y): on the w dof there,
+    whose virtual work is P·w(x, y), exactly (a point that is not a vertex is refused,
+    naming the nearest)."""
+    x: float
+    y: float
+    P: float = 0.0
+    time: Callable = one
+
+    def __post_init__(self):
+        check_finite("PointForce P", self.P)
+        _check_time("PointForce", self.time)
+
+    def vector(self, space: PlateSpace) -> np.ndarray:
+        """b = P e_w at the vertex (N), all dofs."""
+        b = np.zeros(space.basis.N)
+        b[space.w_dofs[vertex_index(space, self.x, self.y)]] = float(self.P)
+        return b
+
+
+def _check_time(what: str, time) -> None:
+    """a(t) a vectorised, finite function of t (the scheme calls it on arrays of times)."""
+    if not callable(time):
+        raise InputError(f"{what} time={time!r} must be a function of t")
+    t = np.array([0.0, 1e-3])
+    try:
+        a = np.asarray(time(t), dtype=float)
+    except Exception as e:          # noqa: BLE001  (the user's function)
+        a = e
+    if not isinstance(a, np.ndarray) or a.shape != t.shape:
+        got = f"shape {a.shape}" if isinstance(a, np.ndarray) else repr(a)
+        raise InputError(f"{what} time must be vectorised: a(t) of an array of times "
+                         f"returns one number per time (e.g. lambda t: np.sin(50 * t)); "
+                         f"for t = [0, 0.001] it gave {got}")
+    if not np.isfinite(a).all():
+        raise InputError(f"{what} time gives {a} at t = [0, 0.001]: a(t) must be finite")
+
+
+@dataclass(frozen=True)
 class PlateInitial:
     """The start: w⁰ = the static deflection under ``static`` (a :class:`Pressure` whose
-    time function is ignored; None: w⁰ = 0), ẇ⁰ = ``v0`` (m/s, a number or a function of
-    x, y), L²-projected on the free dofs as the beam's v0 is."""
+    time function is ignored; None: w⁰ = 0), or the ``mode``-th mode shape scaled to
+    ``amplitude`` (m, its largest |w| at a vertex); ẇ⁰ = ``v0`` (m/s, a number or a
+    function of x, y), L²-projected on the free dofs as the beam's v0 is."""
     static: Pressure | None = None
     v0: float | Callable = 0.0
+    mode: int = 0
+    amplitude: float = 0.0
 
     def __post_init__(self):
         if self.static is not None and not isinstance(self.static, Pressure):
             raise InputError(f"PlateInitial static={self.static!r} must be a Pressure (the "
                              "load whose static deflection starts the run) or None")
         _number_or_function("PlateInitial v0", self.v0, "m/s", "x, y")
+        if isinstance(self.mode, bool) or not isinstance(self.mode, int) or self.mode < 0:
+            raise InputError(f"PlateInitial mode={self.mode!r} must be a whole number ≥ 1 "
+                             "(0: none)")
+        check_finite("PlateInitial amplitude", self.amplitude)
+        if self.mode and (self.static is not None or self.amplitude == 0.0):
+            raise InputError("PlateInitial mode starts from a mode shape: give its "
+                             "amplitude (m, ≠ 0) and no static load")
 
 
 def bounds_act(g1, g2) -> bool:
@@ -292,6 +328,12 @@ def _initial(space, initial: PlateInitial, dofs: np.ndarray, M: sp.csr_matrix):
     u0 = np.zeros(dofs.size)
     if initial.static is not None:
         u0 = from_skfem(space, static_deflection(space, initial.static.vector(space)))[dofs]
+    if initial.mode:
+        from .modes import natural_frequencies
+        shape = natural_frequencies(space, initial.mode)[1][:, initial.mode - 1]
+        w = shape[space.w_dofs]      # a mode's sign is the solver's: its peak made +
+        shape = shape * (initial.amplitude / w[np.argmax(np.abs(w))])
+        u0 = from_skfem(space, shape)[dofs]
     v0 = np.zeros(dofs.size)
     if not (np.isscalar(initial.v0) and initial.v0 == 0.0):
         rho_h = space.plate.rho * space.plate.h      # M carries ρh: (ρh v0, φ) on the right
@@ -326,22 +368,34 @@ def _observers(space, points, position) -> dict[str, np.ndarray]:
 def _check_parts(space, obstacles, loads, initial) -> None:
     """The arguments' kinds, each refused in one line saying what goes there."""
     check_space(space, "plate_system")
-    for name, items, kind in (("obstacles", obstacles, PlateObstacle),
-                              ("loads", loads, Pressure)):
-        if isinstance(items, (kind, str)) or not hasattr(items, "__iter__") \
+    for name, items, kind in (("obstacles", obstacles, (PlateObstacle,)),
+                              ("loads", loads, (Pressure, PointForce))):
+        if isinstance(items, (*kind, str)) or not hasattr(items, "__iter__") \
                 or not all(isinstance(i, kind) for i in items):
-            raise InputError(f"{name}= must be a list of {kind.__name__} (got {items!r})")
+            raise InputError(f"{name}= must be a list of "
+                             f"{' or '.join(k.__name__ for k in kind)} (got {items!r})")
     if initial is not None and not isinstance(initial, PlateInitial):
         raise InputError(f"initial={initial!r} must be a PlateInitial or None")
 
 
+def _damping_matrix(M, K, damping):
+    """B of a Damping on the plate's unknowns (None: no damping), as a beam's
+    (semidiscrete._operators)."""
+    if damping is None or damping.none:
+        return None
+    from ..semidiscrete import modal_damping
+    B = (damping.alpha * M + damping.alpha_K * K).tocsr()
+    return B + modal_damping(M, K, damping.modal) if damping.modal else B
+
+
 def plate_system(space: PlateSpace, obstacles=(), loads=(), initial: PlateInitial | None = None,
-                 observe=None) -> SemiDiscrete:
+                 observe=None, damping=None) -> SemiDiscrete:
     """The plate's :class:`~skfem_beam.system.SemiDiscrete` (physical units, see the
     module docstring): ``obstacles`` a sequence of :class:`PlateObstacle`, ``loads`` of
     :class:`Pressure`, ``initial`` a :class:`PlateInitial` (None: at rest, flat),
     ``observe`` the vertices (x, y) whose w is observed (None: the one nearest the
-    centre).  ``meta``: "dofs" (the space's dof of each unknown), "contact_vertices",
+    centre), ``damping`` a :class:`~skfem_beam.problem.Damping` (Rayleigh αM + α_K K in the
+    plate's M and K, and/or every mode at ζ; None: none).  ``meta``: "dofs" (the space's dof of each unknown), "contact_vertices",
     "y_contact" (x_contact holds the x of each constrained vertex)."""
     _check_parts(space, obstacles, loads, initial)
     if observe is not None:
@@ -366,6 +420,7 @@ def plate_system(space: PlateSpace, obstacles=(), loads=(), initial: PlateInitia
                          f"w0={y0[i]:.10g} not in [{lo[i]:.10g}, {hi[i]:.10g}]")
     return SemiDiscrete(
         M=M, K=K, C=C, lo=lo, hi=hi, x_contact=space.vertices[0, vertices].copy(),
+        B=_damping_matrix(M, K, damping),
         loads=np.column_stack(b) if b else np.zeros((dofs.size, 0)),
         load_time=[load.time for load in loads], u0=u0, v0=v0,
         observe=_observers(space, observe, position), space=space,

@@ -46,8 +46,9 @@ def _structure(data: dict) -> Beam:
                          section_of(data.get("section", {}), "section"))
 
 
-def _damping(data: dict) -> Damping:
-    """[damping]: its refusals name the section ("zeta=2 must be below 1" named none)."""
+def damping_of(data: dict) -> Damping:
+    """[damping] (a beam's or a plate's): its refusals name the section ("zeta=2 must be
+    below 1" named none)."""
     return in_section("damping", _damping_of, d=data.get("damping"))
 
 
@@ -160,7 +161,7 @@ def beam_problem(data: dict, reader: Tables) -> BeamProblem:
             element=mesh.get("element", "hermite"), nodes=mesh.get("nodes"),
             ends=(ends.get("left", "clamped"), ends.get("right", "free")),
             supports=_supports_x(data, beam.L),
-            damping=_damping(data), planes=plane_count(data), holes=holes,
+            damping=damping_of(data), planes=plane_count(data), holes=holes,
             second=Plane(load=load_w))
     except InputError as e:     # the mesh's refusals name its keys alone ("nodes must ...")
         text = str(e)

@@ -17,6 +17,7 @@ from ..contact import SOLVERS
 from ..errors import InputError
 from ..plate.model import EDGES, ELEMENTS, MAX_PLATE_SIDE, SUPPORTS, MeshPlate, Plate
 from ..scheme import Stepping
+from .beam import damping_of
 from .forcing import _time_function, warn_aliased, warn_tables
 from .parts import named_section, need, stepping_of, warn_implausible
 from .read import Parsed, Tables
@@ -263,16 +264,35 @@ def loads_of(data: dict, space, tables: Tables) -> list:
     out = []
     for i, d in enumerate(data.get("loads", [])):
         where = f"loads.{i}"
+        time = {k: d[k] for k in TIME_FORMS if k in d}
+        if "omega" in time and "amplitude" not in time:
+            time["amplitude"] = 1.0          # the pressure (or force) is the amplitude
+        a = _time_function(time, where, tables)
+        a = one if a is None else a
+        if "point" in d:
+            out.append(_point_force(d, where, space, a))
+            continue
         p = need(d, ("pressure",), where)["pressure"]
         region = _region(d["region"], space, f"{where}.region", area=True) \
             if "region" in d else None
-        time = {k: d[k] for k in TIME_FORMS if k in d}
-        if "omega" in time and "amplitude" not in time:
-            time["amplitude"] = 1.0          # the pressure is the amplitude
-        a = _time_function(time, where, tables)
-        p = check_finite(f"{where}.pressure", p)
-        out.append(Pressure(p, one if a is None else a, region))
+        out.append(Pressure(check_finite(f"{where}.pressure", p), a, region))
     return out
+
+
+def _point_force(d: dict, where: str, space, a):
+    """[[loads]] point = [x, y], force = P (N) × a(t): a PointForce at that vertex."""
+    from ..plate.system import PointForce, vertex_index
+    if "pressure" in d or "region" in d:
+        raise InputError(f"[{where}] a point force (point, force) takes no pressure or region")
+    point = d["point"]
+    if not isinstance(point, list) or len(point) != 2:
+        raise InputError(f"[{where}] point = [x, y] (m): got {point!r}")
+    P = check_finite(f"{where}.force", need(d, ("force",), where)["force"])
+    try:
+        vertex_index(space, *point)
+    except InputError as e:
+        raise InputError(f"[{where}] point: {e}") from None
+    return PointForce(float(point[0]), float(point[1]), P, a)
 
 
 def initial_of(data: dict):
@@ -282,7 +302,12 @@ def initial_of(data: dict):
     d = data.get("initial", {})
     static = Pressure(check_finite("[initial] static_pressure", d["static_pressure"])) \
         if "static_pressure" in d else None
-    return PlateInitial(static, check_finite("[initial] velocity", d.get("velocity", 0.0)))
+    if "mode" in d and ("amplitude" not in d or static is not None):
+        raise InputError("[initial] mode = k starts from the k-th mode shape: give its "
+                         "amplitude (m, the largest |w|) and no static_pressure")
+    mode = check_count("[initial] mode", d["mode"]) if "mode" in d else 0
+    return PlateInitial(static, check_finite("[initial] velocity", d.get("velocity", 0.0)),
+                        mode, check_finite("[initial] amplitude", d.get("amplitude", 0.0)))
 
 
 def probes_of(data: dict, space) -> tuple:
@@ -350,9 +375,9 @@ def plate_scene(parsed: Parsed, tables: Tables, dynamic: bool = True) -> PlateSc
     method = method_of(data)
     probes = probes_of(data, space)
     system = plate_system(space, obstacles_of(data, space), loads_of(data, space, tables),
-                          initial_of(data), probes)
+                          initial_of(data), probes, damping_of(data))
     out = {**OUTPUT_DEFAULTS, **data.get("output", {})}
-    stepping = stepping_of(t, out)
+    stepping = stepping_of(t, out, load_window=t.get("load_window", "forward"))
     warn_aliased(parsed.data, stepping.dt)
     warn_tables(tables, stepping.T)
     return PlateScene("plate", PlateSetup(space, system, probes), stepping, method, out,

@@ -93,6 +93,7 @@ SECTION = {"I": N, "A": N, "I_y": N, "I_z": N, "tube": {"outer_diameter": N, "wa
 MATERIAL = {"E": N, "rho": N}
 U0, V0 = {"x": NUMBERS, "u": NUMBERS}, {"x": NUMBERS, "v": NUMBERS}
 TIME_KEYS = {"dt": N, "T": N, "beta": N, "load_window": W}
+DAMPING_KEYS = {"zeta": N, "f1": N, "f2": N, "alpha": N, "alpha_K": N, "modal": N}
 OUTPUT = {"format": W, "save_every": N, "frames": N, "flush_every": N, "checkpoint_every": N,
           "probes": NUMBERS}
 OUTPUT_DEFAULTS = {"format": "both", "save_every": 1, "frames": 200, "flush_every": 20000,
@@ -147,7 +148,7 @@ BEAM_KEYS = {
     "obstacles": [{"x": N, "x_from": N, "x_to": N, "g1": G, "g2": G, "hole": HOLE,
                    "carried": B, "stiffness": N, "damping": N, "friction": N}],
     "wear": {"coefficient": N, "service_years": N, "land": N, "radius": N},
-    "damping": {"zeta": N, "f1": N, "f2": N, "alpha": N, "alpha_K": N, "modal": N},
+    "damping": DAMPING_KEYS,
     "loads": [{"x": N, "distributed": B, "per_mass": B, "gravity": N, "x_from": N, "x_to": N,
                "direction": NUMBERS, "rotating": {"amplitude": N, "omega": N,
                                                   "phase": N},
@@ -178,9 +179,10 @@ PLATE_KEYS = {
     "mesh": {"nx": N, "ny": N, "element": W},
     "obstacles": [{"g1": G_PLATE, "g2": G_PLATE, "region": NUMBERS,
                    "points": ListOf(NUMBERS)}],
-    "loads": [{"pressure": N, "region": NUMBERS, **TIME}],
-    "initial": {"static_pressure": N, "velocity": N},
-    "time": {"dt": N, "T": N, "beta": N},
+    "loads": [{"pressure": N, "region": NUMBERS, "point": NUMBERS, "force": N, **TIME}],
+    "initial": {"static_pressure": N, "velocity": N, "mode": N, "amplitude": N},
+    "damping": DAMPING_KEYS,
+    "time": TIME_KEYS,
     "contact": ContactKeys(law=W, solver=W, stiffness=N, restitution=N, theta=N),
     "output": {**OUTPUT, "probes": ListOf(NUMBERS)},
 }

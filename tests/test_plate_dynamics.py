@@ -252,7 +252,7 @@ def _boom(x, y):
     (lambda S: PlateObstacle(g2=np.nan), "PlateObstacle g2=nan must be a number"),
     (lambda S: plate_system(S, obstacles=None), "obstacles= must be a list"),
     (lambda S: PlateObstacle(g1=-1e-3, points=[(0.5, 0.5)], region=(0, 0.25, 0, 0.25)),
-     "give region or points, not both"),
+     "give one of region, disk, points"),
     (lambda S: Pressure(1e3, time=lambda t: np.nan * t), "Pressure time gives"),
     (lambda S: load_vector(S, lambda x, y: np.nan * x), "load_vector p is nan"),
 ])

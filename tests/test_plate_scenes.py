@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from conftest import assert_scene_refused, exit_code
-from skfem_beam import chart_process
+from skfem_beam import InputError, chart_process
 from skfem_beam.output.plate import MOMENTS, vertex_fields
 from skfem_beam.scenefile import example, load, modes_main, run_main
 from skfem_beam.scheme import drive
@@ -500,3 +500,51 @@ def test_a_plate_released_from_its_first_mode_follows_it(tmp_path):
     omega = natural_frequencies(scene.problem.space, 1)[0][0]
     assert w[0] == pytest.approx(1e-3, rel=1e-12)
     assert np.abs(w - 1e-3 * np.cos(omega * t)).max() < 2e-3 * 1e-3
+
+
+def test_an_obstacle_over_a_disk_acts_at_the_vertices_within_it(tmp_path, capsys):
+    """[[obstacles]] disk = [xc, yc, r] (issue 41's disk region; a plate had rectangles and
+    points only): the constrained vertices are those within r of the centre, counted
+    here from the grid; a disk off the plate or holding no vertex is one line."""
+    text = example("plate_rattling").read_text().replace(
+        "points = [[0.25, 0.25], [0.75, 0.25], [0.25, 0.75], [0.75, 0.75]]",
+        "disk = [0.5, 0.5, 0.3]")
+    (tmp_path / "d.toml").write_text(text)
+    system = load(tmp_path / "d.toml").problem.system
+    k = np.arange(9) / 8                                      # the 8 × 8 grid's vertices
+    X, Y = np.meshgrid(k, k)
+    inside = np.hypot(X - 0.5, Y - 0.5) <= 0.3
+    assert system.C.shape[0] == inside.sum() == 21
+    assert np.all(np.hypot(system.x_contact - 0.5, system.meta["y_contact"] - 0.5) <= 0.3)
+    for disk, line in (("[1.5, 0.5, 0.1]", "obstacles.0.disk centre = [1.5, 0.5] is off"),
+                       ("[0.55, 0.55, 0.01]", "obstacles.0.disk = [0.55, 0.55, 0.01] holds "
+                                               "no vertex of the mesh"),
+                       ("[0.5, 0.5, -0.1]", "obstacles.0.disk r=-0.1 must be > 0")):
+        (tmp_path / "bad.toml").write_text(text.replace("[0.5, 0.5, 0.3]", disk))
+        assert exit_code(run_main, [str(tmp_path / "bad.toml"), "--out",
+                                    str(tmp_path / "b")]) == 2
+        assert line in capsys.readouterr().err
+
+
+def test_render_plate_draws_the_deflected_plate_and_its_contacts(tmp_path):
+    """A plate's render (issue 41: "a render with the [render] extra"; the beam's refused
+    a plate): the frame with the most vertices in contact shows red points, the start's
+    none; a beam's Result is refused in one line."""
+    pytest.importorskip("pyvista")
+    from skfem_beam import solve
+    from skfem_beam.output.render_plate import render_plate
+    scene = load(example("plate_on_stops"))
+    r = solve(scene.problem.system, scene.stepping.dt, 0.004, frames=40)
+    contacts = (np.asarray(r.frames_force) != 0).sum(axis=1)
+    k = int(np.argmax(contacts))
+    assert contacts[k] > 0 and contacts[0] == 0
+
+    def red(img):
+        R, G, B = (img[..., i].astype(int) for i in range(3))
+        return ((R > G + 80) & (R > B + 80)).mean()
+    hit = render_plate(tmp_path / "hit.png", r, time=r.frames_t[k])
+    start = render_plate(tmp_path / "start.png", r, time=0.0)
+    assert (tmp_path / "hit.png").stat().st_size > 5000
+    assert hit.mean(axis=2).std() > 15 and red(hit) > 1e-4 and red(start) == 0.0
+    with pytest.raises(InputError, match="render_plate needs the Result of a plate's"):
+        render_plate(tmp_path / "x.png", object())

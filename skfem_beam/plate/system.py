@@ -94,12 +94,14 @@ def region_holds_plate(space, region) -> bool:
 @dataclass(frozen=True)
 class PlateObstacle:
     """g1(x, y) ≤ w ≤ g2(x, y) (numbers or vectorised functions of x, y; ±inf: one-sided)
-    at the vertices of ``region`` = (x0, x1, y0, y1) (None: the whole plate), or, with
-    ``points`` = ((x, y), ...), at those vertices only (point stops)."""
+    at the vertices of ``region`` = (x0, x1, y0, y1) (None: the whole plate), of ``disk`` =
+    (xc, yc, r) (those within r of the centre), or, with ``points`` = ((x, y), ...), at
+    those vertices only (point stops)."""
     g1: float | Callable = -np.inf
     g2: float | Callable = np.inf
     region: tuple[float, float, float, float] | None = None
     points: tuple[tuple[float, float], ...] | None = None
+    disk: tuple[float, float, float] | None = None
 
     def __post_init__(self):
         for name in ("g1", "g2"):
@@ -112,8 +114,14 @@ class PlateObstacle:
         if not bounds_act(self.g1, self.g2):
             raise InputError("PlateObstacle needs g1 and/or g2 (m): with neither it would "
                              "never act")
-        if self.points and self.region is not None:
-            raise InputError("PlateObstacle: give region or points, not both")
+        if sum(v is not None for v in (self.points, self.region, self.disk)) > 1:
+            raise InputError("PlateObstacle: give one of region, disk, points")
+        if self.disk is not None:
+            d = np.asarray(self.disk, dtype=float).ravel()
+            if d.size != 3 or not np.isfinite(d).all() or d[2] <= 0:
+                raise InputError(f"PlateObstacle disk={self.disk!r} must be (xc, yc, r) (m), "
+                                 "r > 0")
+            object.__setattr__(self, "disk", tuple(float(v) for v in d))
 
     def bounds(self, space: PlateSpace) -> tuple[np.ndarray, np.ndarray]:
         """(g1, g2) at every vertex of the mesh, ±inf where this obstacle does not act."""
@@ -121,6 +129,12 @@ class PlateObstacle:
         if self.points:
             where = np.zeros(x.size, dtype=bool)
             where[[vertex_index(space, px, py) for px, py in self.points]] = True
+        elif self.disk is not None:
+            xc, yc, r = self.disk
+            where = np.hypot(x - xc, y - yc) <= r + 1e-9 * space.plate.size
+            if not where.any():
+                raise InputError(f"PlateObstacle disk=({xc:g}, {yc:g}, {r:g}) holds no vertex "
+                                 "of the mesh")
         else:
             region = checked_region("PlateObstacle", self.region, space, area=False)
             where = region_vertices(space, region)
@@ -199,7 +213,7 @@ def _check_time(what: str, time) -> None:
 class PlateInitial:
     """The start: w⁰ = the static deflection under ``static`` (a :class:`Pressure` whose
     time function is ignored; None: w⁰ = 0), or the ``mode``-th mode shape scaled to
-    ``amplitude`` (m, its largest |w| at a vertex); ẇ⁰ = ``v0`` (m/s, a number or a
+    ``amplitude`` (m, its largest absolute w at a vertex); ẇ⁰ = ``v0`` (m/s, a number or a
     function of x, y), L²-projected on the free dofs as the beam's v0 is."""
     static: Pressure | None = None
     v0: float | Callable = 0.0

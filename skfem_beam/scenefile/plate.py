@@ -173,8 +173,8 @@ def obstacles_of(data: dict, space) -> list:
         where = f"obstacles.{i}"
         if "g1" not in d and "g2" not in d:
             raise InputError(f"[{where}] needs g1 and/or g2 (m)")
-        if "region" in d and "points" in d:
-            raise InputError(f"[{where}] give region or points, not both")
+        if sum(k in d for k in ("region", "points", "disk")) > 1:
+            raise InputError(f"[{where}] give one of region, disk, points")
         region = _region(d["region"], space, f"{where}.region", area=False) \
             if "region" in d else None
         points = tuple(_point(p, space.plate, f"{where}.points[{k}]")
@@ -188,8 +188,25 @@ def obstacles_of(data: dict, space) -> list:
         if not bounds_act(g1, g2):
             raise InputError(f"[{where}] g1 = -inf and g2 = inf: it would never act (give a "
                              "finite g1 and/or g2, m)")
-        out.append(PlateObstacle(g1, g2, region, points if "points" in d else None))
+        disk = _disk(d["disk"], space, f"{where}.disk") if "disk" in d else None
+        out.append(PlateObstacle(g1, g2, region, points if "points" in d else None, disk))
     return out
+
+
+def _disk(value, space, where: str) -> tuple:
+    """disk = [xc, yc, r] (m): its centre on the plate (in a mesh's bounding box), r > 0,
+    at least one vertex within it."""
+    from ..plate.system import PlateObstacle
+    if not isinstance(value, list) or len(value) != 3:
+        raise InputError(f"[{where.rsplit('.', 1)[0]}] disk = [xc, yc, r] (m): got {value!r}")
+    xc, yc = _point(value[:2], space.plate, f"{where} centre")
+    r = check_positive(f"{where} r", value[2])
+    try:        # its vertices: one at least
+        PlateObstacle(0.0, np.inf, disk=(xc, yc, r)).bounds(space)
+    except InputError:
+        raise InputError(f"{where} = [{xc:g}, {yc:g}, {r:g}] holds no vertex of the mesh: "
+                         "a larger r, or a vertex within it") from None
+    return xc, yc, r
 
 
 def _g(value, where: str):

@@ -177,7 +177,7 @@ PLATE_KEYS = {
     "material": {"E": N, "rho": N, "nu": N},
     "edges": Names("left", "right", "bottom", "top"),
     "mesh": {"nx": N, "ny": N, "element": W},
-    "obstacles": [{"g1": G_PLATE, "g2": G_PLATE, "region": NUMBERS,
+    "obstacles": [{"g1": G_PLATE, "g2": G_PLATE, "region": NUMBERS, "disk": NUMBERS,
                    "points": ListOf(NUMBERS)}],
     "loads": [{"pressure": N, "region": NUMBERS, "point": NUMBERS, "force": N, **TIME}],
     "initial": {"static_pressure": N, "velocity": N, "mode": N, "amplitude": N},

@@ -359,10 +359,11 @@ def test_a_start_that_overfills_the_stiff_modes_says_so(tmp_path, capsys, veloci
                     "or a smaller dt"] if warned else [])
 
 
-VELOCITY_START = """kind = "plate"
+# a simply supported a × b steel plate, n × n BFS: the scenes of the tests below
+SS_PLATE = """kind = "plate"
 [geometry]
-a = 1.0
-b = 0.6
+a = {a}
+b = {b}
 [section]
 thickness = 0.01
 [material]
@@ -375,9 +376,10 @@ right = "simply_supported"
 bottom = "simply_supported"
 top = "simply_supported"
 [mesh]
-nx = 8
-ny = 8
-[initial]
+nx = {n}
+ny = {n}
+"""
+VELOCITY_START = SS_PLATE.format(a=1.0, b=0.6, n=8) + """[initial]
 velocity = {velocity}
 [time]
 dt = 1e-4
@@ -439,25 +441,7 @@ def test_a_point_force_at_the_centre_deflects_the_plate_as_navier(tmp_path, caps
     a simply supported square, P = 1000 N at the centre, held by a heavy damping until at
     rest: w = 0.0116 P a²/D (Navier, ν = 0.3) to BFS's error at 16 × 16.  A point off the
     vertices is refused naming the nearest."""
-    text = """kind = "plate"
-[geometry]
-a = 1.0
-b = 1.0
-[section]
-thickness = 0.01
-[material]
-E = 2.1e11
-rho = 7850.0
-nu = 0.3
-[edges]
-left = "simply_supported"
-right = "simply_supported"
-bottom = "simply_supported"
-top = "simply_supported"
-[mesh]
-nx = 16
-ny = 16
-[[loads]]
+    text = SS_PLATE.format(a=1.0, b=1.0, n=16) + """[[loads]]
 point = [0.5, 0.5]
 force = 1000.0
 [damping]

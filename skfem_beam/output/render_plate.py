@@ -26,7 +26,7 @@ def render_plate(path, result, time=None, scale=None, window_size=(1200, 800)) -
                          f"with its frames in memory, not {type(result).__name__}")
     from ..plate.system import full_dofs
     space = system.meta["space"]
-    w = np.array([full_dofs(system, u)[space.w_dofs] for u in result.frames_u])
+    w = full_dofs(system, np.asarray(result.frames_u))[:, space.w_dofs]     # frames × vertices
     k = int(np.argmax(np.abs(w).max(axis=1))) if time is None else _frames(result, time)[0]
     size = max(space.plate.box[1] - space.plate.box[0], space.plate.box[3] - space.plate.box[2])
     peak = float(np.abs(w[k]).max())
@@ -34,7 +34,7 @@ def render_plate(path, result, time=None, scale=None, window_size=(1200, 800)) -
         scale = _nice(0.1 * size / peak) if peak > 0 else 1.0
     pv = _pyvista()
     mesh = space.basis.mesh
-    cells = np.asarray(mesh.t).T[:, :4 if mesh.t.shape[0] >= 4 else 3]
+    cells = np.asarray(mesh.t).T            # quads (BFS) or triangles
     faces = np.hstack([np.full((cells.shape[0], 1), cells.shape[1]), cells]).ravel()
     points = np.column_stack([mesh.p[0], mesh.p[1], scale * w[k]])
     surface = pv.PolyData(points, faces)

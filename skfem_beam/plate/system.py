@@ -130,11 +130,10 @@ class PlateObstacle:
             where = np.zeros(x.size, dtype=bool)
             where[[vertex_index(space, px, py) for px, py in self.points]] = True
         elif self.disk is not None:
-            xc, yc, r = self.disk
-            where = np.hypot(x - xc, y - yc) <= r + 1e-9 * space.plate.size
+            where = disk_vertices(space, self.disk)
             if not where.any():
-                raise InputError(f"PlateObstacle disk=({xc:g}, {yc:g}, {r:g}) holds no vertex "
-                                 "of the mesh")
+                raise InputError("PlateObstacle disk=({:g}, {:g}, {:g}) holds no vertex of "
+                                 "the mesh".format(*self.disk))
         else:
             region = checked_region("PlateObstacle", self.region, space, area=False)
             where = region_vertices(space, region)
@@ -256,6 +255,13 @@ def _number_or_function(name: str, value, unit: str, of: str) -> None:
     except InputError:
         raise InputError(f"{name}={value!r} must be a finite number ({unit}) or a function "
                          f"of {of}") from None
+
+
+def disk_vertices(space: PlateSpace, disk) -> np.ndarray:
+    """Which vertices lie within r of the centre of ``disk`` = (xc, yc, r)."""
+    xc, yc, r = disk
+    x, y = space.vertices
+    return np.hypot(x - xc, y - yc) <= r + 1e-9 * space.plate.size
 
 
 def vertex_index(space: PlateSpace, x: float, y: float) -> int:

@@ -196,16 +196,14 @@ def obstacles_of(data: dict, space) -> list:
 def _disk(value, space, where: str) -> tuple:
     """disk = [xc, yc, r] (m): its centre on the plate (in a mesh's bounding box), r > 0,
     at least one vertex within it."""
-    from ..plate.system import PlateObstacle
+    from ..plate.system import disk_vertices
     if not isinstance(value, list) or len(value) != 3:
         raise InputError(f"[{where.rsplit('.', 1)[0]}] disk = [xc, yc, r] (m): got {value!r}")
     xc, yc = _point(value[:2], space.plate, f"{where} centre")
     r = check_positive(f"{where} r", value[2])
-    try:        # its vertices: one at least
-        PlateObstacle(0.0, np.inf, disk=(xc, yc, r)).bounds(space)
-    except InputError:
+    if not disk_vertices(space, (xc, yc, r)).any():
         raise InputError(f"{where} = [{xc:g}, {yc:g}, {r:g}] holds no vertex of the mesh: "
-                         "a larger r, or a vertex within it") from None
+                         "a larger r, or a vertex within it")
     return xc, yc, r
 
 
@@ -301,15 +299,13 @@ def _point_force(d: dict, where: str, space, a):
     from ..plate.system import PointForce, vertex_index
     if "pressure" in d or "region" in d:
         raise InputError(f"[{where}] a point force (point, force) takes no pressure or region")
-    point = d["point"]
-    if not isinstance(point, list) or len(point) != 2:
-        raise InputError(f"[{where}] point = [x, y] (m): got {point!r}")
+    x, y = _point(d["point"], space.plate, f"{where}.point")
     P = check_finite(f"{where}.force", need(d, ("force",), where)["force"])
     try:
-        vertex_index(space, *point)
+        vertex_index(space, x, y)
     except InputError as e:
         raise InputError(f"[{where}] point: {e}") from None
-    return PointForce(float(point[0]), float(point[1]), P, a)
+    return PointForce(x, y, P, a)
 
 
 def initial_of(data: dict):

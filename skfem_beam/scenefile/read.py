@@ -156,7 +156,7 @@ class Tables:
     def __init__(self, base: Path, stored: dict, resumed: dict | None = None):
         self.base, self.stored, self.read, self.tmp = base, stored, {}, None
         self.resumed, self.meshes = resumed, {}
-        self.time_tables = []       # (key path, file, its last t) of each time table read
+        self.time_tables = []       # (key path, file, Table) of each time table read
 
     def mesh(self, name: str) -> Path:
         """The path of the mesh file ``name`` to read, its bytes kept in ``meshes``.  A

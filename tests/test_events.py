@@ -66,6 +66,11 @@ def test_bar_impulse_is_the_integral_of_R(tmp_path, flags):
         b = start[i + 1] if i + 1 < start.size else R.size + 1
         assert imp["impulse"][i] == pytest.approx(np.nansum(R[a - 1:b - 1]) * dt, rel=1e-12)
     A = 0.01 if "--A" in flags else 1.0
+    # the energy is in J where the cross-section is given, else per unit cross-section
+    if "--A" in flags:
+        assert s["energy_final_J"] == s["energy_final"] == pytest.approx(0.5 * A, rel=0.02)
+    else:
+        assert s["energy_final_J"] is None
     if flags in ([], ["--A", "0.01"]):             # the rigid obstacle, [DRF] Example 1
         # exact: the bar (ρL = 1, v0 = −1) rests on the obstacle for 2L/c = 2 s and
         # leaves with +1: impulse 2ρAL|v0|

@@ -254,6 +254,9 @@ def bar_charts(bar: Bar, series, exact, T: float):
             "T": min(run.n, series.n_steps) * run.dt, "steps": min(run.n, series.n_steps),
             "max_penetration": b.penetration, "max_nodal_violation": b.penetration,
             "energy_final": float(b.energy[-1] + b.load_potential[-1]),
+            # in J where the cross-section is given (--A), else per unit cross-section
+            "energy_final_J": float(b.energy[-1] + b.load_potential[-1])
+            if bar.A is not None else None,
             "impacts": len(periods), "contact_periods": periods,
             "exact_contact_periods": [(a, min(e, T)) for a, e in exact.contact_intervals()
                                       if a <= T] if exact is not None else None,

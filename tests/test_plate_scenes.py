@@ -532,3 +532,43 @@ def test_render_plate_draws_the_deflected_plate_and_its_contacts(tmp_path):
     assert hit.mean(axis=2).std() > 15 and red(hit) > 1e-4 and red(start) == 0.0
     with pytest.raises(InputError, match="render_plate needs the Result of a plate's"):
         render_plate(tmp_path / "x.png", object())
+
+
+def test_a_free_plate_at_rest_in_a_rigid_mode_stays_there(tmp_path):
+    """All edges free, [initial] mode = 1 (a rigid motion) at rest, no load: nothing moves.
+    Its ½E_β is ±1e-17 (round-off of sums whose terms are not zero) against an a-priori
+    bound of 0, which stopped the run as unstable at step 2 (exit 4) before the energy's
+    floor and bound took the terms' size (scheme.watch.Watch._terms)."""
+    text = """kind = "plate"
+[geometry]
+a = 1.0
+b = 0.5
+[section]
+thickness = 0.01
+[material]
+E = 2.1e11
+rho = 7850.0
+nu = 0.3
+[edges]
+left = "free"
+[mesh]
+nx = 8
+ny = 4
+[initial]
+mode = 1
+amplitude = 1e-4
+[time]
+dt = 1e-4
+T = 0.05
+[output]
+probes = [[0.0, 0.0]]
+"""
+    (tmp_path / "p.toml").write_text(text)
+    out = tmp_path / "run"
+    assert exit_code(run_main, [str(tmp_path / "p.toml"), "--format", "none", "--out",
+                                str(out)]) == 0
+    rows = list(csv.DictReader(open(out / "timeseries.csv")))
+    w = np.array([float(r["w_x0_y0"]) for r in rows])
+    assert len(rows) == 501 and abs(w[0]) > 1e-6
+    assert np.abs(w - w[0]).max() < 1e-10 * abs(w[0])       # round-off drift
+    assert max(abs(float(r["energy_J"])) for r in rows) < 1e-12

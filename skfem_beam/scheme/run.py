@@ -14,7 +14,7 @@ from ..stability import kappa_h, linear_limit
 from .kernels import (CONTACT_STEPS, EVENT_COLUMNS, EVENTS_FULL, EVENTS_WRITTEN, FAILED, ROW0,
                       STOPPED_AT, UNSTABLE, WORK_TERMS, Inputs, PythonLaw)
 from .stepping import Named, Result
-from .watch import Watch
+from .watch import ROUND_OFF, Watch
 
 FIRST_ROWS = 1 << 15      # saved rows allocated at first; more as a chunk needs them
 SAVED = ("obs", "obsv", "energy", "work", "lam", "resid", "bound")   # the saved series, by row
@@ -388,9 +388,9 @@ class Run:
 
     def _bound(self, work):
         """The a-priori energy bound after the load's work bound ``work`` (a number or an
-        array): growth_limit (√|E¹| + work)², + 1e-300; a product, not ``**``, so that a
-        float too large gives inf, not an OverflowError."""
-        root = math.sqrt(abs(self.E1)) + work
+        array): growth_limit (√(|E¹| + its round-off) + work)², + 1e-300; a product, not
+        ``**``, so that a float too large gives inf, not an OverflowError."""
+        root = math.sqrt(abs(self.E1) + ROUND_OFF * self.watch.scale) + work
         return self.stepping.growth_limit * root * root + 1e-300
 
     def _energy_bounds(self, G, n0: int, n1: int) -> float:

@@ -4,7 +4,8 @@ energies and its last state.
 
 - **A negative energy.**  ½E_β = ½δᵀ(M/Δt² + (β − ¼)K)δ + ½aᵀKa (δ = uⁿ − uⁿ⁻¹, a their
   mean) is positive for every state exactly when Δt is below the linear stability limit
-  (β < ¼) or always (β ≥ ¼), so a saved ½E_β below round-off's −1e-9 × the bound means the
+  (β < ¼) or always (β ≥ ¼), so a saved ½E_β below round-off's −1e-9 × the bound (plus
+  the start's terms, :meth:`Watch._terms`) means the
   unstable modes have taken over: just above the limit the tip jumped from stop to stop at
   every step while ½E_β went from 1.4 to −5,400, inside the loose a-priori bound.
 - **A growing kinetic energy under a constant ½E_β.**  Without contact the scheme conserves
@@ -28,7 +29,7 @@ import math
 
 import numpy as np
 
-ROUND_OFF = 1e-9       # of the bound: a saved energy below −ROUND_OFF × bound is negative
+ROUND_OFF = 1e-9       # a saved energy below −ROUND_OFF × (bound + Watch.scale) is negative
 R2_CAP = 0.99          # r² used at or beyond the linear limit (no bound there)
 
 
@@ -41,9 +42,21 @@ class Watch:
         self.run, self._kappa = run, None
         from ..spaces.redistribution import massless_rows
         self.definite = massless_rows(run.system.M).size == 0
+        self.scale = self._terms(run.u_cur, run.u_prev)
+
+    def _terms(self, u, u_prev) -> float:
+        """½E_β's sums taken term by term in absolute value at (u, u_prev): what its
+        round-off is relative to.  A state of zero energy that is not zero (a free plate at
+        rest in a rigid mode, no load: the bound is 0) computes ½E_β = ±1e-17, not 0."""
+        s, dt = self.run.system, self.run.dt
+        d, a = np.abs(u - u_prev), 0.5 * np.abs(u + u_prev)
+        M, K = abs(s.M), abs(s.K)
+        beta = 0.25 if self.run.beta is None else self.run.beta
+        return 0.5 * float(d @ (M @ d) / dt ** 2 + abs(beta - 0.25) * (d @ (K @ d))
+                           + a @ (K @ a))
 
     def bad(self, n0: int, n1: int, Ebound: float):
-        floor = -ROUND_OFF * Ebound
+        floor = -ROUND_OFF * (Ebound + self.scale)
         negative = self.negative(n0, n1)
         if negative is not None:
             return negative
@@ -60,7 +73,7 @@ class Watch:
         rows = np.arange(n0 // every + 1, n1 // every + 1)
         energy = np.asarray(run.energy[rows], dtype=float) if rows.size else rows
         bound = np.asarray(run.bound[rows], dtype=float) if rows.size else rows
-        below = np.flatnonzero(energy < -ROUND_OFF * bound)     # each row's own bound
+        below = np.flatnonzero(energy < -ROUND_OFF * (bound + self.scale))  # each row's own
         if not below.size:
             return None
         k = int(rows[below[0]]) * every

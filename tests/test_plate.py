@@ -153,6 +153,19 @@ def test_refusals_say_what_is_allowed():
         assert allowed in str(refused.value), refused.value
 
 
+def test_what_the_python_api_would_drop_is_refused():
+    """An amplitude without its mode (the plate started flat), a point force at a vertex
+    its edges hold (it went into the support): one line each, not a run that ignores
+    them."""
+    from skfem_beam.plate.system import PlateInitial, PointForce
+    with pytest.raises(InputError, match="amplitude=0.001 is a mode shape's"):
+        PlateInitial(amplitude=1e-3)
+    space = plate_space(Plate(nx=2, ny=2, edges={"left": "simply_supported"}))
+    with pytest.raises(InputError, match=r"\(0, 0.5\) is a vertex the edges hold"):
+        PointForce(0.0, 0.5, 10.0).vector(space)
+    assert PointForce(1.0, 0.5, 10.0).vector(space).sum() == 10.0     # the free edge
+
+
 def test_a_point_off_the_mesh_vertices_is_refused():
     space = plate_space(Plate(nx=2, ny=2))
     with pytest.raises(InputError, match=r"\(0.3, 0.5\)"):

@@ -572,3 +572,78 @@ probes = [[0.0, 0.0]]
     assert len(rows) == 501 and abs(w[0]) > 1e-6
     assert np.abs(w - w[0]).max() < 1e-10 * abs(w[0])       # round-off drift
     assert max(abs(float(r["energy_J"])) for r in rows) < 1e-12
+
+
+@pytest.mark.parametrize("extra, line", [
+    # dropped: the plate started flat, exit 0
+    ("[initial]\namplitude = 1e-3\n", "[initial] amplitude = 0.001 scales a mode shape: "
+                                      "give the mode too"),
+    # dropped: the force went into the support's fixed dof, nothing moved, exit 0
+    ("[[loads]]\npoint = [0.0, 0.5]\nforce = 1000.0\n",
+     "[loads.0] point: (0, 0.5) is a vertex the edges hold at w = 0"),
+    # named "n", the modes command's flag, not the key written
+    ("[initial]\nmode = 145\namplitude = 1e-3\n",
+     "[initial] mode=145 must be a whole number in [1, 144] (the plate has 144 free dofs)"),
+])
+def test_a_plate_value_that_would_be_dropped_is_one_line(tmp_path, capsys, extra, line):
+    text = SS_PLATE.format(a=1.0, b=1.0, n=6) + extra + "[time]\ndt = 1e-4\nT = 0.001\n"
+    assert_scene_refused(tmp_path, capsys, {"p.toml": text}, "p.toml", line)
+
+
+def test_the_nearest_vertex_named_can_be_pasted_back(tmp_path, capsys):
+    """A point off the vertices is refused naming the nearest in full: its %g form (six
+    digits, 0.333333 on a grid of thirds) was refused again when pasted back."""
+    base = SS_PLATE.format(a=1.0, b=1.0, n=3) + "[time]\ndt = 1e-4\nT = 0.001\n"
+    (tmp_path / "p.toml").write_text(base + "[[loads]]\npoint = [0.333333, 0.6]\nforce = 1.0\n")
+    assert exit_code(run_main, [str(tmp_path / "p.toml"), "--out", str(tmp_path / "a")]) == 2
+    err = capsys.readouterr().err
+    nearest = err.split("the nearest is (")[1].split(")")[0]
+    assert nearest == "0.3333333333333333, 0.6666666666666666"
+    (tmp_path / "q.toml").write_text(
+        base + f"[[loads]]\npoint = [{nearest}]\nforce = 1.0\n[output]\nformat = \"none\"\n")
+    assert exit_code(run_main, [str(tmp_path / "q.toml"), "--out", str(tmp_path / "b")]) == 0
+
+
+@pytest.mark.parametrize("e, warned", [(1.0, True), (0.0, False)])
+def test_a_contact_that_gains_energy_is_warned_of(tmp_path, capsys, e, warned):
+    """A free plate falling flat at 0.1 m/s onto an obstacle under every vertex: with
+    Newton restitution e = 1 at position level its energy went from 0.196 to 0.365 J in
+    one impact (the contact's work +0.169 J), a run like any other, its units saying the
+    contact's work is ≤ 0.  e = 0 loses energy, as exact contact does: no line."""
+    text = """kind = "plate"
+[geometry]
+a = 1.0
+b = 0.5
+[section]
+thickness = 0.01
+[material]
+E = 2.1e11
+rho = 7850.0
+nu = 0.3
+[edges]
+left = "free"
+[mesh]
+nx = 8
+ny = 4
+[[obstacles]]
+g1 = -1e-3
+[initial]
+velocity = -0.1
+[time]
+dt = 1e-4
+T = 0.02
+[output]
+format = "none"
+[contact]
+restitution = {e}
+""".format(e=e)
+    (tmp_path / "p.toml").write_text(text)
+    out = tmp_path / "run"
+    assert exit_code(run_main, [str(tmp_path / "p.toml"), "--out", str(out)]) == 0
+    rows = list(csv.DictReader(open(out / "timeseries.csv")))
+    gain = float(rows[-1]["work_contact_J"])
+    err = capsys.readouterr().err
+    line = f"warning: the contact with restitution e = 1 did {gain:.4g} J of work, " \
+           f"{100 * gain / float(rows[0]['energy_J']):.0f} % of the energy given to the plate"
+    assert (gain > 0.5 * float(rows[0]["energy_J"])) is warned
+    assert (line in err) is warned and ("restitution" in err) is warned

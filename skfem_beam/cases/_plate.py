@@ -10,12 +10,13 @@ import numpy as np
 
 from .. import cli
 from ..chart_process import draw
+from ..errors import EXIT_UNSTABLE
 from ..output.charts import deflection_chart, energy_chart, trajectory_chart
 from ..output.plate import (UNITS, PlateFieldWriter, plate_cells,
                             plate_columns, plate_impacts, probe_name, vertex_w)
 from ..output.stream import Series, execute, prepare
 from ..spec import RunSpec
-from ._beam import stability_warning, warn_no_contact, warn_rough_start
+from ._beam import stability_warning, warn_contact_gain, warn_no_contact, warn_rough_start
 
 
 def smallest_gap(system) -> float | None:
@@ -70,6 +71,8 @@ def run_plate_case(case: str, setup, spec: RunSpec) -> int:
     if code == 0:
         warn_no_contact(run, system)
         warn_rough_start(run)
+    if code in (0, EXIT_UNSTABLE):
+        warn_contact_gain(run, "plate")
     return code
 
 

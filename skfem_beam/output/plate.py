@@ -38,7 +38,8 @@ UNITS = {"t": "s", "w_x<X>_y<Y>": "m, the deflection at the probe vertex (X, Y)"
          "energy_J": "J, the scheme's discrete energy ½E_β",
          "work_damping_J": "J, work lost in damping (≥ 0), cumulative since t = 0",
          "work_input_J": "J, work of the pressures, cumulative since t = 0",
-         "work_contact_J": "J, work of the contact forces (≤ 0 for exact contact), "
+         "work_contact_J": "J, work of the contact forces (≤ 0 for exact contact with restitution "
+                           "e = 0; a gain, with e > 0 or springs, is warned of), "
                            "cumulative since t = 0",
          "energy_balance": "energy_J − energy_J[0] + work_damping_J = work_input_J + "
                            "work_contact_J (to round-off)",

@@ -9,6 +9,16 @@ from .space import PlateSpace, check_space, to_skfem
 DENSE_UP_TO = 200   # free dofs below which a dense eigh is quicker than shift-invert
 
 
+def check_mode_count(space: PlateSpace, n, name: str = "n") -> None:
+    """``n`` modes can be computed (``name``: as the caller's user wrote it), else one line."""
+    free = len(space.free_dofs)
+    most = free if free <= DENSE_UP_TO else free - 1        # eigsh: k < n
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 1 <= n <= most:
+        why = f"the plate has {free} free dofs" + (
+            ", and the sparse eigensolver finds at most one fewer modes" if most < free else "")
+        raise InputError(f"{name}={n!r} must be a whole number in [1, {most}] ({why})")
+
+
 def natural_frequencies(space: PlateSpace, n: int = 6) -> tuple[np.ndarray, np.ndarray]:
     """The n lowest circular frequencies ω (rad/s), ascending, and their mode shapes
     (all of skfem's dofs, one column each, M-normalised)."""
@@ -17,10 +27,7 @@ def natural_frequencies(space: PlateSpace, n: int = 6) -> tuple[np.ndarray, np.n
     if not len(free):
         raise InputError("the plate has no free dofs (its edges hold them all): it has no "
                          "modes; free an edge or refine the mesh")
-    most = len(free) if len(free) <= DENSE_UP_TO else len(free) - 1   # eigsh: k < n
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 1 <= n <= most:
-        raise InputError(f"n={n!r} must be a whole number in [1, {most}] (the plate has "
-                         f"{len(free)} free dofs)")
+    check_mode_count(space, n)
     K = space.K[free][:, free]
     M = space.M[free][:, free]
     if len(free) <= DENSE_UP_TO:

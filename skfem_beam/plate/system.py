@@ -186,8 +186,17 @@ class PointForce:
     def vector(self, space: PlateSpace) -> np.ndarray:
         """b = P e_w at the vertex (N), all dofs."""
         b = np.zeros(space.basis.N)
-        b[space.w_dofs[vertex_index(space, self.x, self.y)]] = float(self.P)
+        b[self.dof(space)] = float(self.P)
         return b
+
+    def dof(self, space: PlateSpace) -> int:
+        """The w dof of its vertex; one line when it is no vertex, or one the edges hold
+        at w = 0 (the force would go into the support and move nothing)."""
+        dof = int(space.w_dofs[vertex_index(space, self.x, self.y)])
+        if dof in space.fixed_dofs:
+            raise InputError(f"({self.x:g}, {self.y:g}) is a vertex the edges hold at w = 0: "
+                             "a force there goes into the support and moves nothing")
+        return dof
 
 
 def _check_time(what: str, time) -> None:
@@ -231,6 +240,9 @@ class PlateInitial:
         if self.mode and (self.static is not None or self.amplitude == 0.0):
             raise InputError("PlateInitial mode starts from a mode shape: give its "
                              "amplitude (m, ≠ 0) and no static load")
+        if self.amplitude != 0.0 and not self.mode:      # else dropped: the plate flat
+            raise InputError(f"PlateInitial amplitude={self.amplitude!r} is a mode shape's: "
+                             "give the mode too (mode = k ≥ 1)")
 
 
 def bounds_act(g1, g2) -> bool:
@@ -270,8 +282,11 @@ def vertex_index(space: PlateSpace, x: float, y: float) -> int:
     distance = np.hypot(space.vertices[0] - x, space.vertices[1] - y)
     nearest = int(np.argmin(distance))
     if distance[nearest] > 1e-9 * space.plate.size:
+        # the nearest written in full (repr): a user pastes it back, and its %g form, six
+        # digits, may be no vertex either (1/3 on a grid of thirds)
+        vx, vy = (float(v) for v in space.vertices[:, nearest])
         raise InputError(f"({x:g}, {y:g}) is not a vertex of the plate's mesh; the nearest "
-                         f"is ({space.vertices[0, nearest]:g}, {space.vertices[1, nearest]:g})")
+                         f"is ({vx!r}, {vy!r})")
     return nearest
 
 

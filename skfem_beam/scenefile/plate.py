@@ -296,16 +296,17 @@ def loads_of(data: dict, space, tables: Tables) -> list:
 
 def _point_force(d: dict, where: str, space, a):
     """[[loads]] point = [x, y], force = P (N) × a(t): a PointForce at that vertex."""
-    from ..plate.system import PointForce, vertex_index
+    from ..plate.system import PointForce
     if "pressure" in d or "region" in d:
         raise InputError(f"[{where}] a point force (point, force) takes no pressure or region")
     x, y = _point(d["point"], space.plate, f"{where}.point")
     P = check_finite(f"{where}.force", need(d, ("force",), where)["force"])
+    force = PointForce(x, y, P, a)
     try:
-        vertex_index(space, x, y)
+        force.dof(space)
     except InputError as e:
         raise InputError(f"[{where}] point: {e}") from None
-    return PointForce(x, y, P, a)
+    return force
 
 
 def initial_of(data: dict):
@@ -318,6 +319,9 @@ def initial_of(data: dict):
     if "mode" in d and ("amplitude" not in d or static is not None):
         raise InputError("[initial] mode = k starts from the k-th mode shape: give its "
                          "amplitude (m, the largest |w|) and no static_pressure")
+    if "amplitude" in d and "mode" not in d:
+        raise InputError(f"[initial] amplitude = {d['amplitude']!r} scales a mode shape: "
+                         "give the mode too (mode = k, k ≥ 1)")
     mode = check_count("[initial] mode", d["mode"]) if "mode" in d else 0
     return PlateInitial(static, check_finite("[initial] velocity", d.get("velocity", 0.0)),
                         mode, check_finite("[initial] amplitude", d.get("amplitude", 0.0)))
@@ -387,8 +391,12 @@ def plate_scene(parsed: Parsed, tables: Tables, dynamic: bool = True) -> PlateSc
         raise InputError("[time] needs dt and T (s)")
     method = method_of(data)
     probes = probes_of(data, space)
+    initial = initial_of(data)
+    if initial.mode:        # the mode the plate has, named as the file writes it
+        from ..plate.modes import check_mode_count
+        check_mode_count(space, initial.mode, "[initial] mode")
     system = plate_system(space, obstacles_of(data, space), loads_of(data, space, tables),
-                          initial_of(data), probes, damping_of(data))
+                          initial, probes, damping_of(data))
     out = {**OUTPUT_DEFAULTS, **data.get("output", {})}
     stepping = stepping_of(t, out, load_window=t.get("load_window", "forward"))
     warn_aliased(parsed.data, stepping.dt)

@@ -60,7 +60,6 @@ from ..parser import Parser, about
 from ..errors import InputError
 from ..scheme import solve
 from ..semidiscrete import add_probes, beam_system
-from ..spaces.redistribution import redistributed
 
 COURANTS = (0.04, 0.4)
 BENCHMARKS = {"rod": (scenes.periodic_rod, 12.0, 0.125),
@@ -197,14 +196,14 @@ def beam_system_of(scene: str, mass: str = "consistent"):
     """The scene's system (with the flat obstacles' probe), its mass redistributed if
     asked; None when the scene refuses a redistributed mass (contact along a span)."""
     make = BEAM_SCENES[scene][0]
-    system = beam_system(make())
+    try:
+        system = beam_system(make(), mass=mass)
+    except InputError:
+        if mass == "redistributed":
+            return None
+        raise
     if scene == "flat_obstacles":
         add_probes(system, [BEAM_PROBE])
-    if mass == "redistributed":
-        try:
-            system = redistributed(system)
-        except InputError:
-            return None
     return system
 
 

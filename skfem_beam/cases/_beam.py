@@ -21,7 +21,6 @@ from ..methods import MoreauJean, Penalty, summary_word
 from ..scheme.kernels import WORK_TERMS
 from ..spec import RunSpec
 from ..semidiscrete import PLANE_SUFFIXES, add_probes, beam_system
-from ..spaces.redistribution import redistributed
 from ..stability import kappa_h, linear_limit
 
 
@@ -31,10 +30,8 @@ def run_beam_case(case: str, problem, spec: RunSpec, stops=(), extra=None) -> in
     code.  ``extra(folder, data, run)`` may write more files into the output folder
     (``data``: the timeseries columns, from memory)."""
     prepare(spec.options)                         # fail before the run, not after it
-    system = beam_system(problem)
+    system = beam_system(problem, mass=spec.mass)
     add_probes(system, list(spec.probes))
-    if spec.mass == "redistributed":    # before the limit: κ_h of the dofs with mass
-        system = redistributed(system)
     run = spec.method.build(system, spec.stepping)      # its refusals before any warning
     # Moreau–Jean (θ ≥ ½) has no β and no limit: a scene file's [time] beta is not its
     kh, limit = stability_warning(system, spec.stepping.dt,

@@ -785,16 +785,18 @@ class BeamProblem:
         for i, xs in enumerate(sup):
             xs = check_finite(f"supports[{i}]", xs)
             if not 0.0 <= xs <= L:
-                raise InputError(f"support x={xs:g} lies outside [0, L={L:g}]")
+                raise InputError(f"supports[{i}] x={xs:g} must lie on the beam [0, L={L:g}]")
             for end, at in ((0, 0.0), (1, L)):
                 if abs(xs - at) <= 1e-9 * L:
                     e = self.ends[end]
                     fix = "clamped" if e == "sliding" else "pinned"
                     hint = "already fixed there" if END_CONDITIONS[e][0] else \
                         f"use ends.{('left', 'right')[end]}={fix!r} instead"
-                    raise InputError(f"support x={xs:g} is at the {e} end x={at:g} ({hint}); "
-                                     f"supports must lie strictly inside (0, L={L:g})")
+                    raise InputError(f"supports[{i}] x={xs:g} is at the {e} end x={at:g} "
+                                     f"({hint}); supports must lie strictly inside (0, "
+                                     f"L={L:g})")
             if any(abs(xs - o) <= 1e-9 * L for o in out):
-                raise InputError(f"two supports at x={xs:g}; each support needs its own node")
+                raise InputError(f"supports[{i}] x={xs:g}: two supports at x={xs:g}; each "
+                                 "support needs its own node")
             out.append(xs)
         return tuple(sorted(out))

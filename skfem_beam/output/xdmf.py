@@ -41,6 +41,9 @@ class XdmfSeries(meshio.xdmf.TimeSeriesWriter):
         self.h5_filename = str(self.filename.with_suffix(".h5"))
         # unlocked: ParaView opening a run in progress aborted on HDF5's lock
         self.h5_file = h5py.File(self.h5_filename, "w", locking=False)
+        # no times in the datasets' headers: the same run writes the same bytes
+        self._untimed = h5py.h5p.create(h5py.h5p.DATASET_CREATE)
+        self._untimed.set_obj_track_times(False)
         return self
 
     def __exit__(self, *_):
@@ -64,7 +67,7 @@ class XdmfSeries(meshio.xdmf.TimeSeriesWriter):
         self.data_counter += 1
         space = h5py.h5s.create_simple(data.shape)
         dataset = h5py.h5d.create(self.h5_file.id, name.encode(), h5py.h5t.py_create(data.dtype),
-                                  space)
+                                  space, dcpl=self._untimed)
         dataset.write(h5py.h5s.ALL, h5py.h5s.ALL, data)
         return f"{os.path.basename(self.h5_filename)}:/{name}"
 

@@ -44,7 +44,7 @@ def study(obstacle: str = "rigid", Ns=(25, 50, 100, 200, 400), courant: float = 
 
 def table(rows: list[dict], title: str = "") -> str:
     head = (f"{'N':>5} {'dt':>9} {'L2 u(0)':>10} {'rate':>5} {'L2 u(L)':>10} {'rate':>5} "
-            f"{'L2 R':>10} {'rate':>5} {'penetr.':>9} {'ΔE/E':>9} {'wall s':>7}")
+            f"{'L2 R':>10} {'rate':>5} {'penetr.':>9} {'E lost/E':>9} {'wall s':>7}")
     lines = [title, head] if title else [head]
     for r in rows:
         rate = lambda k: f"{r[f'rate_{k}']:5.2f}" if f"rate_{k}" in r else "    -"  # noqa: E731

@@ -351,7 +351,9 @@ def units(rho_S, system, friction: bool = False) -> dict:
                                  "default series observes the node of largest first-mode "
                                  "amplitude (add --probe X for others); ")
     terms = WORK_TERMS + (("friction",) if friction else ())
-    works = ("work lost in damping (≥ 0)", "work of the loads (the support's motion included)",
+    works = ("work lost in damping (≥ 0; with Moreau–Jean θ > ½ it also holds the scheme's "
+             "numerical dissipation at impacts, (θ − ½)pᵀCΔv, whose step may be < 0)",
+             "work of the loads (the support's motion included)",
              "work of the contact forces (≤ 0 for exact contact)",
              "work of Coulomb friction (≤ 0; Moreau–Jean's, taken on each step's "
              "displacement while Coulomb's law holds for v^{n+1}, may rise on a step whose "

@@ -534,12 +534,7 @@ def test_render_plate_draws_the_deflected_plate_and_its_contacts(tmp_path):
         render_plate(tmp_path / "x.png", object())
 
 
-def test_a_free_plate_at_rest_in_a_rigid_mode_stays_there(tmp_path):
-    """All edges free, [initial] mode = 1 (a rigid motion) at rest, no load: nothing moves.
-    Its ½E_β is ±1e-17 (round-off of sums whose terms are not zero) against an a-priori
-    bound of 0, which stopped the run as unstable at step 2 (exit 4) before the energy's
-    floor and bound took the terms' size (scheme.watch.Watch._terms)."""
-    text = """kind = "plate"
+FREE_PLATE = """kind = "plate"
 [geometry]
 a = 1.0
 b = 0.5
@@ -554,7 +549,15 @@ left = "free"
 [mesh]
 nx = 8
 ny = 4
-[initial]
+"""   # a free 1 × 0.5 m steel plate, 8 × 4 BFS
+
+
+def test_a_free_plate_at_rest_in_a_rigid_mode_stays_there(tmp_path):
+    """All edges free, [initial] mode = 1 (a rigid motion) at rest, no load: nothing moves.
+    Its ½E_β is ±1e-17 (round-off of sums whose terms are not zero) against an a-priori
+    bound of 0, which stopped the run as unstable at step 2 (exit 4) before the energy's
+    floor and bound took the terms' size (scheme.watch.Watch._terms)."""
+    text = FREE_PLATE + """[initial]
 mode = 1
 amplitude = 1e-4
 [time]
@@ -610,22 +613,7 @@ def test_a_contact_that_gains_energy_is_warned_of(tmp_path, capsys, e, warned):
     Newton restitution e = 1 at position level its energy went from 0.196 to 0.365 J in
     one impact (the contact's work +0.169 J), a run like any other, its units saying the
     contact's work is ≤ 0.  e = 0 loses energy, as exact contact does: no line."""
-    text = """kind = "plate"
-[geometry]
-a = 1.0
-b = 0.5
-[section]
-thickness = 0.01
-[material]
-E = 2.1e11
-rho = 7850.0
-nu = 0.3
-[edges]
-left = "free"
-[mesh]
-nx = 8
-ny = 4
-[[obstacles]]
+    text = FREE_PLATE + """[[obstacles]]
 g1 = -1e-3
 [initial]
 velocity = -0.1

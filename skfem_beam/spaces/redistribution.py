@@ -132,6 +132,9 @@ def rigid_modes(space) -> np.ndarray:
 def redistributed(system):
     """``system`` (a SemiDiscrete) with its mass redistributed away from the dofs its
     constraints act on.  Loads and moving supports are kept as they are (the run bounds
-    their work in the norm of (M + βΔt²K)⁻¹, see scheme.operators.load_norms)."""
+    their work in the norm of (M + βΔt²K)⁻¹, see scheme.operators.load_norms), and so is
+    its damping B: a bar's (Kelvin–Voigt, bA S) holds no mass; a beam's Rayleigh or modal
+    damping does, so a beam is built with ``beam_system(problem, mass="redistributed")``,
+    which makes B from the redistributed mass."""
     M = redistribute(system.M, system.K, massless_dofs(system.C), rigid_modes(system.space))
     return replace(system, M=M)

@@ -217,13 +217,15 @@ def two_plane_state(ops, nsgs: bool = False) -> dict:
             "fc": np.zeros((ops.pair.size if nsgs else 0, 6))}
 
 
-def start_positions(ops, st, u0, u1) -> None:
-    """State.pos of states 0 and 1 (two planes): each row's node (v, w) in u⁰ and u¹."""
+def start_positions(ops, st, u0, u1, phi=(0.0, 0.0)) -> None:
+    """State.pos of states 0 and 1 (two planes): each row's node (v, w) in u⁰ and u¹ less
+    its hole's centre at φ(t₀), φ(t₁) (``phi``: the bounds' motion; kernels.node_position)."""
     m = ops.Nc.shape[0]
     if m:
         nodes = scipy.sparse.csr_matrix((ops.Nx, ops.Ni, ops.Np), shape=(2 * m, u0.size))
-        st.pos[:, :2] = (nodes @ u0).reshape(m, 2)
-        st.pos[:, 2:] = (nodes @ u1).reshape(m, 2)
+        Nc = ops.Nc
+        st.pos[:, :2] = (nodes @ u0).reshape(m, 2) - (Nc[:, 0:2] + Nc[:, 2:4] * phi[0])
+        st.pos[:, 2:] = (nodes @ u1).reshape(m, 2) - (Nc[:, 0:2] + Nc[:, 2:4] * phi[1])
 
 
 def penetration_samples(system):
@@ -482,7 +484,8 @@ class BetaScheme:
     def _record_first_states(self, out) -> None:
         """States 0 and 1 (E_β needs two states: the energy saved at t = 0 is E_β¹)."""
         system, op, st, Orows = self.system, self.op, self.st, self.Orows
-        start_positions(self.ops, st, st.u_prev, st.u_cur)
+        start_positions(self.ops, st, st.u_prev, st.u_cur,
+                        self.motion(np.array([0.0, self.dt])))
         out.obs[0] = Orows @ st.u_prev
         out.obsv[0] = Orows @ system.v0
         rows_matvec(op.Kb.rows, op.Kb.cols, st.u_prev, st.Ku, 1.0, False)   # K uⁿ⁻¹: energy

@@ -518,13 +518,15 @@ def hole_kinematics(pair, Nc, nodes, at, force, tallies, step, dt, p, lands, fri
         if ev[0] == step + 1:            # a contact starts: where and how fast before it
             vx = (pos[j, 2] - pos[j, 0]) / dt
             vy = (pos[j, 3] - pos[j, 1]) / dt
+            # a face row's lower face (μ > 0: n·p ≥ lo) faces −n
+            sign = -1.0 if pair[j] == 0 and mu[j] > 0.0 else 1.0
             ev[6] = np.arctan2(p[3], p[2])
-            ev[7] = vx * nx + vy * ny
-            ev[8] = -vx * ny + vy * nx
+            ev[7] = sign * (vx * nx + vy * ny)
+            ev[8] = sign * (-vx * ny + vy * nx)
         f = abs(mu[j]) if pair[j] == 0 else abs(mu[j] * nx + mu[pair[j]] * ny)
         if f != 0.0:                     # |F_n||v_t|Δt, v_t of the central difference
-            vx = (p[0] - pos[j, 0]) / (2.0 * dt)
-            vy = (p[1] - pos[j, 1]) / (2.0 * dt)
+            vx = (p[2] - pos[j, 0]) / (2.0 * dt)
+            vy = (p[3] - pos[j, 1]) / (2.0 * dt)
             w = f / (dt * dt) * abs(-vx * ny + vy * nx) * dt
             if slid.size and not np.isnan(slid[j]):
                 w = slid[j]
@@ -540,8 +542,10 @@ def hole_kinematics(pair, Nc, nodes, at, force, tallies, step, dt, p, lands, fri
                 angle = np.arctan2(ny, nx)
             k = int((angle + np.pi) / (2.0 * np.pi) * SECTORS)
             sectors[j, min(max(k, 0), SECTORS - 1)] += w
+        # the offsets from the hole's centre, which a moving support may move: the slip
+        # and the approach are relative to the hole (the lifted u's were the frame's)
         pos[j, 0], pos[j, 1] = pos[j, 2], pos[j, 3]
-        pos[j, 2], pos[j, 3] = p[0], p[1]
+        pos[j, 2], pos[j, 3] = p[2], p[3]
 
 
 def switch(ops, column: int):

@@ -76,7 +76,9 @@ SECTION_DOCS = {
         'open lobes between them: a trefoil is 3, a quatrefoil 4), `{ '
         'polygon = [[y, z], ...] }` (convex, counter-clockwise), `{ faces = [[ny, nz, gap], '
         '...] }` (flat bars: n·(v, w) ≤ gap); `friction` (μ at this hole, overriding '
-        '`[contact] friction`). An obstacle at a node the ends or supports hold is refused '
+        '`[contact] friction`; refused at a hole that moves with the support\'s motion, '
+        'carried or fixed under a `[motion]`: its slip is not yet taken relative to the '
+        'hole). An obstacle at a node the ends or supports hold is refused '
         '(it would bound nothing). Bar: one, `x = 0` or `L`, `stiffness` for an elastic '
         'obstacle.'
     ),

@@ -648,3 +648,19 @@ def test_a_face_s_impact_velocity_points_into_the_face_touched(tmp_path):
         v = impacts["normal_velocity"][impacts["bound"] == bound]
         assert (v > 1e-9).sum() > 2 * (v < -1e-9).sum() > 0     # lower faces: 34 to 9,
         #                                                          were 9 to 34
+
+
+@pytest.mark.parametrize("carried", ["true", "false"])
+def test_friction_at_a_hole_that_moves_with_the_support_is_refused(tmp_path, capsys, carried):
+    """The friction law takes its slip from the lifted u, not relative to a hole that moves
+    in the run's frame (carried, or fixed while the support moves): a carried hole's
+    friction work was 3,700× apart between two liftings.  Refused, nothing written."""
+    from conftest import assert_refused
+    scene = tmp_path / "s.toml"
+    scene.write_text(SHAKEN.format(lifting="auto", carried=carried, hole="radius = 0.0004",
+                                   T=0.01) + "[contact]\nfriction = 0.3\n")
+    bad = tmp_path / "bad"
+    bad.mkdir()
+    assert_refused(run_main, [str(scene), "--out", str(bad / "run")],
+                   "Coulomb friction at the hole at x=0.5, which moves with the support's "
+                   "motion", capsys, bad)

@@ -127,6 +127,23 @@ def friction(system) -> bool:
     return bool(np.any(friction_of(system) > 0))
 
 
+def refuse_moving_friction(system) -> None:
+    """Coulomb friction at a hole that moves in the run's frame (carried by a moving
+    support, or fixed while the support moves: the lifted frame moves it) is refused: the
+    friction law takes its slip from the lifted u, not relative to the hole (a user's
+    carried hole: its friction work 3,700× apart between two liftings)."""
+    centres = getattr(system, "row_centres", None)      # per row [cy, cz, sy, sz]
+    if system.bound_motion is None or centres is None or not len(centres):
+        return
+    moving = (friction_of(system) > 0) & np.any(np.asarray(centres)[:, 2:4] != 0.0, axis=1)
+    if moving.any():
+        x = float(system.x_contact[int(np.argmax(moving))])
+        raise InputError(f"Coulomb friction at the hole at x={x:g}, which moves with the "
+                         "support's motion (carried, or fixed while the support moves), is "
+                         "not modelled: the friction law's slip is not taken relative to "
+                         "the moving hole; drop its friction, or the [motion]")
+
+
 def obstacle_rows(system) -> np.ndarray:
     """Per constrained row the obstacle giving its lo and its hi (SemiDiscrete.row_obstacle;
     unknown: (0, 2))."""
@@ -272,6 +289,7 @@ class BetaScheme:
             raise InputError(f"Coulomb friction needs law = round-hole-friction (or auto: "
                              f"exact contact at position level) or moreau-jean (a "
                              f"velocity-level law), not {law.name}")
+        refuse_moving_friction(system)
         if law.name not in ("round-hole", "round-hole-friction"):
             refuse_lands(system, f"the {law.name} law")
         if self.step.disks.size and not law.round_holes:

@@ -345,7 +345,8 @@ def _two_disks(degenerate: bool):
 
 
 @pytest.mark.parametrize("degenerate, scene, word", [
-    (True, DISK, "has no area (a repeated or collinear point"),
+    # a repeated point: two vertices at one place, a seam that was never merged
+    (True, DISK, "has 1 pair(s) of coincident vertices (the first at (0, 0)): a seam"),
     # the scene's static start of a plate whose second part nothing holds (energy_J[0] was
     # 9e13 J, then "unstable")
     (False, DISK, "a static deflection needs edges that hold the plate"),
@@ -363,3 +364,22 @@ def test_a_folder_named_as_the_mesh_file_is_called_a_folder(tmp_path):
     (tmp_path / "dir.msh").mkdir()
     with pytest.raises(InputError, match="dir.msh: a folder, not a file"):
         read_plate_mesh(tmp_path / "dir.msh")
+
+
+def test_what_a_mesh_file_would_lose_or_misplace_is_refused(tmp_path):
+    """From a user pass: quads beside the triangles were left out (holes in the plate: a
+    clamped square's ω₁ 564 → 1,024 rad/s); a disk moved 50 m off the origin lost digits
+    in Argyris' global monomials (ω₁ 33 % off), silently."""
+    import meshio
+    from skfem_beam.plate import MeshPlate, plate_space
+    d = disk(0.5, 2)
+    path = tmp_path / "mixed.vtu"
+    quad = np.array([[0, 1, 2, 3]])
+    meshio.write(path, meshio.Mesh(np.column_stack([d.points.T, 0 * d.points[0]]),
+                                   [("triangle", d.triangles.T), ("quad", quad)]))
+    with pytest.raises(InputError, match="holds 1 quad cell.s. beside its triangles"):
+        read_plate_mesh(path)
+    far = type(d)(d.points + [[50.0], [0.0]], d.triangles, d.boundaries)
+    with pytest.raises(InputError, match="lies up to 50.5 m from the origin, 50.5 times"):
+        plate_space(MeshPlate(far, edges={"rim": "clamped"}, element="argyris"))
+    plate_space(MeshPlate(far, edges={"rim": "clamped"}, element="morley"))   # its basis is local

@@ -79,13 +79,18 @@ def run_plate_case(case: str, setup, spec: RunSpec) -> int:
 def warn_thick(plate) -> None:
     """One warning line for a plate thicker than a tenth of its shorter side: Kirchhoff–Love
     is a thin-plate model (no shear deformation), which such a plate leaves behind (a 5 m
-    thickness on a 1 m plate ran without a word)."""
+    thickness on a 1 m plate ran without a word); or thinner than 1/10,000 of it, which a
+    mesh file in mm makes of a plate in m."""
     x0, x1, y0, y1 = plate.box
     side = min(x1 - x0, y1 - y0)
     if plate.h > 0.1 * side:
         cli.warn(f"[section] thickness={plate.h:g} m is {plate.h / side:.2g} of the plate's "
                  f"shorter side {side:g} m: Kirchhoff–Love plates are thin (up to about 1/10); "
                  "shear deformation, which it leaves out, matters at this thickness")
+    elif plate.h < 1e-4 * side:     # a mesh file in mm: a 1 km plate, w = 5e8 m, no word
+        cli.warn(f"[section] thickness={plate.h:g} m is {plate.h / side:.2g} of the plate's "
+                 f"shorter side {side:g} m: is the plate (its mesh file) in mm? Every length "
+                 "is in m")
 
 
 def plate_charts(case: str, system, setup):

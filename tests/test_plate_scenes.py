@@ -54,6 +54,17 @@ def test_shipped_plate_scene_writes_its_folder(shipped):
     assert summary["max_contact_force_N"] > 0
 
 
+def test_every_cell_is_counter_clockwise_seen_from_above(shipped):
+    """ParaView's normals point along +w: a BFS plate's quads were all clockwise and the
+    disk's triangles mixed (91 of 216), so normals and lighting flipped across it."""
+    _, out = shipped
+    mesh = meshio.read(out / "fields_vtu" / "fields_000000.vtu")
+    (block,) = mesh.cells
+    x, y = mesh.points[block.data, 0], mesh.points[block.data, 1]
+    area = np.sum(x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y, axis=1)
+    assert len(area) > 50 and np.all(area > 0)
+
+
 def test_exact_contact_at_every_vertex(shipped):
     _, out = shipped
     summary = json.loads((out / "summary.json").read_text())

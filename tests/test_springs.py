@@ -158,3 +158,17 @@ def test_two_plane_supports_report_their_springs(tmp_path, capsys):
     for e in springs:
         assert e["stiffness"] == 1e6 and e["impacts"] >= 10
         assert abs(e["max_force"] / e["max_deflection"] / 1e6 - 1) < 0.03, e
+
+
+def test_a_span_of_springs_deflects_as_much_as_its_springs(tmp_path):
+    """max_support_deflection is the springs' largest compression, at the nodes where they
+    act: on flat obstacles along a span it was max_penetration, the beam's between the
+    nodes too (1.4e-4 m against the springs' 7.4e-5)."""
+    from skfem_beam.cases import flat_obstacles
+    out = tmp_path / "run"
+    assert exit_code(flat_obstacles.main, ["--law", "penalty", "--stiffness", "1e6", "--dt",
+                                           "1e-4", "--format", "none", "--out", str(out)]) == 0
+    s = json.loads((out / "summary.json").read_text())
+    springs = max(e["max_deflection"] for e in s["spring_supports"])
+    assert s["max_support_deflection"] == springs == s["max_nodal_violation"] > 0
+    assert s["max_penetration"] > 1.5 * springs         # the beam between the nodes

@@ -134,11 +134,17 @@ def vertex_w(system, u) -> np.ndarray:
 
 
 def plate_cells(system) -> tuple[np.ndarray, list]:
-    """(the vertices padded to 3-D, [(cell type, cells)]) of the plate's mesh."""
+    """(the vertices padded to 3-D, [(cell type, cells)]) of the plate's mesh, each cell
+    counter-clockwise seen from +z, so that ParaView's normals point along +w (a BFS mesh's
+    quads were all clockwise, a mesh file's triangles as the file had them)."""
     mesh = system.meta["space"].basis.mesh
     points = np.column_stack([mesh.p[0], mesh.p[1], np.zeros(mesh.p.shape[1])])
     kind = "quad" if mesh.t.shape[0] == 4 else "triangle"
-    return points, [(kind, np.ascontiguousarray(mesh.t.T))]
+    cells = np.ascontiguousarray(mesh.t.T)
+    x, y = mesh.p[0][cells], mesh.p[1][cells]       # twice each cell's signed area
+    area = np.sum(x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y, axis=1)
+    cells[area < 0] = cells[area < 0, ::-1]
+    return points, [(kind, cells)]
 
 
 class PlateFieldWriter(FieldWriter):

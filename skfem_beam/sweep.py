@@ -212,6 +212,14 @@ def stepping_of(settings: dict, value: float):
 
 # ---------------------------------------------------------------- one task
 
+# the keys of every result run_value (or a failure) writes: a saved file without one of
+# them is run again (it was a KeyError or AttributeError traceback)
+RESULT_KEYS = {"param", "value", "settings", "omega", "dt", "steps_per_period",
+               "transient_periods", "k", "t", "tip_displacement", "tip_velocity", "impacts",
+               "impacts_per_period", "contact_fraction", "impacts_total", "damping", "status",
+               "message"}
+
+
 def run_value(settings: dict, value: float) -> dict:
     """One parameter value → its Poincaré section and impact statistics (a plain dict).
 
@@ -305,6 +313,8 @@ def load_run(out: Path, settings: dict, value: float) -> dict | None:
         result = json.loads(path.read_text())
     except (OSError, ValueError):
         return None   # unreadable: run it again
+    if not isinstance(result, dict) or not RESULT_KEYS <= result.keys():
+        return None   # not a whole result (an edited or damaged file): run it again
     same_settings(out, result.get("settings"), settings)
     return result
 

@@ -120,6 +120,20 @@ def test_overwrite_keeps_the_users_files_in_a_run_folder(tmp_path):
     assert sorted(q.name for q in out.iterdir()) == before
 
 
+@pytest.mark.parametrize("mine", ["fields_vtu/my_notes.txt", "runs/my_data.csv",
+                                  "orbit_mine.png"])
+def test_overwrite_keeps_the_users_files_in_the_run_s_own_subfolders(tmp_path, mine):
+    """A user's file inside the run's fields_vtu/ (or a runs/ folder), or named like its
+    charts (orbit_*.png): --overwrite deleted it with the run's files, exit 0."""
+    out = tmp_path / "run"
+    assert run(["--T", "0.01", "--out", str(out)]).returncode == 0
+    (out / mine).parent.mkdir(exist_ok=True)
+    (out / mine).write_text("mine")
+    p = run(["--T", "0.01", "--out", str(out), "--overwrite"])
+    assert p.returncode == 2 and mine in p.stderr and p.stderr.count("\n") == 1
+    assert (out / mine).read_text() == "mine"
+
+
 def test_unstable_run_exit_code_and_valid_files(tmp_path):
     out = tmp_path / "run"
     p = run(["--beta", "0.1", "--dt", "1.92e-5", "--T", "0.1", "--out", str(out)])

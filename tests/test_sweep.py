@@ -414,3 +414,23 @@ def test_more_workers_than_a_machine_runs_are_refused(tmp_path, capsys):
     assert_refused(main, ["--values", "8,10", "--workers", "1000", "--out",
                           str(tmp_path / "s" / "sweep")], "--workers 1000 on ", capsys,
                    tmp_path / "s")
+
+
+@pytest.mark.parametrize("damage", ["null", "no k"])
+def test_a_saved_result_that_is_not_whole_is_run_again(tmp_path, damage):
+    """A runs/<value>.json that parses but is not a whole result (an edited or damaged
+    file: null, or a key missing) ended the sweep in a traceback (AttributeError,
+    KeyError); it is run again, as an unreadable one is, to the same files."""
+    out = tmp_path / "sweep"
+    args = ["--values", "5,10", "--periods", "3", "--transient", "0.5", "--workers", "0",
+            "--no-progress", "--out", str(out)]
+    assert exit_code(main, args) == 0
+    path = out / "runs" / "omega=5.0.json"
+    whole = path.read_bytes()
+    result = json.loads(whole)
+    del result["k"]
+    path.write_text("null" if damage == "null" else json.dumps(result))
+    assert exit_code(main, args) == 0
+    again, first = json.loads(path.read_text()), json.loads(whole)
+    assert {**again, "timing": None} == {**first, "timing": None}      # run again: its times
+    assert json.loads((out / "sweep.json").read_text())["timing"]["values_resumed"] == 1

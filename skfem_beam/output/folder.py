@@ -49,8 +49,11 @@ WRITTEN = (
     "stability_map.csv", "stability_map.png",
     "beam_shapes.png", "contact_force.png", "deflection.png", "displacement.png",  # charts
     "energy.csv", "energy.png", "energy_decay.png", "probes.png", "tip_displacement.png",
-    "orbit_*.png", "wear_*.png",
+    "orbit_[0-9]*.png", "wear_[0-9]*.png",          # per support x: orbit_0.5.png
     *OURS, *TEMPORARIES)
+# what the run's own subfolders hold (a user's file in one was deleted with it)
+WRITTEN_INSIDE = {"fields_vtu": ("fields_[0-9]*.vtu", *TEMPORARIES),
+                  "runs": ("*=*.json", *TEMPORARIES)}
 NAME_MAX = 255          # bytes of one file name (Linux, macOS, Windows' NTFS in characters)
 OPENED: list[Path] = []         # the folders this process opened (for the interrupt line)
 
@@ -144,11 +147,18 @@ def check_clearable(out: Path) -> None:
 
 def _shown(out: Path, ours=None) -> str:
     """The first three names in ``out`` that are not ``ours`` (None: not a name a run
-    writes, WRITTEN), for an error line ("" when there is none)."""
-    def theirs(name: str) -> bool:
+    writes, WRITTEN, nor in the run's subfolders WRITTEN_INSIDE), for an error line (""
+    when there is none)."""
+    def theirs(name: str, written=WRITTEN) -> bool:
         return name not in ours if ours is not None else \
-            not any(fnmatch.fnmatch(name, w) for w in WRITTEN)
-    names = sorted(p.name for p in out.iterdir() if theirs(p.name))
+            not any(fnmatch.fnmatch(name, w) for w in written)
+    names = [p.name for p in out.iterdir() if theirs(p.name)]
+    if ours is None:
+        for sub, written in WRITTEN_INSIDE.items():
+            if (out / sub).is_dir() and not (out / sub).is_symlink():
+                names += [f"{sub}/{p.name}" for p in (out / sub).iterdir()
+                          if p.is_dir() or theirs(p.name, written)]
+    names = sorted(names)
     return ", ".join(names[:3]) + (", …" if len(names) > 3 else "")
 
 

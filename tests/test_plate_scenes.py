@@ -23,6 +23,15 @@ FILES = ("timeseries.csv", "impacts.csv", "summary.json", "fields.xdmf", "fields
          "fields.pvd", "probes.png", "energy.png", "deflection.png", "checkpoint.npz")
 
 
+def run_rows(tmp_path, text: str) -> list[dict]:
+    """The timeseries.csv rows of the scene ``text`` run without fields (exit 0 asserted)."""
+    (tmp_path / "p.toml").write_text(text)
+    out = tmp_path / "run"
+    assert exit_code(run_main, [str(tmp_path / "p.toml"), "--format", "none", "--out",
+                                str(out)]) == 0
+    return list(csv.DictReader(open(out / "timeseries.csv")))
+
+
 def columns(folder) -> dict:
     with open(folder / "timeseries.csv", newline="") as fh:
         rows = list(csv.reader(fh))
@@ -467,12 +476,8 @@ T = 0.5
 [output]
 probes = [[0.5, 0.5]]
 """
-    (tmp_path / "p.toml").write_text(text)
-    out = tmp_path / "run"
-    assert exit_code(run_main, [str(tmp_path / "p.toml"), "--format", "none", "--out",
-                                str(out)]) == 0
     D = 2.1e11 * 0.01**3 / (12 * (1 - 0.3**2))
-    w = float(list(csv.DictReader(open(out / "timeseries.csv")))[-1]["w_x0.5_y0.5"])
+    w = float(run_rows(tmp_path, text)[-1]["w_x0.5_y0.5"])
     assert w == pytest.approx(0.0116 * 1000.0 / D, rel=3e-3)     # Navier's 3 digits
     (tmp_path / "bad.toml").write_text(text.replace("point = [0.5, 0.5]", "point = [0.52, 0.5]"))
     assert exit_code(run_main, [str(tmp_path / "bad.toml"), "--out", str(tmp_path / "b")]) == 2
@@ -581,11 +586,7 @@ T = 0.05
 [output]
 probes = [[0.0, 0.0]]
 """
-    (tmp_path / "p.toml").write_text(text)
-    out = tmp_path / "run"
-    assert exit_code(run_main, [str(tmp_path / "p.toml"), "--format", "none", "--out",
-                                str(out)]) == 0
-    rows = list(csv.DictReader(open(out / "timeseries.csv")))
+    rows = run_rows(tmp_path, text)
     w = np.array([float(r["w_x0_y0"]) for r in rows])
     assert len(rows) == 501 and abs(w[0]) > 1e-6
     assert np.abs(w - w[0]).max() < 1e-10 * abs(w[0])       # round-off drift

@@ -384,7 +384,7 @@ def test_a_start_that_overfills_the_stiff_modes_says_so(tmp_path, capsys, veloci
 
 
 # a simply supported a × b steel plate, n × n BFS: the scenes of the tests below
-SS_PLATE = """kind = "plate"
+PLATE = """kind = "plate"
 [geometry]
 a = {a}
 b = {b}
@@ -395,7 +395,8 @@ E = 2.1e11
 rho = 7850.0
 nu = 0.3
 [edges]
-left = "simply_supported"
+"""     # a steel plate a × b, 1 cm thick: its edges follow
+SS_PLATE = PLATE + """left = "simply_supported"
 right = "simply_supported"
 bottom = "simply_supported"
 top = "simply_supported"
@@ -554,22 +555,7 @@ def test_render_plate_draws_the_deflected_plate_and_its_contacts(tmp_path):
         render_plate(tmp_path / "x.png", object())
 
 
-FREE_PLATE = """kind = "plate"
-[geometry]
-a = 1.0
-b = 0.5
-[section]
-thickness = 0.01
-[material]
-E = 2.1e11
-rho = 7850.0
-nu = 0.3
-[edges]
-left = "free"
-[mesh]
-nx = 8
-ny = 4
-"""   # a free 1 × 0.5 m steel plate, 8 × 4 BFS
+FREE_PLATE = PLATE.format(a=1.0, b=0.5) + 'left = "free"\n[mesh]\nnx = 8\nny = 4\n'   # 8 × 4 BFS
 
 
 def test_a_free_plate_at_rest_in_a_rigid_mode_stays_there(tmp_path):

@@ -105,7 +105,8 @@ def plate_charts(case: str, system, setup):
              title=f"{case}: deflection at the probes ({about})")
         draw(energy_chart, folder / "energy.png", t, data["energy_J"],
              title=f"{case}: discrete energy ½E_β ({about})",
-             work={k: data[f"work_{k}_J"] for k in run.work_terms}, joules=True)
+             work={k: data[f"work_{k}_J"] for k in run.work_terms}, joules=True,
+             support=False)         # a plate has no moving support
         if np.any(data["contact_force_N"]):
             draw(trajectory_chart, folder / "contact_force.png", t,
                  {"total contact force": data["contact_force_N"]},

@@ -97,14 +97,17 @@ def trajectory_chart(path, t, series: dict, stops=(), title="", ylabel="displace
         _frame(ax, "t (s)", ylabel, title, fontsize=9)
 
 
-def energy_chart(path, t, energy, title="discrete energy ½E_β", work=None, joules=False):
+def energy_chart(path, t, energy, title="discrete energy ½E_β", work=None, joules=False,
+                 support=True):
     """½E_β against t; with ``work`` (the cumulative "damping", "input", "contact" work,
     in the units of energy) also the terms of its balance that are not all zero
     (½E_β − ½E_β[0] + damping = input + contact).  ``joules``:
-    the values are in J (× ρS), else per unit mass per length (m³/s²)."""
+    the values are in J (× ρS), else per unit mass per length (m³/s²); ``support``: the
+    loads' work includes a moving support's (a beam's; a plate has none)."""
     series = {"½E_β" + ("" if joules else " (per unit mass per length)"): energy}
     if work is not None and any(np.any(w) for w in work.values()):
-        labels = {"input": "work of the loads (support motion included)",
+        labels = {"input": "work of the loads" + (" (support motion included)" if support
+                                                    else ""),
                   "damping": "work lost in damping", "contact": "work of the contact forces",
                   "friction": "work of friction"}
         series.update({labels[k]: w for k, w in work.items() if np.any(w)})

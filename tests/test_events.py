@@ -217,3 +217,12 @@ def test_impacts_csv_written_a_piece_at_a_time_is_the_same_file(tmp_path, monkey
                                             "--out", str(out)]) == 0
         files.append((out / "impacts.csv").read_bytes())
     assert files[0] == files[1] and files[0].count(b"\n") > 10
+
+
+@pytest.mark.parametrize("flags", [[], ["--law", "moreau-jean"]])
+def test_a_run_in_contact_from_its_start_has_a_contact_fraction_of_one(tmp_path, flags):
+    """The bar rests on its obstacle from t = 0 to 2L/c = 2 s: in contact at every state of
+    a 0.3 s run.  Its contact_fraction read 301/300 (the start's state counted over the
+    n − 1 steps from t₁), and a 10-step run 10/9."""
+    r = run_case(impacting_bar.main, tmp_path, "bar", flags + ["--T", "0.3"])
+    assert r.summary["contact_fraction"] == 1.0

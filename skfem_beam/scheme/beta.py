@@ -24,8 +24,8 @@ from ..contact.registry import Auto
 from ..contact.round_hole import disk_kinds
 from ..errors import InputError, SolverError
 from ..linalg import band_solve, row_layout_of, rows_matvec
-from .kernels import (FRICTION_COLUMN, IMPACT_FIELDS, NC_COLUMNS, SECTORS, TANGENT_COLUMN,
-                      Inputs, Ops, PythonLaw, Series, State, csr_product, energy_beta,
+from .kernels import (CONTACT_STEPS, FRICTION_COLUMN, IMPACT_FIELDS, NC_COLUMNS, SECTORS,
+                      TANGENT_COLUMN, Inputs, Ops, PythonLaw, Series, State, csr_product, energy_beta,
                       friction_of_ops, lands_of, move_bounds, record, run_steps,
                       run_steps_python, saved_series, track_impacts)
 from .operators import csr_arrays, load_norms, step_operators
@@ -433,14 +433,16 @@ class BetaScheme:
         st = self.st
         if not self.first_active.any():
             return
-        saved = st.active.copy(), st.dy.copy(), st.mu.copy()
+        saved = st.active.copy(), st.dy.copy(), st.mu.copy(), st.counters[CONTACT_STEPS]
         v0 = np.zeros(st.mu.size)
         csr_product(self.ops.Cp, self.ops.Ci, self.ops.Cx, self.system.v0.astype(float), v0)
         st.active[:] = self.first_active
         st.dy[:] = st.y_cur - st.y_prev + self.dt * v0   # (yⁿ − yⁿ⁻¹)/Δt reads v0 at n = 0
         st.mu[:] = 0.0
         uncompiled(track_impacts)(self.ops, st, out, 0, self.lands)
-        (st.active[:], st.dy[:], st.mu[:]) = saved
+        # the contact steps count states 2..n, over the n − 1 steps of t₁..tₙ (state 1
+        # counted too, a run in contact from its start read contact_fraction n/(n − 1))
+        (st.active[:], st.dy[:], st.mu[:], st.counters[CONTACT_STEPS]) = saved
 
     def _first_free_step(self, u0, first_params) -> np.ndarray:
         """The start step's solution without the law's multipliers (docstring of start)."""

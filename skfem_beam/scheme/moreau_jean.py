@@ -343,6 +343,10 @@ class MoreauJeanScheme:
         """Saved-series buffers (Moreau–Jean keeps its frames, whatever the run asked)."""
         return saved_series(self.system, self.Orows, rows, nframes)
 
+    # its loop computes state 1 and counts its contact: contact_fraction over n states (the
+    # β-scheme's start step counts none, over the n − 1 of states 2..n); n − 1 read 1.0033
+    counts_state_one = 1
+
     def start(self, out) -> int:
         """State 0 is the data themselves: recorded; the driver steps on from there."""
         start_positions(self.ops, self.st, self.st.u_cur, self.st.u_cur)

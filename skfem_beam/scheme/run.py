@@ -546,7 +546,8 @@ class Run:
             max_nodal_violation=float(max(st[0], 0.0)),
             max_penetration=float(max(st[1], st[2], st[0], 0.0)),
             max_penetration_below=float(st[1]), max_penetration_above=float(st[2]),
-            impacts=int(c[0]), contact_fraction=float(c[1]) / max(1, self.n - 1),
+            impacts=int(c[0]), contact_fraction=float(c[1]) / max(1, self.n - 1 + getattr(
+                self.scheme, "counts_state_one", 0)),
             qp_iterations=int(c[2]),
             work=Named({k: out.work[:keep, i] for i, k in enumerate(self.work_terms)}),
             impact_events=self.impact_events(), system=self.system,

@@ -234,7 +234,7 @@ def _plane(problem: BeamProblem, space, massless=None) -> _Plane:
     K = _stiffness(problem, space)
     M = space.M if massless is None else \
         redistribute(space.M, K, massless, rigid_modes(space))
-    B = _damping(problem, M, K)
+    B = damping_matrix(problem.damping, M, K)
     if B is not None and lift is not None and lift.kind == "paper":
         loads = np.column_stack([loads, _damping_relative(problem, space, B)])
         times = times + [problem.support.phi_d]
@@ -332,16 +332,15 @@ def _stiffness(problem: BeamProblem, space) -> sp.csr_matrix:
     return K
 
 
-def _damping(problem: BeamProblem, M, K):
-    """The damping of ``problem.damping`` (None: none) with the mass M the run uses: a
-    redistributed mass's massless rows get no mass-proportional or modal damping (built
-    from the consistent mass they did, and the Rayleigh ratios were off by up to 0.7 %
-    at J = 20)."""
-    damp = problem.damping
-    B = None if damp.none else (damp.alpha * M + damp.alpha_K * K).tocsr()
-    if damp.modal:
-        B = B + modal_damping(M, K, damp.modal)
-    return B
+def damping_matrix(damping, M, K):
+    """B of a :class:`~skfem_beam.problem.Damping` (None, or none: None) with the mass M
+    the run uses (a beam's or a plate's): a redistributed mass's massless rows get no
+    mass-proportional or modal damping (built from the consistent mass they did, and the
+    condensed modes' ratios were off by up to 2.5 % Rayleigh, 11 % modal, at J = 20)."""
+    if damping is None or damping.none:
+        return None
+    B = (damping.alpha * M + damping.alpha_K * K).tocsr()
+    return B + modal_damping(M, K, damping.modal) if damping.modal else B
 
 
 def _observation(problem: BeamProblem, space):
@@ -421,7 +420,7 @@ def _both_sides(space, problem, x: float):
     """At an inner node, where u'' (Hermite) or EI (a step) jumps, the row of the mean of
     both sides' EI(x)/EI_ref·u'', as the bending_moment field takes it (the probe read the
     right side's: 0.52 against the field's 0.39 N·m; on a B-spline beam's step −3.6
-    against −7.4 N·m); else None (a B-spline's u'' is continuous)."""
+    against −7.4 N·m); else None (a B-spline's u'' is continuous: only EI may jump)."""
     n = space.nodes
     j = int(np.argmin(np.abs(n - x)))
     if not 0 < j < len(n) - 1 or abs(n[j] - x) > 1e-12 * problem.beam.L:

@@ -360,7 +360,9 @@ def units(rho_S, system, friction: bool = False) -> dict:
     works = ("work lost in damping (≥ 0; with Moreau–Jean θ > ½ it also holds the scheme's "
              "numerical dissipation at impacts, (θ − ½)pᵀCΔv, whose step may be < 0)",
              "work of the loads (the support's motion included)",
-             "work of the contact forces (≤ 0 for exact contact)",
+             "work of the contact forces (≤ 0 for exact contact at obstacles at rest in the "
+             "lifted frame; a gain, with restitution e > 0, springs or a quasi-static "
+             "massless row, is warned of)",
              "work of Coulomb friction (≤ 0; Moreau–Jean's, taken on each step's "
              "displacement while Coulomb's law holds for v^{n+1}, may rise on a step whose "
              "slip reverses, its total ≤ 0)")

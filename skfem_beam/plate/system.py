@@ -413,16 +413,6 @@ def _check_parts(space, obstacles, loads, initial) -> None:
         raise InputError(f"initial={initial!r} must be a PlateInitial or None")
 
 
-def _damping_matrix(M, K, damping):
-    """B of a Damping on the plate's unknowns (None: no damping), as a beam's
-    (semidiscrete._operators)."""
-    if damping is None or damping.none:
-        return None
-    from ..semidiscrete import modal_damping
-    B = (damping.alpha * M + damping.alpha_K * K).tocsr()
-    return B + modal_damping(M, K, damping.modal) if damping.modal else B
-
-
 def plate_system(space: PlateSpace, obstacles=(), loads=(), initial: PlateInitial | None = None,
                  observe=None, damping=None) -> SemiDiscrete:
     """The plate's :class:`~skfem_beam.system.SemiDiscrete` (physical units, see the
@@ -432,6 +422,7 @@ def plate_system(space: PlateSpace, obstacles=(), loads=(), initial: PlateInitia
     centre), ``damping`` a :class:`~skfem_beam.problem.Damping` (Rayleigh αM + α_K K in the
     plate's M and K, and/or every mode at ζ; None: none).  ``meta``: "dofs" (the space's dof of each unknown), "contact_vertices",
     "y_contact" (x_contact holds the x of each constrained vertex)."""
+    from ..semidiscrete import damping_matrix       # as a beam's (Rayleigh and modal)
     _check_parts(space, obstacles, loads, initial)
     if observe is not None:
         observe = _points("plate_system observe", observe)
@@ -455,7 +446,7 @@ def plate_system(space: PlateSpace, obstacles=(), loads=(), initial: PlateInitia
                          f"w0={y0[i]:.10g} not in [{lo[i]:.10g}, {hi[i]:.10g}]")
     return SemiDiscrete(
         M=M, K=K, C=C, lo=lo, hi=hi, x_contact=space.vertices[0, vertices].copy(),
-        B=_damping_matrix(M, K, damping),
+        B=damping_matrix(damping, M, K),
         loads=np.column_stack(b) if b else np.zeros((dofs.size, 0)),
         load_time=[load.time for load in loads], u0=u0, v0=v0,
         observe=_observers(space, observe, position), space=space,

@@ -25,8 +25,8 @@ from ..contact.round_hole import disk_kinds
 from ..errors import InputError, SolverError
 from ..linalg import band_solve, row_layout_of, rows_matvec
 from .kernels import (CONTACT_STEPS, FRICTION_COLUMN, IMPACT_FIELDS, NC_COLUMNS, SECTORS,
-                      TANGENT_COLUMN, Inputs, Ops, PythonLaw, Series, State, csr_product, energy_beta,
-                      friction_of_ops, lands_of, move_bounds, record, run_steps,
+                      TANGENT_COLUMN, Inputs, Ops, PythonLaw, Series, State, csr_product,
+                      energy_beta, friction_of_ops, lands_of, move_bounds, record, run_steps,
                       run_steps_python, saved_series, track_impacts)
 from .operators import csr_arrays, load_norms, step_operators
 from .stepping import Stepping

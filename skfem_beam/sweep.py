@@ -212,12 +212,14 @@ def stepping_of(settings: dict, value: float):
 
 # ---------------------------------------------------------------- one task
 
-# the keys of every result run_value (or a failure) writes: a saved file without one of
-# them is run again (it was a KeyError or AttributeError traceback)
-RESULT_KEYS = {"param", "value", "settings", "omega", "dt", "steps_per_period",
-               "transient_periods", "k", "t", "tip_displacement", "tip_velocity", "impacts",
-               "impacts_per_period", "contact_fraction", "impacts_total", "damping", "status",
-               "message"}
+def blank_result(settings: dict, value: float, omega: float) -> dict:
+    """A value's result before its run: every key run_value and a failure write, in their
+    order (a saved file without one of them is run again: load_run)."""
+    return {"param": settings["param"], "value": float(value), "settings": settings,
+            "omega": omega, "dt": None, "steps_per_period": None, "transient_periods": None,
+            "k": [], "t": [], "tip_displacement": [], "tip_velocity": [], "impacts": None,
+            "impacts_per_period": None, "contact_fraction": None, "impacts_total": None,
+            "damping": None, "status": "success", "message": ""}
 
 
 def run_value(settings: dict, value: float) -> dict:
@@ -234,11 +236,8 @@ def run_value(settings: dict, value: float) -> dict:
     dt, spp, ntr, omega = section_plan(settings, value)
     periods = settings["periods"]
     n_total, n_trans = (ntr + periods) * spp, ntr * spp
-    out = {"param": settings["param"], "value": float(value), "settings": settings,
-           "omega": omega, "dt": dt, "steps_per_period": spp, "transient_periods": ntr,
-           "k": [], "t": [], "tip_displacement": [], "tip_velocity": [],
-           "impacts": None, "impacts_per_period": None, "contact_fraction": None,
-           "impacts_total": None, "damping": None, "status": "success", "message": ""}
+    out = {**blank_result(settings, value, omega), "dt": dt, "steps_per_period": spp,
+           "transient_periods": ntr}
     run = None
     try:
         out["damping"] = damping_of(settings, value)
@@ -313,7 +312,8 @@ def load_run(out: Path, settings: dict, value: float) -> dict | None:
         result = json.loads(path.read_text())
     except (OSError, ValueError):
         return None   # unreadable: run it again
-    if not isinstance(result, dict) or not RESULT_KEYS <= result.keys():
+    if not isinstance(result, dict) or not blank_result(settings, value, 0.0).keys() \
+            <= result.keys():
         return None   # not a whole result (an edited or damaged file): run it again
     same_settings(out, result.get("settings"), settings)
     return result
@@ -416,11 +416,8 @@ def assemble(out: Path, settings: dict, results: list[dict], extra: dict | None 
 def lost(settings: dict, value: float, error: BaseException, attempts: int) -> dict:
     """The result of a value whose task never finished (its worker died every time):
     "failed", not saved in runs/, so that the same command run again retries it."""
-    return {"param": settings["param"], "value": float(value), "settings": settings,
-            "omega": section_plan(settings, value)[3], "dt": None, "steps_per_period": None,
-            "transient_periods": None, "k": [], "t": [], "tip_displacement": [],
-            "tip_velocity": [], "impacts": None, "impacts_per_period": None,
-            "contact_fraction": None, "impacts_total": None, "damping": None, "status": "failed",
+    return {**blank_result(settings, value, section_plan(settings, value)[3]),
+            "status": "failed",
             "message": f"{type(error).__name__} after {attempts} attempts: {error}",
             "timing": {"task_s": 0.0, "task_cpu_s": 0.0, "time_loop_s": 0.0, "steps": 0,
                        "pid": None}}

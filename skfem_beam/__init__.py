@@ -6,6 +6,9 @@ if _sys.argv[:1] == ["-m"]:   # a command starting (runpy is importing it): Ctrl
     command_starting()                        # until the command's own handlers take over
 from ._startup import numba_cache as _numba_cache
 _numba_cache()      # before the kernels' modules: numba needs a writable cache folder
+if _sys.argv[:1] == ["-m"]:   # a command compiles without two of numba's idle costs
+    from . import numba_speed as _numba_speed
+    _numba_speed.apply()
 from .errors import InputError, SolverError
 from .modes import Modes, modes
 from .problem import (Beam, BeamProblem, Damping, InitialState, Load, Material, Obstacles,

@@ -5,8 +5,9 @@ The child is a new interpreter.  The packages above the kernels' modules are ent
 its ``sys.modules`` bare (their folder, not their ``__init__``), so that it imports what
 those modules need (numpy, scipy.sparse, numba), not the package's whole API (0.5 → 0.25 s,
 on a core that this process's compile shares).  It ends without the interpreter's teardown
-(0.3 s with numba loaded), which a run waiting for it would wait for too, and it collects
-garbage as seldom as the process that started it (a command's ``_startup.GC_THRESHOLD``).
+(0.3 s with numba loaded), which a run waiting for it would wait for too, it collects
+garbage as seldom as the process that started it (a command's ``_startup.GC_THRESHOLD``),
+and its numba compiles without two idle costs, as a command's does (``numba_speed``).
 A kernel it has compiled is loaded from the cache by this process when its own compile
 reaches it; one it has not compiled yet is compiled here, as without the child (the same
 code either way).
@@ -22,17 +23,19 @@ import sys
 
 _CHILD = """
 import gc, importlib, os, pickle, sys, types
-packages, jobs, threshold = pickle.load(sys.stdin.buffer)
+packages, jobs, threshold, speed = pickle.load(sys.stdin.buffer)
 gc.set_threshold(*threshold)
 for package, folder in packages.items():
     sys.modules[package] = types.ModuleType(package)
     sys.modules[package].__path__ = [folder]
+importlib.import_module(speed).apply()
 for module, name, sig in jobs:
     kernel = getattr(importlib.import_module(module), name)
     kernel.cfunc if sig is None else kernel.compile(sig)
 os._exit(0)
 """
 _CHILDREN = []
+SPEED = __name__.rpartition(".")[0] + ".numba_speed"    # applied in the child (numba_speed)
 
 
 def cores() -> int:
@@ -66,7 +69,7 @@ def start(kernels) -> subprocess.Popen | None:
         return None
     _CHILDREN.append(child)
     try:
-        child.stdin.write(pickle.dumps((packages, jobs, gc.get_threshold())))
+        child.stdin.write(pickle.dumps((packages, jobs, gc.get_threshold(), SPEED)))
         child.stdin.close()
     except OSError:         # it died: what it was to compile is compiled here
         pass

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 import skfem_beam
-from skfem_beam import beam_system
+from skfem_beam import beam_system, numba_speed
 from skfem_beam.contact import resolve
 from skfem_beam.scenefile import example, load
 
@@ -101,3 +101,60 @@ def test_the_law_sent_aside_early_is_the_one_its_setup_picks(name, early):
     else:
         assert [k.func.__name__ for k in picked] == [early]
         assert picked == (scheme.law.kernel,)
+
+
+NUMBA_SPEED_CHILD = """
+import sys
+from skfem_beam import aside, beam_system, numba_speed, solve
+from skfem_beam.contact.round_hole import broached_hole_kernel
+from skfem_beam.scenefile import example, load
+from skfem_beam.scheme.kernels import run_steps
+if sys.argv[1] == "1":
+    numba_speed.apply()
+aside.cores = lambda: 1         # the law compiled here, where its LLVM IR can be read
+scene = load(example("tube_trefoil_holes.toml"))
+r = solve(beam_system(scene.problem), scene.stepping.dt, 20 * scene.stepping.dt)
+with open(sys.argv[2], "w") as out:
+    out.write(r.solver + "\\n" + "".join(run_steps.inspect_llvm().values()))
+    out.write(broached_hole_kernel.cfunc.inspect_llvm())
+from numba.core import inline_closurecall, targetconfig
+print(type(inline_closurecall.copy).__name__, targetconfig.TargetConfig.__eq__.__name__)
+"""
+
+
+def test_numba_speed_compiles_the_same_code(tmp_path):
+    """numba_speed removes two of numba's costs, not what numba makes: the LLVM IR of the
+    loop (every inlined helper) and of a broached hole's law (its overloads and helpers)
+    is the same text with and without it, compiled afresh in two processes."""
+    texts = []
+    for speed in ("0", "1"):
+        cache = tmp_path / f"cache{speed}"
+        p = subprocess.run([sys.executable, "-c", NUMBA_SPEED_CHILD, speed,
+                            str(tmp_path / f"ir{speed}.ll")],
+                           env={**os.environ, "NUMBA_CACHE_DIR": str(cache)},
+                           capture_output=True, text=True)
+        assert p.returncode == 0, p.stderr
+        assert p.stdout.split() == (["SimpleNamespace", "quick_equal"] if speed == "1" else
+                                    ["module", "__eq__"]), p.stdout
+        texts.append((tmp_path / f"ir{speed}.ll").read_text())
+    assert texts[0].startswith("round-hole\n") and len(texts[0]) > 500_000, texts[0][:200]
+    assert texts[0] == texts[1]
+
+
+def test_numba_speed_flags_compare_as_numba_does():
+    """The flags' quicker equality and hash give numba's answers (what its typing cache
+    finds depends on them), for flags set alike, apart, and to a default's value."""
+    from numba.core import compiler, targetconfig
+    numba_speed.apply()
+    config = targetconfig.TargetConfig
+    a, b, c = compiler.Flags(), compiler.Flags(), compiler.Flags()
+    b.nrt, c.nrt = True, False       # c: set to the default's value, so alike a
+    pairs = [(a, b, False), (a, c, compiler.Flags.options["nrt"].default is False),
+             (b, b.copy(), True), (a, compiler.Flags(), True)]
+    for x, y, same in pairs:
+        assert (x == y) is same and (y == x) is same
+        # numba's own: every option's value, through its property
+        assert ({k: getattr(x, k) for k in x.options} == {k: getattr(y, k) for k in y.options}) \
+            is same
+        assert hash(x) == hash(tuple(sorted(x.options)))
+    assert config.values is not None and a.values() == {k: getattr(a, k) for k in a.options}

@@ -1,6 +1,6 @@
 """numba's compile in less time: two of its costs that make nothing, removed where this
-package's processes compile (a command, its compile children, the test suite; the Python
-API leaves numba as it is).  numba types, lowers and optimises the same IR either way: the
+package's processes compile (a command, its compile children, a sweep's workers, the test
+suite; the Python API leaves numba as it is).  numba types, lowers and optimises the same IR either way: the
 LLVM IR of the loop and of a broached hole's law is the same text with and without them
 (tests/test_cold_start.py), so the same machine code and the same cached kernels.
 

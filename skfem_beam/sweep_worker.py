@@ -3,6 +3,7 @@
 Ctrl-C in a terminal sends SIGINT to the whole process group, the workers included: each
 printed a KeyboardInterrupt traceback (30–80 lines) around the sweep's own one-line
 message.  The sweep process handles Ctrl-C and closes its cluster, so a worker ignores it.
+A worker compiles as its command does, without two of numba's idle costs (numba_speed).
 """
 import signal
 
@@ -10,3 +11,5 @@ import signal
 def dask_setup(worker) -> None:
     # called in the worker process's main thread, where its event loop runs
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    from skfem_beam import numba_speed
+    numba_speed.apply()

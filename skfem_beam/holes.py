@@ -63,7 +63,10 @@ class Hole:
         """Faces n·((v, w) − centre) ≤ gap, rows (ny, nz, gap), as written: a row whose
         normal is not of length 1 is normalised with its gap (2v ≤ 0.0004 is v ≤ 0.0002;
         the gap was kept, a hole twice as wide as written).  ``rows`` is not changed."""
-        rows = np.array(rows, dtype=float) if _is_table(rows) else None      # a copy
+        try:    # a ragged list (a face of two numbers) is no array
+            rows = np.array(rows, dtype=float) if _is_table(rows) else None      # a copy
+        except ValueError:
+            rows = None
         if rows is None or rows.ndim != 2 or rows.shape[1] != 3 or rows.shape[0] < 1:
             raise InputError("hole faces must be [[ny, nz, gap], ...] (at least one face)")
         if not np.isfinite(rows).all():
@@ -125,6 +128,11 @@ class Hole:
         the first centred at ``angle`` rad; open lobes between them (module docstring)."""
         lands = check_count("lands", lands, 2)
         width = check_finite("land_width", land_width)
+        if width == 0.0:    # the limit the lands' pieces degenerate in: the polygon is that
+            raise InputError(f"land_width=0°: lands of no width are the regular polygon "
+                             f"of {lands} sides, {{ sides = {lands}, radius = r, angle = "
+                             f"{angle:g} }} in a scene file (its angle in rad; "
+                             f"Hole.regular)")
         if not 0.0 < width <= 2 * math.pi / lands * (1 + 1e-12):
             raise InputError(f"land_width={math.degrees(width):g}° must be in (0, "
                              f"{360 / lands:g}]° (360/lands: the lands may not overlap)")

@@ -165,7 +165,9 @@ def test_the_outline_lies_on_the_wall(lands, width, angle):
 @pytest.mark.parametrize("table, word", [
     ({"lands": 1, "land_width": 40, "radius": R}, "lands=1"),
     ({"lands": 2.5, "land_width": 40, "radius": R}, "lands=2.5"),
-    ({"lands": 3, "land_width": 0, "radius": R}, "(0, 120]"),
+    ({"lands": 3, "land_width": 0, "radius": R, "angle": 90},     # the n-gon, named
+     "lands of no width are the regular polygon of 3 sides, { sides = 3, radius = r, "
+     "angle = 1.5708 } in a scene file (its angle in rad"),
     ({"lands": 3, "land_width": -5, "radius": R}, "(0, 120]"),
     ({"lands": 4, "land_width": 91, "radius": R}, "(0, 90]"),
     ({"lands": 3, "land_width": 40, "radius": 0.0}, "radius=0"),

@@ -308,6 +308,30 @@ def test_bad_set_key_is_refused_by_name(tmp_path, capsys, setting, word):
                    capsys, out)
 
 
+def test_set_an_item_of_an_array_of_values():
+    """--set replaces or appends an item of an array of numbers by its index, as it does
+    an array of tables' (``output.probes.0`` was "unknown key '0'; allows: none")."""
+    from skfem_beam.errors import InputError
+    from skfem_beam.scenefile.read import apply_set
+    data = {"kind": "beam", "output": {"probes": [0.75]}, "loads": [{"direction": [1.0, 0.0]}]}
+    for setting in ("output.probes.0=0.5", "output.probes[1]=0.25", "loads.0.direction.1=0.5",
+                    "obstacles.0.hole.centre.0=1e-4"):
+        assert apply_set(data, setting)[1] == setting.partition("=")[2]
+    assert data["output"]["probes"] == [0.5, 0.25]
+    assert data["loads"][0]["direction"] == [1.0, 0.5]
+    assert data["obstacles"][0]["hole"]["centre"] == [1e-4]   # the pair's check: the scene's
+    for setting, word in (("output.probes.3=1.0", "output.probes has 2 item(s); index '3' "
+                                                   "must be 0..1 (an item) or 2 (a new one)"),
+                          ("output.probes.0.x=1.0", "output.probes.0 is a value, not a table"),
+                          ("output.format.0=1.0", "output.format is a value, not a table")):
+        with pytest.raises(InputError) as e:
+            apply_set(data, setting)
+        assert word in str(e.value), str(e.value)
+    with pytest.raises(InputError) as e:     # a number where the array goes
+        apply_set({"kind": "beam", "output": {"probes": 0.5}}, "output.probes.0=1.0")
+    assert "output.probes is not an array in the file" in str(e.value)
+
+
 def test_unknown_key_message_lists_the_allowed_ones(tmp_path):
     with pytest.raises(Exception) as e:
         load(write(tmp_path, PIPE.replace("dt = 5e-5", "dt = 5e-5\nsteps = 3")))
@@ -920,6 +944,20 @@ def test_a_hole_radius_like_the_hole_s_own_warns(tmp_path, capsys):
                    "(0.0004 for 0.4 mm), not the hole's own radius"]
 
 
+@pytest.mark.parametrize("angle, warned", [(30.0, True), (-7.0, True), (0.5236, False)])
+def test_a_polygon_angle_beyond_a_turn_warns(tmp_path, capsys, angle, warned):
+    """A regular polygon's angle is in rad (a broached hole's in degrees): 30 meant as
+    degrees ran as 30 rad, another polygon, silently; beyond a turn it warns and runs."""
+    argv = [str(example("tube_round_holes")), "--set",
+            f"obstacles.0.hole={{sides=6,radius=0.0004,angle={angle}}}",
+            "--set", "time.T=0.005", "--format", "none", "--out", str(tmp_path / "r")]
+    assert exit_code(run_main, argv) == 0
+    err = [e for e in capsys.readouterr().err.splitlines() if e.startswith("warning")]
+    line = (f"warning: [obstacles.0] hole angle = {angle:g} is in rad for sides = n (a turn is "
+            f"6.283): {angle:g}° would be angle = {np.radians(angle):.6g}")
+    assert err == ([line] if warned else []), err
+
+
 
 @pytest.mark.parametrize("argv, line", [
     (["--set", "time.dt=-1e-5"], "error: scene.toml: [time] dt=-1e-05 must be > 0"),
@@ -989,6 +1027,8 @@ def test_the_bar_refuses_keys_it_ignored(tmp_path, capsys, setting, word):
     ("tube_round_holes.toml",
      "obstacles.0.hole={polygon=[[0.001,0.0,1.0],[0.0,0.001],[-0.001,0.0]]}",
      "hole polygon must be [[y1, z1], [y2, z2], ...]"),
+    ("tube_round_holes.toml", "obstacles.0.hole={faces=[[1.0,0.0],[-1.0,0.0,0.0004]]}",
+     "obstacles.0.hole: hole faces must be [[ny, nz, gap], ...]"),
     # a zero load, silently
     ("flat_obstacles.toml", "loads=[{per_mass=true,omega=10.0}]",
      "[loads.0] amplitude and omega go together"),

@@ -2,6 +2,8 @@
 point, over a span or along the whole beam) and the holes (two planes)."""
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..checks import check_finite
@@ -107,6 +109,19 @@ def _warn_hole_size(items, tube: float | None) -> None:
                  "(0.0004 for 0.4 mm), not the hole's own radius")
 
 
+def _warn_polygon_degrees(items) -> None:
+    """One warning line for a regular polygon's angle beyond a turn: it is in rad (a
+    broached hole's lands are in degrees, a drawing's), and 30 meant as degrees ran as
+    30 rad, another polygon, silently."""
+    from ..cli import warn
+    for i, o in items:
+        hole = o.get("hole") if isinstance(o.get("hole"), dict) else {}
+        a = hole.get("angle")
+        if "sides" in hole and isinstance(a, (int, float)) and abs(a) > 2 * math.pi:
+            warn(f"[obstacles.{i}] hole angle = {a:g} is in rad for sides = n (a turn is "
+                 f"6.283): {a:g}° would be angle = {math.radians(a):.6g}")
+
+
 def obstacles_and_holes(data: dict, L: float) -> tuple[Obstacles, tuple]:
     """The flat obstacles (the first plane's, g1 ≤ v ≤ g2) and the holes, each on the beam
     [0, L] (BeamProblem checks it too, without the key path)."""
@@ -121,6 +136,7 @@ def obstacles_and_holes(data: dict, L: float) -> tuple[Obstacles, tuple]:
                 raise InputError(f"obstacles.{i}: hole at x={b:g} lies outside the beam "
                                  f"[0, L={L:g}]")
     _warn_hole_size(items, outer_radius(data.get("section", {})))
+    _warn_polygon_degrees(items)
     if (mu or any("friction" in o for _, o in items)) and plane_count(data) != 2:
         raise InputError("friction acts along the wall of a hole, in the cross-section: the "
                          "one-plane beam has no tangential direction (planes = 2 and a hole)")

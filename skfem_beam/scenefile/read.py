@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import InputError
-from .schema import BEAM_KEYS, KINDS, Names, check_keys, key_path
+from .schema import BEAM_KEYS, KINDS, ListOf, Names, check_keys, key_path
 
 
 @dataclass(frozen=True)
@@ -103,48 +103,58 @@ def _toml_value(text: str):
 
 def apply_set(data: dict, assignment: str) -> tuple[str, str]:
     """``KEY=VALUE`` (KEY dotted, array items by index: ``obstacles.0.g1``, or
-    ``obstacles[0].g1`` as refusal lines write list items) into ``data``; a key the
-    scene's kind does not allow is refused by name.  Returns (KEY, VALUE), KEY dotted."""
+    ``obstacles[0].g1`` as refusal lines write list items; an item of an array of values
+    too, ``output.probes.0``) into ``data``; a key the scene's kind does not allow is
+    refused by name.  Returns (KEY, VALUE), KEY dotted."""
     key, eq, text = assignment.partition("=")
     if not eq or not key.strip():
         raise InputError(f"--set {assignment!r}: expected KEY=VALUE, e.g. time.dt=1e-5")
     parts = re.sub(r"\[(\d+)\]", r".\1", key.strip()).split(".")
+    value = text.strip()
     schema = KINDS.get(data.get("kind", "beam"), BEAM_KEYS)
     node, sub = data, schema
     for i, part in enumerate(parts):
         last = i == len(parts) - 1
-        if isinstance(sub, list):
-            items = node
-            if not part.isdigit() or int(part) > len(items):
-                n = len(items)
-                raise InputError(f"--set {key}: {key_path(parts[:i])} has {n} item(s); "
-                                 f"index {part!r} must be "
-                                 + (f"0..{n - 1} (an item) or " if n else "")
-                                 + f"{n} (a new one)")
-            if int(part) == len(items):
-                items.append({})
-            node, sub = items[int(part)], sub[0]
+        if isinstance(sub, (list, ListOf)):
+            k = _item_index(key, parts, i, node)
+            if isinstance(sub, ListOf) and last:    # an item of an array of values
+                node[k:k + 1] = [_toml_value(value)]
+                return ".".join(parts), value
+            if k == len(node):
+                node.append({} if isinstance(sub, list) else [])
+            node, sub = node[k], sub[0] if isinstance(sub, list) else sub.item
             if last:
                 raise InputError(f"--set {key}: name a key of the item, e.g. "
                                  f"{key}.{next(iter(sub))}")
             continue
         if isinstance(sub, Names) and last:
-            node[part] = _toml_value(text.strip())      # a name the objects check
-            return ".".join(parts), text.strip()
-        if not isinstance(sub, dict) or part not in sub:
-            allowed = ", ".join(sub) if isinstance(sub, dict) else "none"
+            node[part] = _toml_value(value)      # a name the objects check
+            return ".".join(parts), value
+        if not isinstance(sub, dict):
+            raise InputError(f"--set {key}: {key_path(parts[:i])} is a value, not a table: "
+                             f"set it whole, --set {key_path(parts[:i])}=...")
+        if part not in sub:
             raise InputError(f"--set {key}: unknown key {part!r}; "
                              f"{'[' + key_path(parts[:i]) + ']' if i else 'the top level'} "
-                             f"allows: {allowed}")
+                             f"allows: {', '.join(sub)}")
         if last:
-            node[part] = _toml_value(text.strip())
-            return ".".join(parts), text.strip()
-        child = sub[part]
-        if isinstance(child, list):
-            node = node.setdefault(part, [])
-        else:
-            node = node.setdefault(part, {})
-        sub = child
+            node[part] = _toml_value(value)
+            return ".".join(parts), value
+        node = node.setdefault(part, [] if isinstance(sub[part], (list, ListOf)) else {})
+        sub = sub[part]
+
+
+def _item_index(key: str, parts: list, i: int, items) -> int:
+    """``parts[i]`` as the index of an item of the array ``items`` (its length: a new
+    item), or one line saying what is allowed."""
+    if not isinstance(items, list):
+        raise InputError(f"--set {key}: {key_path(parts[:i])} is not an array in the file")
+    n, part = len(items), parts[i]
+    if not part.isdigit() or int(part) > n:
+        raise InputError(f"--set {key}: {key_path(parts[:i])} has {n} item(s); "
+                         f"index {part!r} must be "
+                         + (f"0..{n - 1} (an item) or " if n else "") + f"{n} (a new one)")
+    return int(part)
 
 
 class Tables:

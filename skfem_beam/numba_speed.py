@@ -1,8 +1,8 @@
 """numba's compile in less time: two of its costs that make nothing, removed where this
 package's processes compile (a command, its compile children, a sweep's workers, the test
-suite; the Python API leaves numba as it is).  numba types, lowers and optimises the same IR either way: the
-LLVM IR of the loop and of a broached hole's law is the same text with and without them
-(tests/test_cold_start.py), so the same machine code and the same cached kernels.
+suite; the Python API leaves numba as it is).  numba types, lowers and optimises the same
+IR either way: the LLVM IR of the loop and of a broached hole's law is the same text with
+and without them (tests/test_cold_start.py), so the same machine code and cached kernels.
 
 1. **The inliner's copies** (``inline="always"``).  numba deep-copies the IR of a helper it
    inlines block by block, each block with a copy memo of its own, so each block's copy
@@ -61,8 +61,11 @@ def _one_memo_per_copy() -> None:
             return copy.deepcopy(x, state.memo)
         return copy.deepcopy(x, memo)
 
+    shim = types.ModuleType("copy")     # the copy module, but for deepcopy
+    shim.__dict__.update(vars(copy))
+    shim.deepcopy = deepcopy
     ir.FunctionIR.copy = copy_starting
-    inline_closurecall.copy = types.SimpleNamespace(deepcopy=deepcopy, copy=copy.copy)
+    inline_closurecall.copy = shim
 
 
 def _quick_flags() -> None:

@@ -10,6 +10,8 @@ from .errors import InputError
 
 
 def check_finite(name: str, value) -> float:
+    if isinstance(value, (str, bytes)):     # float("0.2") would take it: the API's numbers
+        raise InputError(f"{name}={value!r} is a string: give a number")   # are numbers
     try:
         value = float(value)
     except (TypeError, ValueError):
@@ -25,7 +27,8 @@ def check_bound(name: str, value, of: str) -> None:
     if callable(value):
         return
     try:
-        ok = not np.iscomplexobj(value) and not math.isnan(float(value))
+        ok = not isinstance(value, (str, bytes)) and not np.iscomplexobj(value) \
+            and not math.isnan(float(value))
     except (TypeError, ValueError):
         ok = False
     if not ok:

@@ -26,7 +26,7 @@ from .output.options import OutputOptions
 from .output.folder import lock_folder
 from .output.checkpoint import (_resume_folder, check_resumable, has_checkpoint,
                                 read_checkpoint, read_summary)
-from .parser import Defaults, Parser
+from .parser import Defaults, Parser, same_sets
 from .scheme.stepping import MASSLESS, Stepping
 from .spec import RunSpec
 
@@ -349,6 +349,8 @@ def stored_args(args, parser, argv=None):
         if k == "T":
             raise InputError(f"--resume {out}: --T {v:g} is shorter than the run's T={T:g} "
                              "(a run can only be extended)")
+        if k == "set" and same_sets(v, config.get("set")):
+            continue        # the same settings, written another way
         if k not in config or config[k] != v:
             raise InputError(f"--resume {out}: {_as_given(k, v)}, where the run had "
                              f"{_as_given(k, config.get(k))}; a resumed run keeps its scene "

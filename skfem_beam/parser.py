@@ -3,13 +3,16 @@ and exit code 2 (``errors.EXIT_INPUT``), not a usage block.  ``cli`` builds the 
 flags on it; ``results.export_main`` and the scene file's subcommands use it too."""
 import argparse
 import re
+import tomllib
 
 from .errors import EXIT_INPUT
 
 
 # a negative number argparse takes for a value, not a flag: its own "-1", "-.5", and also
-# "-1e-3" ("--dt -1e-3" read "expected one argument", "--v0 -1e-1" was unusable)
-NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
+# "-1e-3" ("--dt -1e-3" read "expected one argument", "--v0 -1e-1" was unusable), and a
+# list that starts with one ("--values -5,10" read "expected one argument" too)
+_NUMBER = r"(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?"
+NEGATIVE_NUMBER = re.compile(rf"^-{_NUMBER}(\s*,\s*-?{_NUMBER})*$")
 
 
 class Parser(argparse.ArgumentParser):
@@ -80,3 +83,33 @@ def about(doc: str) -> str:
     """A command's --help description: its module docstring's first paragraph, joined
     (its first line alone stopped mid-sentence)."""
     return " ".join((doc or "").strip().split("\n\n")[0].split())
+
+
+def toml_value(text: str):
+    """``text`` as a TOML value (number, boolean, array, inline table, quoted string);
+    a bare word is a string (``--set ends.right=free``)."""
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        return text
+
+
+def set_pair(assignment: str) -> tuple[str, object]:
+    """A ``--set KEY=VALUE`` as (KEY dotted, ``obstacles[0].x`` as ``obstacles.0.x``,
+    VALUE read as TOML)."""
+    key, _, text = assignment.partition("=")
+    return re.sub(r"\[(\d+)\]", r".\1", key.strip()), toml_value(text.strip())
+
+
+def same_sets(a, b) -> bool:
+    """Whether two lists of ``--set`` flags set the same values however written (a key
+    dotted or indexed, 0.30 or 0.3), in any order where no key is set twice or inside
+    another (then their order decides, and is compared too)."""
+    pa, pb = [set_pair(x) for x in a or ()], [set_pair(x) for x in b or ()]
+    if pa == pb:
+        return True
+    keys = [k for k, _ in pa]
+    nested = any(i != j and (k == q or q.startswith(k + "."))
+                 for i, k in enumerate(keys) for j, q in enumerate(keys))
+    return not nested and len(pa) == len(pb) and \
+        sorted(pa, key=lambda p: p[0]) == sorted(pb, key=lambda p: p[0])

@@ -303,6 +303,8 @@ class Obstacles:
     def stops(cls, x, g1, g2, carried: bool = False, name: str = "") -> "Obstacles":
         """Point stops g1[i] ≤ u(x[i]) ≤ g2[i] (numbers apply to every x; ±inf: one-sided)."""
         xs = np.atleast_1d(np.asarray(x, dtype=float))
+        if xs.size == 0:
+            raise InputError("Obstacles.stops needs one x or more (x=[] holds no stop)")
         for key, g in (("g1", g1), ("g2", g2)):    # complex: a TypeError, or cast silently
             for v in np.atleast_1d(np.asarray(g, dtype=object)).ravel():
                 check_bound(key, v, "x")

@@ -117,7 +117,7 @@ def _initial(problem: BeamProblem, space, lift: Lifting | None):
     starts away from 0, and the interpolant dropped the gap, a kink whose strain energy grew
     as J³."""
     ini = problem.initial
-    u0f, du0f, v0f = ini.u0, ini.du0, ini.v0
+    u0f, du0f, v0f = (_shaped(name, getattr(ini, name)) for name in ("u0", "du0", "v0"))
     if ini.fixed_frame and lift is not None:
         p0, dp0 = float(lift.motion.phi(0.0)), float(lift.motion.phi_d(0.0))
         zero = lambda x: np.zeros(np.shape(x))  # noqa: E731
@@ -144,6 +144,28 @@ def _initial(problem: BeamProblem, space, lift: Lifting | None):
     if not (np.isfinite(u0).all() and np.isfinite(v0).all()):
         raise InputError("the initial state u0, v0 is not finite")
     return u0, v0
+
+
+def _shaped(name: str, f):
+    """The profile ``f`` of InitialState, its values checked: of x's shape (or one that
+    broadcasts to it), else one line naming it (numpy's broadcast error came from inside
+    the projection)."""
+    if f is None:
+        return None
+
+    def checked(x):
+        values = f(x)
+        shape = np.shape(values)
+        try:
+            ok = np.broadcast_shapes(shape, np.shape(x)) == np.shape(x)
+        except ValueError:
+            ok = False
+        if not ok:
+            raise InputError(f"InitialState {name}(x) returned shape {shape} for x of shape "
+                             f"{np.shape(x)}: a profile is a vectorised function of x, one "
+                             "value per x")
+        return values
+    return checked
 
 
 def _meets_support(problem: BeamProblem, u, p0: float) -> None:

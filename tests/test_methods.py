@@ -16,6 +16,7 @@ from skfem_beam.scheme import Stepping, drive, solve
 from skfem_beam.scenefile import load
 from skfem_beam.scheme.solve import moreau_jean
 from skfem_beam.semidiscrete import beam_system
+from skfem_beam.problem import Beam, BeamProblem, Obstacles
 
 from test_motion import observe_constraints, span_problem
 
@@ -187,3 +188,49 @@ def test_a_penalty_in_newtons_per_metre_needs_the_beams_mass_per_length():
         solve(beam_system(problem), 1e-4, 0.01, method=Penalty(1e8), progress=False)
     assert solve(beam_system(problem), 1e-4, 0.01, progress=False,
                  method=Penalty(1e8, equation_units=True)).success
+
+
+def test_api_numbers_written_as_strings_are_refused():
+    """float("0.2") took a string silently (dt, T, L, k2, a load, a support's amplitude,
+    which ended in numpy's UFuncTypeError inside solve): one line each, as J='19' had."""
+    from skfem_beam import Load, Support
+    for build, word in ((lambda: Beam("1.5", k2=282.84, rho_S=0.1), "L='1.5' is a string"),
+                        (lambda: Support(amplitude="0.2", omega=10.0),
+                         "amplitude='0.2' is a string"),
+                        (lambda: Load.point(1.0, "0.5"), "'0.5' is a string"),
+                        (lambda: Obstacles.point_stops(1.5, "-0.1", 0.1), "g1='-0.1' must be")):
+        with pytest.raises(InputError) as e:
+            build()
+        assert word in str(e.value), str(e.value)
+
+
+def test_a_beta_beside_a_method_that_has_its_own_or_none_is_refused():
+    """solve(beta=) beside PositionLevel(beta=0.3) ran with 0.25, beside Moreau–Jean it
+    was dropped: one line each; the same β twice, or β with a method at its default
+    (which it sets: the shorthand), runs."""
+    system = beam_system(BeamProblem(Beam(1.0, k2=1.0), Obstacles.point_stops(1.0, -0.1, 0.1),
+                                     J=4))
+    for method, word in ((PositionLevel(beta=0.3), "beta=0.25 beside the method's beta=0.3"),
+                         (MoreauJean(theta=0.5), "Moreau–Jean has no β")):
+        with pytest.raises(InputError) as e:
+            solve(system, 1e-3, 2e-3, beta=0.25, method=method)
+        assert word in str(e.value), str(e.value)
+    assert solve(system, 1e-3, 2e-3, beta=0.5, method=PositionLevel(beta=0.5)).beta == 0.5
+    assert solve(system, 1e-3, 2e-3, beta=0.25, method=PositionLevel()).beta == 0.25
+    with pytest.raises(InputError, match="needs one x or more"):
+        Obstacles.stops([], -0.1, 0.1)
+
+
+def test_an_initial_profile_of_the_wrong_shape_is_one_line():
+    """InitialState(v0=f) with f(x) of another shape than x ended in numpy's broadcast
+    error from inside the projection: one line naming v0 (a scalar still broadcasts)."""
+    from skfem_beam import InitialState
+    for initial, ok in ((InitialState(v0=lambda x: np.zeros(3)), False),
+                        (InitialState(v0=lambda x: 0.0 * x + 0.01), True)):
+        problem = BeamProblem(Beam(1.0, k2=1.0), Obstacles.point_stops(1.0, -0.1, 0.1), J=4,
+                              initial=initial)
+        if ok:
+            assert np.abs(beam_system(problem).v0).max() > 0
+            continue
+        with pytest.raises(InputError, match=r"InitialState v0\(x\) returned shape \(3,\)"):
+            beam_system(problem)

@@ -898,6 +898,23 @@ def test_resume_names_a_changed_set_or_scene_as_written(tmp_path, capsys):
             "--T may grow: extend it with --T)\n")
 
 
+def test_resume_takes_the_run_s_set_however_written(tmp_path, capsys):
+    """--resume with the run's own --set written another way (indexed, 0.30, another
+    order) is the same run (it was refused as a change); one that changes a value, or
+    reorders a table and a key inside it (order decides), is not."""
+    from skfem_beam.parser import same_sets
+    src = write(tmp_path, PIPE + '[output]\nformat = "none"\nprobes = [0.5]\n')
+    out = tmp_path / "run"
+    run = ["--set", "time.T=0.02", "--set", "output.probes.0=0.3"]
+    assert exit_code(run_main, [str(src), "--out", str(out), *run]) == 0
+    capsys.readouterr()
+    again = ["--set", "output.probes[0]=0.30", "--set", "time.T=0.02", "--T", "0.03"]
+    assert exit_code(run_main, ["--resume", str(out), *again]) == 0
+    assert same_sets(["a.b=1", "c=[1, 2]"], ["c = [1.0, 2]", "a.b=1.0"])
+    assert not same_sets(["a.b=1"], ["a.b=2"]) and not same_sets(["a=1"], ["a=1", "b=2"])
+    assert not same_sets(["a={b=1}", "a.b=2"], ["a.b=2", "a={b=1}"])
+
+
 def test_a_T_between_steps_says_where_the_run_ends(tmp_path, capsys):
     """The run ends at the first step at or after T (⌈T/Δt⌉ steps): one line says so."""
     argv = [str(write(tmp_path, PIPE)), "--format", "none", "--set", "time.dt=3e-5"]

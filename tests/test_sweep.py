@@ -176,6 +176,7 @@ def test_a_signal_after_the_last_value_lets_every_file_be_written(tmp_path, monk
     (["--values", "5,nan"], "nan is not a finite number"),
     (["--values", "5,5"], "repeat"),
     (["--values=-2,5"], "omega=-2 must be > 0"),
+    (["--values", "-2,5"], "omega=-2 must be > 0"),    # argparse: "expected one argument"
     (["--param", "gap", "--values", "linspace(0, 0.1, 3)"], "gap=0 must be > 0"),
     (["--param", "amplitude", "--omega", "0"], "omega=0 must be > 0"),
     (["--periods", "0"], "periods=0"),

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import InputError
+from ..parser import toml_value
 from .schema import BEAM_KEYS, KINDS, ListOf, Names, check_keys, key_path
 
 
@@ -92,15 +93,6 @@ def scene_path(path) -> Path:
     return path
 
 
-def _toml_value(text: str):
-    """``text`` as a TOML value (number, boolean, array, inline table, quoted string);
-    a bare word is a string (``--set ends.right=free``)."""
-    try:
-        return tomllib.loads(f"v = {text}")["v"]
-    except tomllib.TOMLDecodeError:
-        return text
-
-
 def apply_set(data: dict, assignment: str) -> tuple[str, str]:
     """``KEY=VALUE`` (KEY dotted, array items by index: ``obstacles.0.g1``, or
     ``obstacles[0].g1`` as refusal lines write list items; an item of an array of values
@@ -118,7 +110,7 @@ def apply_set(data: dict, assignment: str) -> tuple[str, str]:
         if isinstance(sub, (list, ListOf)):
             k = _item_index(key, parts, i, node)
             if isinstance(sub, ListOf) and last:    # an item of an array of values
-                node[k:k + 1] = [_toml_value(value)]
+                node[k:k + 1] = [toml_value(value)]
                 return ".".join(parts), value
             if k == len(node):
                 node.append({} if isinstance(sub, list) else [])
@@ -128,7 +120,7 @@ def apply_set(data: dict, assignment: str) -> tuple[str, str]:
                                  f"{key}.{next(iter(sub))}")
             continue
         if isinstance(sub, Names) and last:
-            node[part] = _toml_value(value)      # a name the objects check
+            node[part] = toml_value(value)      # a name the objects check
             return ".".join(parts), value
         if not isinstance(sub, dict):
             raise InputError(f"--set {key}: {key_path(parts[:i])} is a value, not a table: "
@@ -138,7 +130,7 @@ def apply_set(data: dict, assignment: str) -> tuple[str, str]:
                              f"{'[' + key_path(parts[:i]) + ']' if i else 'the top level'} "
                              f"allows: {', '.join(sub)}")
         if last:
-            node[part] = _toml_value(value)
+            node[part] = toml_value(value)
             return ".".join(parts), value
         node = node.setdefault(part, [] if isinstance(sub[part], (list, ListOf)) else {})
         sub = sub[part]

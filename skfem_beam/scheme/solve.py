@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 import sys
 
+from ..checks import check_beta
 from ..errors import InputError, SolverError
 from ..system import SemiDiscrete
 from .methods import MoreauJean, Penalty, PositionLevel, with_beta
@@ -28,8 +29,10 @@ def solve(system, dt: float, T: float, beta: float | None = None, method=None, *
     restitution)``); None: ``PositionLevel()``, exact contact by the cheapest exact law.
     β is the β-scheme method's (default: the method's own, 1/2 for exact contact, 1/4 for
     springs); ``beta``: a shorthand that sets it (``replace(method, beta=beta)``); None:
-    the method's as it is.  Moreau–Jean has no β: with it ``beta`` is checked and not
-    used.  ``recording``: any of ``save_every`` (1), ``frames`` (200),
+    the method's as it is.  A ``beta`` beside a method that sets another than its
+    default, or beside Moreau–Jean (no β), is refused in one line (it was overridden or
+    ignored silently).
+    ``recording``: any of ``save_every`` (1), ``frames`` (200),
     ``load_window`` ("forward"), ``growth_limit`` (10): see :class:`Stepping`.
 
     The run stops with status "unstable" when the discrete energy exceeds
@@ -51,6 +54,7 @@ def solve(system, dt: float, T: float, beta: float | None = None, method=None, *
     if unknown:
         raise TypeError(f"solve() got an unexpected keyword argument {unknown[0]!r} "
                         f"(it takes {', '.join(RECORDING)} and progress)")
+    _check_beta_beside(method, beta)
     method = with_beta(method, beta)
     stepping = Stepping(dt, T, **recording, massless=method.massless)
     rows = stepping.steps // stepping.save_every + 1
@@ -63,6 +67,18 @@ def solve(system, dt: float, T: float, beta: float | None = None, method=None, *
     run = method.build(system, stepping)
     drive(run, progress=progress)
     return run.result()
+
+
+def _check_beta_beside(method, beta) -> None:
+    """``beta`` given with ``method``: refused where one of them would be dropped."""
+    if beta is None:
+        return
+    if isinstance(method, MoreauJean):
+        raise InputError(f"beta={beta!r}: Moreau–Jean has no β (its parameter is "
+                         f"theta={method.theta:g}); leave beta out")
+    # a method's β is its default unless set (the two are one value once it is built)
+    if method.beta != method.default_beta and check_beta(beta) != method.beta:
+        raise InputError(f"beta={beta:g} beside the method's beta={method.beta:g}: give one")
 
 
 def moreau_jean(system, dt: float, T: float, theta: float = 0.5, restitution: float = 0.0,

@@ -961,6 +961,35 @@ def test_a_hole_radius_like_the_hole_s_own_warns(tmp_path, capsys):
                    "(0.0004 for 0.4 mm), not the hole's own radius"]
 
 
+@pytest.mark.parametrize("setting, line", [
+    ("wear.land=19.0", "warning: [wear] land = 19 m is longer than the beam (L = 1.5 m): it "
+                       "is the baffle's thickness in m (0.019 for 19 mm)"),
+    ("wear.radius=9.525", "warning: [wear] radius = 9.525 m is 1000× the section's outer "
+                          "radius 0.009525 m: it is the tube's outer radius in m (0.009525 "
+                          "for 9.525 mm)"),
+    ("wear.land=0.019", None)])
+def test_a_wear_size_in_mm_written_as_m_warns(tmp_path, capsys, setting, line):
+    """A [wear] land or radius in mm written as m made the depth 1000 times too small
+    and dropped the wear-through warning, silently: one line, and it runs."""
+    argv = [str(example("tube_round_holes_friction")), "--set", setting,
+            "--set", "time.T=0.005", "--format", "none", "--out", str(tmp_path / "r")]
+    assert exit_code(run_main, argv) == 0
+    err = [e for e in capsys.readouterr().err.splitlines() if e.startswith("warning: [wear]")]
+    assert err == ([line] if line else []), err
+
+
+def test_a_hole_in_a_one_plane_scene_asks_for_planes_first(tmp_path, capsys):
+    """A hole beside g1, g2 in a one-plane file was told to leave out g1, g2, and then
+    that it needs planes = 2: the planes first."""
+    src = example("heat_exchanger_tube").read_text()
+    assert "planes" not in src and "g1 = " in src
+    out = tmp_path / "out"
+    out.mkdir()
+    assert_refused(run_main, [str(example("heat_exchanger_tube")), "--set",
+                              "obstacles.0.hole={radius=0.0004}", "--out", str(out / "r")],
+                   "it needs planes = 2 at the top of the file", capsys, out)
+
+
 @pytest.mark.parametrize("angle, warned", [(30.0, True), (-7.0, True), (0.5236, False)])
 def test_a_polygon_angle_beyond_a_turn_warns(tmp_path, capsys, angle, warned):
     """A regular polygon's angle is in rad (a broached hole's in degrees): 30 meant as

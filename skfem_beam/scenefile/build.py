@@ -205,14 +205,33 @@ def wear(scene: Scene):
     sections = [s.get("section", {}) for s in scene.data.get("segments", [])] or \
         [scene.data.get("section", {})]
     radii = {outer_radius(section) for section in sections}     # a stepped tube's: one?
-    radius = d.get("radius", radii.pop() if len(radii) == 1 else None)
+    outer = radii.pop() if len(radii) == 1 else None
+    radius = d.get("radius", outer)
     if radius is None and "land" in d:
         raise InputError("[wear] radius (m, the tube's outer radius) is needed for the depth "
                          "(land) when the section is not a tube or a rod, or its segments' "
                          "outer diameters differ")
     walls = {section.get("tube", {}).get("wall") for section in sections}
     given = need(d, ("coefficient", "service_years"), "wear")
-    return Wear(given["coefficient"], given["service_years"], d.get("land"), radius,
+    worn = Wear(given["coefficient"], given["service_years"], d.get("land"), radius,
                 walls.pop() if len(walls) == 1 else None)
+    _warn_wear_sizes(worn, scene.problem.beam.L, outer)
+    return worn
+
+
+def _warn_wear_sizes(worn, L: float, section: float | None) -> None:
+    """One warning line for a [wear] land longer than the beam, or a radius ten times
+    the section's outer radius or more (none: longer than the beam): a size in mm written
+    as m (19 for 0.019) made the depth 1000 times too small and dropped the wear-through
+    warning."""
+    from ..cli import warn
+    if worn.land is not None and worn.land > L:
+        warn(f"[wear] land = {worn.land:g} m is longer than the beam (L = {L:g} m): it is "
+             "the baffle's thickness in m (0.019 for 19 mm)")
+    r = worn.radius
+    if r is not None and (r >= 10 * section if section else r > L):
+        warn(f"[wear] radius = {r:g} m is " + (f"{r / section:.4g}× the section's outer "
+             f"radius {section:g} m" if section is not None else f"longer than the beam "
+             f"(L = {L:g} m)") + ": it is the tube's outer radius in m (0.009525 for 9.525 mm)")
 
 

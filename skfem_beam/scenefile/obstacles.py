@@ -129,6 +129,9 @@ def obstacles_and_holes(data: dict, L: float) -> tuple[Obstacles, tuple]:
     mu = data.get("contact", {}).get("friction", 0.0)
     if check_finite("[contact] friction", mu) < 0:     # also where every hole sets its own
         raise InputError(f"[contact] friction={mu:g} must be ≥ 0 (Coulomb's μ)")
+    if any("hole" in o for _, o in items) and plane_count(data) != 2:   # first: the other
+        raise InputError("[[obstacles]] hole bounds (v, w) in the cross-section: it needs "
+                         "planes = 2 at the top of the file")       # lines assume it
     holes = tuple(_hole(o, i, mu) for i, o in items if "hole" in o)
     for i, h in zip([i for i, o in items if "hole" in o], holes):
         for b in h.breakpoints:
@@ -150,9 +153,6 @@ def obstacles_and_holes(data: dict, L: float) -> tuple[Obstacles, tuple]:
     if mu and not holes:        # it ran frictionless without a word
         raise InputError(f"[contact] friction={mu:g} acts at a hole's wall: this scene has "
                          "no hole ([[obstacles]] hole = ...)")
-    if holes and plane_count(data) != 2:
-        raise InputError("[[obstacles]] hole bounds (v, w) in the cross-section: it needs "
-                         "planes = 2 at the top of the file")
     parts = [_obstacle(o, i) for i, o in items if "hole" not in o]
     if not parts:
         return Obstacles(), holes

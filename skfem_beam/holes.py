@@ -359,6 +359,7 @@ class HoleAt:
     x_to: float | None = None
     carried: bool = False
     friction: float = 0.0
+    name: str = ""          # how error lines name it (a scene file's obstacles.<i>)
 
     def __post_init__(self):
         object.__setattr__(self, "x", check_finite("x", self.x))

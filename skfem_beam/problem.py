@@ -63,7 +63,7 @@ class Section:
         wall = check_positive("wall", wall)
         if wall >= D / 2:
             raise InputError(f"wall={wall:g} must be less than the outer radius {D / 2:g} "
-                             "(a solid rod: Section.rod)")
+                             "(a solid rod: [section] rod = { diameter = d }, Section.rod)")
         d = D - 2 * wall
         return cls(math.pi * (D**4 - d**4) / 64, math.pi * (D**2 - d**2) / 4)
 
@@ -657,8 +657,8 @@ class BeamProblem:
                 raise InputError(f"obstacle break point x={b:g} lies outside [0, L={self.beam.L:g}]")
             d = np.abs(self.nodes - b).min()
             if d > 1e-9 * self.beam.L:
-                owner = [o.name for o in self.obstacles.parts or (self.obstacles,)
-                         if b in o.breakpoints and o.name]
+                owner = [o.name for o in (*(self.obstacles.parts or (self.obstacles,)),
+                                          *self.holes) if b in o.breakpoints and o.name]
                 raise InputError(f"{_named(owner[0] if owner else '')}the mesh has no node at "
                                  f"the obstacle break point x={b:g} (nearest node {d:.3g} m "
                                  "away); choose J so that it is a node")

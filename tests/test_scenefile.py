@@ -978,6 +978,21 @@ def test_a_wear_size_in_mm_written_as_m_warns(tmp_path, capsys, setting, line):
     assert err == ([line] if line else []), err
 
 
+def test_a_hole_off_the_mesh_is_named_and_modes_write_no_minus_zero(tmp_path, capsys):
+    """A hole at no node was refused without its key (a flat obstacle's line has it); a
+    mode's shape at a held node was written -0."""
+    out = tmp_path / "out"
+    out.mkdir()
+    assert_refused(run_main, [str(example("tube_round_holes")), "--set", "obstacles.0.x=0.52",
+                              "--out", str(out / "r")],
+                   "tube_round_holes.toml: obstacles.0: the mesh has no node at the obstacle "
+                   "break point x=0.52", capsys, out)
+    assert exit_code(modes_main, [str(example("tube_round_holes")), "--out",
+                                  str(tmp_path / "m")]) == 0
+    text = (tmp_path / "m" / "modes.csv").read_text()
+    assert ",-0," not in text and not text.count(",-0\n"), text[:300]
+
+
 def test_a_hole_in_a_one_plane_scene_asks_for_planes_first(tmp_path, capsys):
     """A hole beside g1, g2 in a one-plane file was told to leave out g1, g2, and then
     that it needs planes = 2: the planes first."""

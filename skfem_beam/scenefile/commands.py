@@ -279,7 +279,7 @@ def _write_modes(out: Path, rows: list, x, two: bool) -> None:
                    + [f"u({float(xi):.12g})" for xi in x])
         for i, (f, om, p, shape) in enumerate(rows, 1):
             w.writerow([i] + ([p] if two else []) + [f"{f:.17g}", f"{om:.17g}"]
-                       + [f"{u:.17g}" for u in shape])
+                       + [f"{u + 0.0:.17g}" for u in shape])     # −0 at a held node: 0
 
 
 def _modes_folder(out: Path, overwrite: bool):

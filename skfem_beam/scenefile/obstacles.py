@@ -63,7 +63,7 @@ def _hole(o: dict, i: int, friction: float = 0.0):
     else:
         at = tuple(need(o, ("x_from", "x_to"), where).values())
     return _named(where, lambda: HoleAt(hole, *at, carried=o.get("carried", False),
-                                        friction=mu))
+                                        friction=mu, name=where))
 
 
 def _named(where: str, make):

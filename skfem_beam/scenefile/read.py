@@ -6,13 +6,12 @@ from __future__ import annotations
 
 import base64
 import hashlib
-import re
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import InputError
-from ..parser import toml_value
+from ..parser import set_pair
 from .schema import BEAM_KEYS, KINDS, ListOf, Names, check_keys, key_path
 
 
@@ -101,8 +100,8 @@ def apply_set(data: dict, assignment: str) -> tuple[str, str]:
     key, eq, text = assignment.partition("=")
     if not eq or not key.strip():
         raise InputError(f"--set {assignment!r}: expected KEY=VALUE, e.g. time.dt=1e-5")
-    parts = re.sub(r"\[(\d+)\]", r".\1", key.strip()).split(".")
-    value = text.strip()
+    dotted, parsed = set_pair(assignment)
+    parts, value = dotted.split("."), text.strip()
     schema = KINDS.get(data.get("kind", "beam"), BEAM_KEYS)
     node, sub = data, schema
     for i, part in enumerate(parts):
@@ -110,7 +109,7 @@ def apply_set(data: dict, assignment: str) -> tuple[str, str]:
         if isinstance(sub, (list, ListOf)):
             k = _item_index(key, parts, i, node)
             if isinstance(sub, ListOf) and last:    # an item of an array of values
-                node[k:k + 1] = [toml_value(value)]
+                node[k:k + 1] = [parsed]
                 return ".".join(parts), value
             if k == len(node):
                 node.append({} if isinstance(sub, list) else [])
@@ -120,7 +119,7 @@ def apply_set(data: dict, assignment: str) -> tuple[str, str]:
                                  f"{key}.{next(iter(sub))}")
             continue
         if isinstance(sub, Names) and last:
-            node[part] = toml_value(value)      # a name the objects check
+            node[part] = parsed      # a name the objects check
             return ".".join(parts), value
         if not isinstance(sub, dict):
             raise InputError(f"--set {key}: {key_path(parts[:i])} is a value, not a table: "
@@ -130,7 +129,7 @@ def apply_set(data: dict, assignment: str) -> tuple[str, str]:
                              f"{'[' + key_path(parts[:i]) + ']' if i else 'the top level'} "
                              f"allows: {', '.join(sub)}")
         if last:
-            node[part] = toml_value(value)
+            node[part] = parsed
             return ".".join(parts), value
         node = node.setdefault(part, [] if isinstance(sub[part], (list, ListOf)) else {})
         sub = sub[part]

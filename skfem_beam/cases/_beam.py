@@ -366,7 +366,8 @@ def units(rho_S, system, friction: bool = False) -> dict:
              "work of Coulomb friction (≤ 0; Moreau–Jean's, taken on each step's "
              "displacement while Coulomb's law holds for v^{n+1}, may rise on a step whose "
              "slip reverses, its total ≤ 0)")
-    out = {"t": "s", "displacement": "m",
+    out = {"t": "s", "displacement": "m: the field series' displacement (fields.xdmf, "
+                                      "fields.pvd), no column here",
            "tip_displacement": f"m, {held}{frame}",
            "tip_velocity": "m/s, backward difference of tip_displacement"
                            + (" plus h(L)φ'(t)" if lift is not None else ""),
